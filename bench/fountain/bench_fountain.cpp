@@ -1,0 +1,191 @@
+// The fountain workload: the fused update and the whole step against the machine's
+// in-place read-modify-write bandwidth and against an unfused baseline, in one run.
+//
+//   build/release/bench/bench_fountain --benchmark_repetitions=5
+//
+// After the runs it prints a summary of ratios between the medians of this run.
+#include <benchmark/benchmark.h>
+#include <sys/mman.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "builtin.hpp"
+#include "flurry/flurry.hpp"
+
+using namespace flurry;
+
+namespace {
+
+unsigned threads() { return std::max(1u, std::thread::hardware_concurrency()); }
+
+// Bytes the fountain's update reads and writes per particle-step: position and velocity
+// read and written (24 + 24), age read and written (4 + 4), lifetime read (4).
+constexpr double kUpdateBytes = 60.0;
+constexpr int kLanes = 9;  // position 3, velocity 3, age, lifetime, id
+
+ActionList fountainActions() {
+  return {Gravity{Vec3(0.0f, -9.81f, 0.0f)},
+          Bounce{Domain::plane(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f)), 0.4f, 0.1f, 0.0f}, Move{},
+          KillOld{}};
+}
+
+// A group of n immortal fountain particles: the update pass alone, no deaths, no births.
+void UpdatePass(benchmark::State& state, bool fused) {
+  const auto n = std::size_t(state.range(0));
+  ContextOptions o;
+  o.threads = threads();
+  o.fused = fused;
+  Context ctx(o);
+  Group& g = ctx.createGroup("fountain", n);
+  Emitter e;
+  e.shape = Domain::disc(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f), 0.1f);
+  ParticleType t;
+  t.velocity = Domain::cone(Vec3(0.0f), Vec3(0.0f, 8.0f, 0.0f), 1.5f);
+  t.lifetime = 1e30f;
+  e.types = {t};
+  e.bursts = {{0.0, std::uint32_t(n), 0.0, 1}};
+  g.addEmitter(e);
+  g.setActions(fountainActions());
+  ctx.step();  // emits all n
+  for (auto _ : state) ctx.step();
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(n));
+  state.SetBytesProcessed(std::int64_t(double(state.iterations()) * double(n) * kUpdateBytes));
+  state.counters["B/particle"] = g.attributes().bytesPerParticle();
+}
+
+// The whole step at steady state: 10 % of the particles die and are born every step.
+void FountainStep(benchmark::State& state) {
+  const auto n = std::size_t(state.range(0));
+  ContextOptions o;
+  o.threads = threads();
+  Context ctx(o);
+  // Mean lifetime 10 steps of 1/30 s, rate 3n/s: about n alive, n/10 born per step.
+  Group& g = samples::buildFountain(ctx, n + n / 2, 3.0 * double(n), 1.0f / 3.0f);
+  g.setActions(fountainActions());
+  ctx.run(30);
+  std::uint64_t born = g.stats().emitted;
+  double live = 0;
+  for (auto _ : state) {
+    ctx.step();
+    live += double(g.size());
+  }
+  born = g.stats().emitted - born;
+  const double mean = live / double(state.iterations());
+  state.SetItemsProcessed(std::int64_t(live));
+  state.SetBytesProcessed(std::int64_t(live * kUpdateBytes));
+  state.counters["live"] = mean;
+  state.counters["born/step"] = double(born) / double(state.iterations());
+  state.counters["B/particle"] = g.attributes().bytesPerParticle();
+}
+
+// Emission alone (nearly): every particle dies after one step and n are born per step.
+void Emission(benchmark::State& state) {
+  const auto n = std::size_t(state.range(0));
+  ContextOptions o;
+  o.threads = threads();
+  Context ctx(o);
+  Group& g = samples::buildFountain(ctx, n, double(n) / o.dt, 1e-6f);
+  g.setActions({KillOld{}});
+  ctx.run(3);
+  const std::uint64_t before = g.stats().emitted;
+  for (auto _ : state) ctx.step();
+  const double born = double(g.stats().emitted - before);
+  state.SetItemsProcessed(std::int64_t(born));
+  state.counters["ns/newborn/core"] = benchmark::Counter(
+      born / threads() * 1e-9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+// The ceiling: a[i] = a[i]*s + c over arrays of the same total size as the group's lanes,
+// allocated the same way (huge pages), on the same number of threads.
+void ReadModifyWrite(benchmark::State& state) {
+  const auto n = std::size_t(state.range(0));
+  std::vector<float*> arrays;
+  const std::size_t bytes = (n * 4 + (2u << 20) - 1) / (2u << 20) * (2u << 20);
+  for (int k = 0; k < kLanes; ++k) {
+    auto* a = static_cast<float*>(std::aligned_alloc(2u << 20, bytes));
+    madvise(a, bytes, MADV_HUGEPAGE);
+    for (std::size_t i = 0; i < n; ++i) a[i] = float(i & 1023);
+    arrays.push_back(a);
+  }
+  const unsigned t = threads();
+  for (auto _ : state) {
+    std::vector<std::thread> pool;
+    for (unsigned w = 0; w < t; ++w)
+      pool.emplace_back([&, w] {
+        const std::size_t lo = n * w / t, hi = n * (w + 1) / t;
+        for (float* a : arrays) {
+          float* __restrict p = a;
+          for (std::size_t i = lo; i < hi; ++i) p[i] = p[i] * 0.999f + 0.001f;
+        }
+      });
+    for (auto& th : pool) th.join();
+    benchmark::ClobberMemory();
+  }
+  state.SetBytesProcessed(std::int64_t(double(state.iterations()) * double(n) * kLanes * 8.0));
+  for (float* a : arrays) std::free(a);
+}
+
+// Prints ratios between the medians (or single runs) of this process's benchmarks.
+class RatioReporter : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    ConsoleReporter::ReportRuns(runs);
+    for (const Run& r : runs) {
+      const bool median = r.run_type == Run::RT_Aggregate && r.aggregate_name == "median";
+      if (r.run_type == Run::RT_Iteration && r.repetitions > 1) continue;
+      if (r.run_type == Run::RT_Aggregate && !median) continue;
+      const auto it = r.counters.find("bytes_per_second");
+      const auto items = r.counters.find("items_per_second");
+      std::string name = r.run_name.function_name + "/" + r.run_name.args;
+      if (it != r.counters.end()) bytes_[name] = it->second;
+      if (items != r.counters.end()) items_[name] = items->second;
+    }
+  }
+  void Finalize() override {
+    ConsoleReporter::Finalize();
+    std::printf("\nSummary (%u threads; GB/s count the bytes of the attributes read and written):\n",
+                threads());
+    for (const char* n : {"1048576", "4194304"}) {
+      const std::string N = n;
+      const double rmw = bytes_["ReadModifyWrite/" + N];
+      const double upd = bytes_["UpdatePass/fused/" + N];
+      const double unf = bytes_["UpdatePass/unfused/" + N];
+      const double step = bytes_["FountainStep/" + N];
+      if (rmw <= 0) continue;
+      std::printf("  %s particles: read-modify-write %.1f GB/s\n", n, rmw / 1e9);
+      if (upd > 0)
+        std::printf("    fused update   %.1f GB/s = %3.0f %% of it, %.2f G particle-steps/s\n",
+                    upd / 1e9, 100 * upd / rmw, items_["UpdatePass/fused/" + N] / 1e9);
+      if (step > 0)
+        std::printf("    whole step     %.1f GB/s = %3.0f %% of it (10 %% born and dying per step)\n",
+                    step / 1e9, 100 * step / rmw);
+      if (upd > 0 && unf > 0)
+        std::printf("    fused / unfused: %.2fx\n", upd / unf);
+    }
+  }
+
+ private:
+  std::map<std::string, double> bytes_, items_;
+};
+
+}  // namespace
+
+BENCHMARK(ReadModifyWrite)->Arg(1 << 20)->Arg(1 << 22)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(UpdatePass, fused, true)->Arg(1 << 20)->Arg(1 << 22)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(UpdatePass, unfused, false)->Arg(1 << 20)->Arg(1 << 22)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(FountainStep)->Arg(1 << 20)->Arg(1 << 22)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(Emission)->Arg(1 << 18)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  RatioReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  benchmark::Shutdown();
+  return 0;
+}

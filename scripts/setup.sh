@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Installs every Debian and PyPI dependency Flurry uses. Idempotent: when all is
+# present it only checks (a few seconds) and installs nothing.
+set -euo pipefail
+
+DEB_PACKAGES=(
+  build-essential cmake ninja-build pkg-config git clang-format
+  libglm-dev nlohmann-json3-dev libcli11-dev libstb-dev libpng-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  # OpenCL through PoCL
+  pocl-opencl-icd ocl-icd-opencl-dev opencl-clhpp-headers opencl-c-headers clinfo
+  # OpenVDB export (and an independent reader for the tests)
+  libopenvdb-dev libtbb-dev libblosc-dev libboost-iostreams-dev libopenvdb-tools python3-openvdb
+  # Rendering: GLFW + OpenGL, headless under Xvfb with Mesa's software GL
+  libglfw3-dev libgl-dev libgl1-mesa-dri libegl-mesa0 xvfb xauth
+)
+PY_PACKAGES=(numpy matplotlib pytest nanobind scikit-build-core)
+
+SUDO=""
+if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
+
+missing=()
+for p in "${DEB_PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing Debian packages: ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -q
+  $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
+
+PY=${PYTHON:-python3}
+pymissing=()
+for p in "${PY_PACKAGES[@]}"; do
+  mod=${p//-/_}
+  "$PY" -c "import ${mod}" 2>/dev/null || pymissing+=("$p")
+done
+if [ ${#pymissing[@]} -gt 0 ]; then
+  echo "setup: installing PyPI packages: ${pymissing[*]}"
+  "$PY" -m pip install -q "${pymissing[@]}" || "$PY" -m pip install -q --break-system-packages "${pymissing[@]}"
+fi
+echo "setup: all dependencies present"

@@ -1,0 +1,64 @@
+// The Context: owns groups, the seed, the time step, the thread pool and the backend.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "flurry/group.hpp"
+
+namespace flurry {
+
+enum class Backend { Cpu, OpenCL, Auto };
+
+struct ContextOptions {
+  std::uint64_t seed = 1;
+  double dt = 1.0 / 30.0;  ///< seconds per step
+  unsigned threads = 0;    ///< 0: one per hardware thread
+  Backend backend = Backend::Cpu;
+  /// Particles per block of the fused pass: every action runs over a block while it is in
+  /// cache, so memory is read and written once per step. 0 picks the default.
+  std::size_t blockSize = 0;
+  /// false runs one pass over the whole group per action: the unfused baseline that the
+  /// benchmarks compare against. Results are identical either way.
+  bool fused = true;
+};
+
+class Context {
+ public:
+  explicit Context(ContextOptions options = {});
+  ~Context();
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+  /// Creates a group of fixed capacity (> 0; throws InvalidArgument "capacity").
+  Group& createGroup(std::string name, std::size_t capacity);
+  /// The group of that name; throws Error if there is none.
+  Group& group(std::string_view name);
+  std::vector<Group*> groups();
+
+  /// Advances every group by one step of timeStep() seconds: the action list runs as one
+  /// fused pass, the dead are removed, emitters create the newborns.
+  void step();
+  void run(std::size_t steps) {
+    for (std::size_t i = 0; i < steps; ++i) step();
+  }
+
+  double time() const;
+  std::uint64_t stepIndex() const;
+  double timeStep() const;
+  /// Throws InvalidArgument "dt" unless 0 < dt <= 10 and finite.
+  void setTimeStep(double dt);
+  unsigned threads() const;
+  std::uint64_t seed() const;
+  Backend backend() const;
+  const ContextOptions& options() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace flurry

@@ -1,0 +1,15 @@
+// Flurry: a particle-system SDK. Include this one header.
+#pragma once
+
+#include "flurry/actions.hpp"
+#include "flurry/attribute.hpp"
+#include "flurry/context.hpp"
+#include "flurry/domain.hpp"
+#include "flurry/emitter.hpp"
+#include "flurry/error.hpp"
+#include "flurry/fuzzy.hpp"
+#include "flurry/group.hpp"
+#include "flurry/io.hpp"
+#include "flurry/math.hpp"
+#include "flurry/random.hpp"
+#include "flurry/version.hpp"

@@ -1,0 +1,104 @@
+// A particle group: a fixed-capacity structure-of-arrays store of particles, the emitters
+// that feed it and the action list applied to it every step.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "flurry/actions.hpp"
+#include "flurry/attribute.hpp"
+#include "flurry/emitter.hpp"
+
+namespace flurry {
+
+namespace detail {
+struct GroupImpl;
+}
+
+/// One particle gathered from the arrays (for tests, tools and small groups; hot code reads
+/// the arrays through Group::lane()).
+struct Particle {
+  Vec3 position{0.0f};
+  Vec3 velocity{0.0f};
+  Vec4 color{1.0f};
+  float size = 0.05f;
+  float mass = 1.0f;
+  float age = 0.0f;
+  float lifetime = 1e30f;
+  Vec3 prevPosition{0.0f};
+  Vec3 up{0.0f, 1.0f, 0.0f};
+  Vec3 rotVelocity{0.0f};
+  float charge = 0.0f;
+  bool visible = true;
+  float userData = 0.0f;
+  std::uint32_t id = 0;  ///< assigned by the group on add()
+};
+
+/// Where the particles went. emitted == size() + killedByAge + absorbed + droppedAtCapacity.
+struct GroupStats {
+  std::uint64_t emitted = 0;            ///< created by emitters or add(), dropped ones included
+  std::uint64_t killedByAge = 0;        ///< by KillOld
+  std::uint64_t absorbed = 0;           ///< by Sink (and other absorbers)
+  std::uint64_t droppedAtCapacity = 0;  ///< not created: the group was full
+  std::vector<std::uint64_t> killedByAction;  ///< per action-list entry
+};
+
+struct Bounds {
+  Vec3 min{0.0f}, max{0.0f};
+  bool empty = true;
+};
+
+class Group {
+ public:
+  ~Group();
+  Group(const Group&) = delete;
+  Group& operator=(const Group&) = delete;
+
+  const std::string& name() const;
+  /// Live particles; they occupy indices [0, size()).
+  std::size_t size() const;
+  std::size_t capacity() const;
+
+  /// The attributes this group stores: what its actions use, plus what readers required.
+  AttributeSet attributes() const;
+  /// Asks the group to store attributes a reader (renderer, exporter, user code) will read.
+  void require(AttributeSet attributes);
+
+  Group& setActions(ActionList actions);
+  const ActionList& actions() const;
+
+  /// Adds an emitter (validated: throws InvalidArgument naming the bad field).
+  Emitter& addEmitter(Emitter emitter);
+  std::span<Emitter> emitters();
+
+  /// Adds one particle now; returns false (and counts it dropped) when the group is full.
+  bool add(const Particle& p);
+  /// Gathers particle i (0 <= i < size()); attributes not stored read as Particle's defaults.
+  Particle particle(std::size_t i) const;
+
+  /// The array of one component of a stored float attribute, size() long.
+  /// Throws Error if the attribute is not stored (Id and Visible: use ids() / visible()).
+  std::span<const float> lane(Attribute a, int component = 0) const;
+  std::span<float> lane(Attribute a, int component = 0);
+  std::span<const std::uint32_t> ids() const;
+  std::span<const std::uint32_t> visible() const;
+
+  const GroupStats& stats() const;
+  /// Axis-aligned bounds of the live particles' positions (one pass; not maintained per step).
+  Bounds bounds() const;
+  /// Removes every particle (stats are kept).
+  void clear();
+
+  detail::GroupImpl& impl() { return *impl_; }
+  const detail::GroupImpl& impl() const { return *impl_; }
+
+ private:
+  friend class Context;
+  explicit Group(std::unique_ptr<detail::GroupImpl> impl);
+  std::unique_ptr<detail::GroupImpl> impl_;
+};
+
+}  // namespace flurry

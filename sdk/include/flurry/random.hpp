@@ -1,0 +1,82 @@
+// Counter-based random numbers (Philox4x32-10, Salmon et al., SC'11).
+//
+// A draw is a pure function of (seed, counter), so every particle has its own stream keyed
+// by (particle id, step, stream) and a run is the same on 1 thread or 16, and on the CPU
+// and OpenCL backends (kernels/philox.h computes the identical function).
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+namespace flurry {
+
+/// One Philox4x32-10 block: 4 random 32-bit words for a 128-bit counter and 64-bit key.
+struct Philox4x32 {
+  struct Block {
+    std::uint32_t v[4];
+  };
+  static inline Block generate(std::uint32_t c0, std::uint32_t c1, std::uint32_t c2,
+                               std::uint32_t c3, std::uint32_t k0, std::uint32_t k1) noexcept {
+    constexpr std::uint32_t M0 = 0xD2511F53u, M1 = 0xCD9E8D57u;
+    constexpr std::uint32_t W0 = 0x9E3779B9u, W1 = 0xBB67AE85u;
+    for (int r = 0; r < 10; ++r) {
+      const std::uint64_t p0 = std::uint64_t(M0) * c0;
+      const std::uint64_t p1 = std::uint64_t(M1) * c2;
+      const std::uint32_t hi0 = std::uint32_t(p0 >> 32), lo0 = std::uint32_t(p0);
+      const std::uint32_t hi1 = std::uint32_t(p1 >> 32), lo1 = std::uint32_t(p1);
+      c0 = hi1 ^ c1 ^ k0;
+      c1 = lo1;
+      c2 = hi0 ^ c3 ^ k1;
+      c3 = lo0;
+      k0 += W0;
+      k1 += W1;
+    }
+    return {{c0, c1, c2, c3}};
+  }
+};
+
+/// Maps 32 random bits to a float in [0, 1) with 24 bits of resolution.
+inline float uniformFloat(std::uint32_t bits) noexcept {
+  return float(bits >> 8) * (1.0f / 16777216.0f);
+}
+
+/// A stream of random numbers for one particle (or one emitter event), drawn four at a time.
+/// Streams with different (id, step, stream) never overlap.
+class Random {
+ public:
+  Random(std::uint64_t seed, std::uint32_t id, std::uint32_t step, std::uint32_t stream) noexcept
+      : k0_(std::uint32_t(seed)), k1_(std::uint32_t(seed >> 32)), id_(id), step_(step),
+        stream_(stream) {}
+
+  std::uint32_t bits() noexcept {
+    if (pos_ == 4) {
+      block_ = Philox4x32::generate(id_, step_, stream_, counter_++, k0_, k1_);
+      pos_ = 0;
+    }
+    return block_.v[pos_++];
+  }
+  /// Uniform in [0, 1).
+  float uniform() noexcept { return uniformFloat(bits()); }
+  /// Uniform in [lo, hi).
+  float uniform(float lo, float hi) noexcept { return lo + (hi - lo) * uniform(); }
+  /// Standard normal (Box-Muller; the log's argument is kept in (0, 1]).
+  float normal() noexcept {
+    const float u1 = 1.0f - uniform();
+    const float u2 = uniform();
+    return std::sqrt(-2.0f * std::log(u1)) * std::cos(6.28318530718f * u2);
+  }
+
+ private:
+  std::uint32_t k0_, k1_, id_, step_, stream_;
+  std::uint32_t counter_ = 0;
+  int pos_ = 4;
+  Philox4x32::Block block_{};
+};
+
+/// Stream numbers reserved by the SDK; actions use their index in the action list.
+namespace stream {
+inline constexpr std::uint32_t kEmission = 0xFFFF0000u;  ///< a newborn's attributes
+inline constexpr std::uint32_t kEmitterEvent = 0xFFFF0001u;
+}  // namespace stream
+
+}  // namespace flurry

@@ -1,0 +1,39 @@
+// The backend interface: how one step of one group is carried out.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "group_impl.hpp"
+#include "thread_pool.hpp"
+
+namespace flurry::detail {
+
+struct StepParams {
+  double time = 0.0;  ///< at the start of the step
+  double dt = 0.0;
+  std::uint64_t seed = 0;
+  std::uint64_t step = 0;
+  std::size_t blockSize = 0;
+  bool fused = true;
+  ThreadPool* pool = nullptr;
+};
+
+class BackendImpl {
+ public:
+  virtual ~BackendImpl() = default;
+  virtual const char* name() const = 0;
+  /// Act, then remove the dead and emit the newborns (the seed's order of the update).
+  virtual void step(GroupImpl& group, const StepParams& params) = 0;
+};
+
+std::unique_ptr<BackendImpl> makeCpuBackend();
+
+/// Runs the group's action list over [0, size) as one fused pass and gathers the dead into
+/// group.holes (ascending) with their kill counts tallied into group.stats.
+void actFused(GroupImpl& group, const StepParams& params);
+/// Creates the step's newborns from the emitters: first into holes, then at the end.
+/// Remaining holes are filled from the tail, so [0, size) is dense again.
+void emitAndCompact(GroupImpl& group, const StepParams& params);
+
+}  // namespace flurry::detail

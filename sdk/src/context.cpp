@@ -1,0 +1,116 @@
+#include "flurry/context.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <thread>
+
+#include "backend.hpp"
+#include "flurry/error.hpp"
+#include "flurry/version.hpp"
+
+namespace flurry {
+
+const char* versionString() { return "0.1.0"; }
+
+struct Context::Impl {
+  ContextOptions options;
+  std::vector<std::unique_ptr<Group>> groups;
+  std::unique_ptr<detail::ThreadPool> pool;
+  std::unique_ptr<detail::BackendImpl> backend;
+  Backend backendKind = Backend::Cpu;
+  double time = 0.0;
+  std::uint64_t step = 0;
+  double timeAtDtChange = 0.0;  // time = timeAtDtChange + stepsSinceDtChange·dt: no drift
+  std::uint64_t stepsSinceDtChange = 0;
+};
+
+namespace {
+void checkDt(double dt) {
+  if (!std::isfinite(dt) || dt <= 0.0 || dt > 10.0)
+    throw InvalidArgument("dt", "must be finite, > 0 and <= 10 seconds (got " + std::to_string(dt) + ")");
+}
+}  // namespace
+
+Context::Context(ContextOptions options) : impl_(std::make_unique<Impl>()) {
+  checkDt(options.dt);
+  if (options.threads == 0) options.threads = std::max(1u, std::thread::hardware_concurrency());
+  if (options.threads > 1024) throw InvalidArgument("threads", "must be <= 1024");
+  impl_->options = options;
+  impl_->pool = std::make_unique<detail::ThreadPool>(options.threads);
+  switch (options.backend) {
+    case Backend::Cpu:
+      break;
+    case Backend::OpenCL:
+      throw Error("backend opencl: this build of Flurry has no OpenCL backend yet");
+    case Backend::Auto:
+      break;  // OpenCL when a device is there (once the backend exists), else the CPU
+  }
+  impl_->backend = detail::makeCpuBackend();
+  impl_->backendKind = Backend::Cpu;
+}
+
+Context::~Context() = default;
+
+Group& Context::createGroup(std::string name, std::size_t capacity) {
+  if (capacity == 0) throw InvalidArgument("capacity", "a group needs a capacity > 0");
+  if (capacity > std::size_t(0xFFFFFFF0u))
+    throw InvalidArgument("capacity", "at most 4294967280 particles per group");
+  for (auto& g : impl_->groups)
+    if (g->name() == name) throw InvalidArgument("name", "a group named '" + name + "' exists");
+  auto gi = std::make_unique<detail::GroupImpl>();
+  gi->name = std::move(name);
+  gi->capacity = capacity;
+  gi->index = std::uint32_t(impl_->groups.size());
+  gi->ensureStorage();
+  impl_->groups.push_back(std::unique_ptr<Group>(new Group(std::move(gi))));
+  return *impl_->groups.back();
+}
+
+Group& Context::group(std::string_view name) {
+  for (auto& g : impl_->groups)
+    if (g->name() == name) return *g;
+  throw Error("no group named '" + std::string(name) + "'");
+}
+
+std::vector<Group*> Context::groups() {
+  std::vector<Group*> r;
+  for (auto& g : impl_->groups) r.push_back(g.get());
+  return r;
+}
+
+void Context::step() {
+  detail::StepParams sp;
+  sp.time = impl_->time;
+  sp.dt = impl_->options.dt;
+  sp.seed = impl_->options.seed;
+  sp.step = impl_->step;
+  sp.blockSize = impl_->options.blockSize;
+  sp.fused = impl_->options.fused;
+  sp.pool = impl_->pool.get();
+  for (auto& g : impl_->groups) {
+    auto& gi = g->impl();
+    gi.ensureStorage();
+    if (gi.stats.killedByAction.size() != gi.actions.size())
+      gi.stats.killedByAction.assign(gi.actions.size(), 0);
+    impl_->backend->step(gi, sp);
+  }
+  ++impl_->step;
+  ++impl_->stepsSinceDtChange;
+  impl_->time = impl_->timeAtDtChange + double(impl_->stepsSinceDtChange) * impl_->options.dt;
+}
+
+double Context::time() const { return impl_->time; }
+std::uint64_t Context::stepIndex() const { return impl_->step; }
+double Context::timeStep() const { return impl_->options.dt; }
+void Context::setTimeStep(double dt) {
+  checkDt(dt);
+  impl_->timeAtDtChange = impl_->time;
+  impl_->stepsSinceDtChange = 0;
+  impl_->options.dt = dt;
+}
+unsigned Context::threads() const { return impl_->pool->size(); }
+std::uint64_t Context::seed() const { return impl_->options.seed; }
+Backend Context::backend() const { return impl_->backendKind; }
+const ContextOptions& Context::options() const { return impl_->options; }
+
+}  // namespace flurry

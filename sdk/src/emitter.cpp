@@ -1,0 +1,61 @@
+#include <algorithm>
+#include <cmath>
+
+#include "flurry/emitter.hpp"
+#include "flurry/error.hpp"
+
+namespace flurry {
+
+namespace {
+bool finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+}  // namespace
+
+Vec3 Emitter::positionAt(double t) const {
+  if (path.empty()) return position + velocity * float(t - start);
+  if (t <= path.front().time) return path.front().position;
+  if (t >= path.back().time) return path.back().position;
+  const auto it = std::upper_bound(path.begin(), path.end(), t,
+                                   [](double x, const Keyframe& k) { return x < k.time; });
+  const Keyframe& b = *it;
+  const Keyframe& a = *(it - 1);
+  const double w = (t - a.time) / (b.time - a.time);
+  return a.position + (b.position - a.position) * float(w);
+}
+
+void Emitter::validate(const std::string& where) const {
+  auto fail = [&](const std::string& field, const std::string& why) {
+    throw InvalidArgument(where + "." + field, why);
+  };
+  if (!std::isfinite(rate) || rate < 0) fail("rate", "must be finite and >= 0");
+  if (!finite(position)) fail("position", "not finite");
+  if (!finite(velocity)) fail("velocity", "not finite");
+  if (!std::isfinite(start)) fail("start", "not finite");
+  if (std::isnan(stop) || stop < start) fail("stop", "must be >= start");
+  for (std::size_t i = 0; i < bursts.size(); ++i) {
+    const Burst& b = bursts[i];
+    const std::string f = "bursts[" + std::to_string(i) + "]";
+    if (!std::isfinite(b.time)) fail(f + ".time", "not finite");
+    if (!std::isfinite(b.interval) || b.interval < 0) fail(f + ".interval", "must be >= 0");
+    if (b.repeat > 1 && b.interval <= 0) fail(f + ".interval", "must be > 0 to repeat");
+  }
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    const std::string f = "path[" + std::to_string(i) + "]";
+    if (!std::isfinite(path[i].time) || !finite(path[i].position)) fail(f, "not finite");
+    if (i > 0 && path[i].time <= path[i - 1].time) fail(f + ".time", "keyframe times must increase");
+  }
+  if (types.empty()) fail("types", "an emitter needs at least one particle type");
+  double total = 0;
+  for (std::size_t i = 0; i < types.size(); ++i) {
+    const ParticleType& t = types[i];
+    const std::string f = "types[" + std::to_string(i) + "]";
+    if (!std::isfinite(t.weight) || t.weight < 0) fail(f + ".weight", "must be finite and >= 0");
+    total += t.weight;
+    const std::string fs[] = {f + ".alpha", f + ".size", f + ".mass", f + ".lifetime", f + ".charge"};
+    const Fuzzy* vals[] = {&t.alpha, &t.size, &t.mass, &t.lifetime, &t.charge};
+    for (int k = 0; k < 5; ++k) vals[k]->validate((where + "." + fs[k]).c_str());
+    if (t.lifetime.center <= 0) fail(f + ".lifetime", "must be > 0");
+  }
+  if (!(total > 0)) fail("types", "the weights add up to 0");
+}
+
+}  // namespace flurry

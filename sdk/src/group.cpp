@@ -1,0 +1,295 @@
+#include <sys/mman.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <new>
+
+#include "flurry/error.hpp"
+#include "group_impl.hpp"
+
+namespace flurry {
+
+std::string_view attributeName(Attribute a) {
+  static constexpr std::string_view names[] = {
+      "position", "velocity", "color",  "size",    "mass",     "age",      "lifetime",
+      "id",       "prevPosition", "up", "rotVelocity", "charge", "visible", "userData"};
+  const auto i = std::size_t(a);
+  return i < std::size(names) ? names[i] : "unknown";
+}
+
+namespace detail {
+
+namespace {
+constexpr std::size_t kHugePage = std::size_t(2) << 20;
+}
+
+LaneBuffer::LaneBuffer(std::size_t count) : count_(count) {
+  std::size_t bytes = std::max<std::size_t>(count, 16) * 4;
+  const bool huge = bytes >= 4 * kHugePage;
+  const std::size_t align = huge ? kHugePage : 64;
+  bytes = (bytes + align - 1) / align * align;
+  data_ = std::aligned_alloc(align, bytes);
+  if (!data_) throw Error("out of memory allocating " + std::to_string(bytes) + " bytes of particles");
+#ifdef MADV_HUGEPAGE
+  if (huge) madvise(data_, bytes, MADV_HUGEPAGE);  // a hint; failure only costs speed
+#endif
+}
+
+LaneBuffer::~LaneBuffer() { std::free(data_); }
+
+LaneBuffer& LaneBuffer::operator=(LaneBuffer&& o) noexcept {
+  if (this != &o) {
+    std::free(data_);
+    data_ = o.data_;
+    count_ = o.count_;
+    o.data_ = nullptr;
+    o.count_ = 0;
+  }
+  return *this;
+}
+
+Lanes Lanes::offset(std::size_t b) const {
+  Lanes r = *this;
+  auto shift = [b](auto*& ptr) {
+    if (ptr) ptr += b;
+  };
+  for (auto& q : r.p) shift(q);
+  for (auto& q : r.v) shift(q);
+  for (auto& q : r.color) shift(q);
+  for (auto& q : r.prev) shift(q);
+  for (auto& q : r.up) shift(q);
+  for (auto& q : r.rot) shift(q);
+  shift(r.size);
+  shift(r.mass);
+  shift(r.age);
+  shift(r.lifetime);
+  shift(r.id);
+  shift(r.charge);
+  shift(r.visible);
+  shift(r.user);
+  return r;
+}
+
+Lanes GroupImpl::lanePointers() const {
+  Lanes l;
+  auto f = [&](Attribute a, int c) { return lanes[std::size_t(a)][c].f(); };
+  for (int c = 0; c < 3; ++c) {
+    l.p[c] = f(Attribute::Position, c);
+    l.v[c] = f(Attribute::Velocity, c);
+    l.prev[c] = f(Attribute::PrevPosition, c);
+    l.up[c] = f(Attribute::Up, c);
+    l.rot[c] = f(Attribute::RotVelocity, c);
+  }
+  for (int c = 0; c < 4; ++c) l.color[c] = f(Attribute::Color, c);
+  l.size = f(Attribute::Size, 0);
+  l.mass = f(Attribute::Mass, 0);
+  l.age = f(Attribute::Age, 0);
+  l.lifetime = f(Attribute::Lifetime, 0);
+  l.id = lanes[std::size_t(Attribute::Id)][0].u();
+  l.charge = f(Attribute::Charge, 0);
+  l.visible = lanes[std::size_t(Attribute::Visible)][0].u();
+  l.user = f(Attribute::UserData, 0);
+  return l;
+}
+
+void GroupImpl::write(std::size_t i, const Particle& q) {
+  const Lanes l = lanePointers();
+  for (int c = 0; c < 3; ++c) {
+    l.p[c][i] = q.position[c];
+    if (l.v[c]) l.v[c][i] = q.velocity[c];
+    if (l.prev[c]) l.prev[c][i] = q.prevPosition[c];
+    if (l.up[c]) l.up[c][i] = q.up[c];
+    if (l.rot[c]) l.rot[c][i] = q.rotVelocity[c];
+  }
+  for (int c = 0; c < 4; ++c)
+    if (l.color[c]) l.color[c][i] = q.color[c];
+  if (l.size) l.size[i] = q.size;
+  if (l.mass) l.mass[i] = q.mass;
+  if (l.age) l.age[i] = q.age;
+  if (l.lifetime) l.lifetime[i] = q.lifetime;
+  if (l.id) l.id[i] = q.id;
+  if (l.charge) l.charge[i] = q.charge;
+  if (l.visible) l.visible[i] = q.visible ? 1u : 0u;
+  if (l.user) l.user[i] = q.userData;
+}
+
+Particle GroupImpl::read(std::size_t i) const {
+  const Lanes l = lanePointers();
+  Particle q;
+  for (int c = 0; c < 3; ++c) {
+    q.position[c] = l.p[c][i];
+    if (l.v[c]) q.velocity[c] = l.v[c][i];
+    if (l.prev[c]) q.prevPosition[c] = l.prev[c][i];
+    if (l.up[c]) q.up[c] = l.up[c][i];
+    if (l.rot[c]) q.rotVelocity[c] = l.rot[c][i];
+  }
+  for (int c = 0; c < 4; ++c)
+    if (l.color[c]) q.color[c] = l.color[c][i];
+  if (l.size) q.size = l.size[i];
+  if (l.mass) q.mass = l.mass[i];
+  if (l.age) q.age = l.age[i];
+  if (l.lifetime) q.lifetime = l.lifetime[i];
+  if (l.id) q.id = l.id[i];
+  if (l.charge) q.charge = l.charge[i];
+  if (l.visible) q.visible = l.visible[i] != 0;
+  if (l.user) q.userData = l.user[i];
+  return q;
+}
+
+void GroupImpl::move(std::size_t from, std::size_t to) {
+  for (auto& attr : lanes)
+    for (auto& lane : attr)
+      if (lane) lane.u()[to] = lane.u()[from];
+}
+
+void GroupImpl::ensureStorage() {
+  const AttributeSet want = wanted();
+  if (want == stored) return;
+  const Particle defaults;
+  for (int a = 0; a < int(Attribute::Count); ++a) {
+    const Attribute attr = Attribute(a);
+    auto& slot = lanes[std::size_t(a)];
+    if (want.has(attr) && !stored.has(attr)) {
+      for (int c = 0; c < componentCount(attr); ++c) slot[c] = LaneBuffer(capacity);
+    } else if (!want.has(attr) && stored.has(attr)) {
+      for (auto& lane : slot) lane = LaneBuffer();
+    }
+  }
+  const AttributeSet before = stored;
+  stored = want;
+  if (size == 0) return;
+  // Existing particles get the defaults for the lanes just added.
+  const Lanes l = lanePointers();
+  for (std::size_t i = 0; i < size; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      if (!before.has(Attribute::Velocity) && l.v[c]) l.v[c][i] = defaults.velocity[c];
+      if (!before.has(Attribute::PrevPosition) && l.prev[c]) l.prev[c][i] = l.p[c][i];
+      if (!before.has(Attribute::Up) && l.up[c]) l.up[c][i] = defaults.up[c];
+      if (!before.has(Attribute::RotVelocity) && l.rot[c]) l.rot[c][i] = 0.0f;
+    }
+    for (int c = 0; c < 4; ++c)
+      if (!before.has(Attribute::Color) && l.color[c]) l.color[c][i] = defaults.color[c];
+    if (!before.has(Attribute::Size) && l.size) l.size[i] = defaults.size;
+    if (!before.has(Attribute::Mass) && l.mass) l.mass[i] = defaults.mass;
+    if (!before.has(Attribute::Age) && l.age) l.age[i] = 0.0f;
+    if (!before.has(Attribute::Lifetime) && l.lifetime) l.lifetime[i] = defaults.lifetime;
+    if (!before.has(Attribute::Charge) && l.charge) l.charge[i] = 0.0f;
+    if (!before.has(Attribute::Visible) && l.visible) l.visible[i] = 1u;
+    if (!before.has(Attribute::UserData) && l.user) l.user[i] = 0.0f;
+  }
+}
+
+}  // namespace detail
+
+Group::Group(std::unique_ptr<detail::GroupImpl> impl) : impl_(std::move(impl)) {}
+Group::~Group() = default;
+
+const std::string& Group::name() const { return impl_->name; }
+std::size_t Group::size() const { return impl_->size; }
+std::size_t Group::capacity() const { return impl_->capacity; }
+AttributeSet Group::attributes() const { return impl_->wanted(); }
+
+void Group::require(AttributeSet attributes) {
+  impl_->required.insert(attributes);
+  impl_->ensureStorage();
+}
+
+Group& Group::setActions(ActionList actions) {
+  impl_->actions = std::move(actions);
+  impl_->stats.killedByAction.assign(impl_->actions.size(), 0);
+  impl_->ensureStorage();
+  return *this;
+}
+
+const ActionList& Group::actions() const { return impl_->actions; }
+
+Emitter& Group::addEmitter(Emitter emitter) {
+  emitter.validate("emitters[" + std::to_string(impl_->emitters.size()) + "]");
+  impl_->emitters.push_back(std::move(emitter));
+  impl_->emitterState.emplace_back();
+  return impl_->emitters.back();
+}
+
+std::span<Emitter> Group::emitters() { return impl_->emitters; }
+
+bool Group::add(const Particle& p) {
+  auto& g = *impl_;
+  g.ensureStorage();
+  ++g.stats.emitted;
+  if (g.size >= g.capacity) {
+    ++g.stats.droppedAtCapacity;
+    return false;
+  }
+  Particle q = p;
+  q.id = g.nextId++;
+  g.write(g.size++, q);
+  return true;
+}
+
+Particle Group::particle(std::size_t i) const {
+  if (i >= impl_->size)
+    throw InvalidArgument("index", std::to_string(i) + " is past the live count " +
+                                       std::to_string(impl_->size));
+  return impl_->read(i);
+}
+
+namespace {
+void checkFloatLane(const detail::GroupImpl& g, Attribute a, int component) {
+  if (a == Attribute::Id || a == Attribute::Visible || a >= Attribute::Count)
+    throw InvalidArgument("attribute", std::string(attributeName(a)) +
+                                           " is not a float attribute (use ids() / visible())");
+  if (component < 0 || component >= componentCount(a))
+    throw InvalidArgument("component", "attribute " + std::string(attributeName(a)) + " has " +
+                                           std::to_string(componentCount(a)) + " components");
+  if (!g.stored.has(a))
+    throw Error("group '" + g.name + "' does not store attribute " +
+                std::string(attributeName(a)) + " (call require() first)");
+}
+}  // namespace
+
+std::span<const float> Group::lane(Attribute a, int component) const {
+  checkFloatLane(*impl_, a, component);
+  return {impl_->lanes[std::size_t(a)][component].f(), impl_->size};
+}
+
+std::span<float> Group::lane(Attribute a, int component) {
+  checkFloatLane(*impl_, a, component);
+  return {impl_->lanes[std::size_t(a)][component].f(), impl_->size};
+}
+
+std::span<const std::uint32_t> Group::ids() const {
+  return {impl_->lanes[std::size_t(Attribute::Id)][0].u(), impl_->size};
+}
+
+std::span<const std::uint32_t> Group::visible() const {
+  if (!impl_->stored.has(Attribute::Visible))
+    throw Error("group '" + impl_->name + "' does not store attribute visible");
+  return {impl_->lanes[std::size_t(Attribute::Visible)][0].u(), impl_->size};
+}
+
+const GroupStats& Group::stats() const { return impl_->stats; }
+
+Bounds Group::bounds() const {
+  Bounds b;
+  const auto& g = *impl_;
+  if (g.size == 0) return b;
+  const detail::Lanes l = g.lanePointers();
+  for (int c = 0; c < 3; ++c) {
+    const float* x = l.p[c];
+    float lo = x[0], hi = x[0];
+    for (std::size_t i = 1; i < g.size; ++i) {
+      lo = std::min(lo, x[i]);
+      hi = std::max(hi, x[i]);
+    }
+    b.min[c] = lo;
+    b.max[c] = hi;
+  }
+  b.empty = false;
+  return b;
+}
+
+void Group::clear() { impl_->size = 0; }
+
+}  // namespace flurry

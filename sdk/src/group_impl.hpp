@@ -1,0 +1,98 @@
+// The inside of a Group: lane storage and the per-step scratch the backends share.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "flurry/group.hpp"
+
+namespace flurry::detail {
+
+/// One 64-byte aligned array of 32-bit values. Large arrays ask for transparent huge pages:
+/// the update is bandwidth-bound, and huge pages measurably raise the bandwidth reached.
+class LaneBuffer {
+ public:
+  LaneBuffer() = default;
+  explicit LaneBuffer(std::size_t count);
+  ~LaneBuffer();
+  LaneBuffer(LaneBuffer&& o) noexcept : data_(o.data_), count_(o.count_) {
+    o.data_ = nullptr;
+    o.count_ = 0;
+  }
+  LaneBuffer& operator=(LaneBuffer&& o) noexcept;
+  LaneBuffer(const LaneBuffer&) = delete;
+  LaneBuffer& operator=(const LaneBuffer&) = delete;
+
+  void* data() const { return data_; }
+  float* f() const { return static_cast<float*>(data_); }
+  std::uint32_t* u() const { return static_cast<std::uint32_t*>(data_); }
+  explicit operator bool() const { return data_ != nullptr; }
+
+ private:
+  void* data_ = nullptr;
+  std::size_t count_ = 0;
+};
+
+/// Raw pointers to every stored lane (nullptr where not stored), offset by a base index.
+struct Lanes {
+  float* p[3] = {};
+  float* v[3] = {};
+  float* color[4] = {};
+  float* size = nullptr;
+  float* mass = nullptr;
+  float* age = nullptr;
+  float* lifetime = nullptr;
+  std::uint32_t* id = nullptr;
+  float* prev[3] = {};
+  float* up[3] = {};
+  float* rot[3] = {};
+  float* charge = nullptr;
+  std::uint32_t* visible = nullptr;
+  float* user = nullptr;
+
+  Lanes offset(std::size_t b) const;
+};
+
+/// Per-emitter progress.
+struct EmitterState {
+  std::uint64_t emittedByRate = 0;  ///< particles the rate has produced so far
+};
+
+struct GroupImpl {
+  std::string name;
+  std::uint32_t index = 0;  ///< creation order in the context: keeps groups' random streams apart
+  std::size_t capacity = 0;
+  std::size_t size = 0;
+  AttributeSet required{Attribute::Position, Attribute::Id};
+  AttributeSet stored;  ///< what the lanes hold now
+  ActionList actions;
+  std::vector<Emitter> emitters;
+  std::vector<EmitterState> emitterState;
+  std::array<std::array<LaneBuffer, 4>, std::size_t(Attribute::Count)> lanes;
+  GroupStats stats;
+  std::uint32_t nextId = 0;
+
+  // Scratch reused every step (no allocation per step).
+  std::vector<std::uint32_t> deadIndex;  ///< per block: [block*B, block*B + deadCount[block])
+  std::vector<std::uint8_t> deadCode;    ///< 1 + index of the action that killed
+  std::vector<std::uint32_t> deadCount;  ///< per block
+  std::vector<std::uint32_t> holes;      ///< sorted dead indices of this step
+  std::vector<std::uint32_t> deadFlags;  ///< the unfused baseline's per-particle kill codes
+
+  /// The attributes the group must store now.
+  AttributeSet wanted() const { return required | actions.attributes(); }
+  /// Allocates the lanes of wanted() not yet stored (existing particles get defaults) and
+  /// frees lanes nobody uses any more.
+  void ensureStorage();
+  Lanes lanePointers() const;
+  /// Writes particle p's stored attributes at index i.
+  void write(std::size_t i, const Particle& p);
+  Particle read(std::size_t i) const;
+  /// Copies every stored lane's element `from` to `to`.
+  void move(std::size_t from, std::size_t to);
+};
+
+}  // namespace flurry::detail

@@ -1,0 +1,230 @@
+// Every action against its closed-form expectation.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "flurry/flurry.hpp"
+
+using namespace flurry;
+
+namespace {
+ContextOptions opts(double dt = 0.01, unsigned threads = 1) {
+  ContextOptions o;
+  o.dt = dt;
+  o.threads = threads;
+  return o;
+}
+}  // namespace
+
+TEST(Gravity, ProjectileMatchesTheDiscreteAndAnalyticSolutions) {
+  Context ctx(opts(0.01));
+  Group& g = ctx.createGroup("p", 4);
+  g.setActions({Gravity{Vec3(0, -9.81f, 0)}, Move{}});
+  Particle p;
+  p.position = Vec3(1, 2, 3);
+  p.velocity = Vec3(3, 10, -1);
+  g.add(p);
+  const int N = 100;
+  ctx.run(N);
+  const double dt = 0.01, T = N * dt, gy = -9.81;
+  const Particle q = g.particle(0);
+  // Semi-implicit Euler: p_N = p0 + v0 T + g dt^2 N(N+1)/2 exactly (up to float rounding).
+  EXPECT_NEAR(q.position.x, 1 + 3 * T, 1e-4);
+  EXPECT_NEAR(q.position.y, 2 + 10 * T + gy * dt * dt * N * (N + 1) / 2, 1e-4);
+  EXPECT_NEAR(q.position.z, 3 - T, 1e-4);
+  EXPECT_NEAR(q.velocity.y, 10 + gy * T, 1e-4);
+  // ...which is the parabola p0 + v0 T + g T^2 / 2 to first order in dt.
+  EXPECT_NEAR(q.position.y, 2 + 10 * T + 0.5 * gy * T * T, std::abs(gy) * T * dt);
+}
+
+TEST(Damping, DecaysExponentiallyAtAnyStepSize) {
+  for (double dt : {0.1, 1.0}) {
+    Context ctx(opts(dt));
+    Group& g = ctx.createGroup("p", 1);
+    g.setActions({Damping{Vec3(0.6931472f)}, Move{}});  // rate ln 2: halves each second
+    Particle p;
+    p.velocity = Vec3(8, -4, 2);
+    g.add(p);
+    ctx.run(std::size_t(std::lround(1.0 / dt)));
+    const Vec3 v = g.particle(0).velocity;
+    EXPECT_NEAR(v.x, 4.0, 1e-5) << "dt " << dt;
+    EXPECT_NEAR(v.y, -2.0, 1e-5);
+    EXPECT_NEAR(v.z, 1.0, 1e-5);
+  }
+}
+
+TEST(Bounce, ReflectsWithRestitutionAndFriction) {
+  Context ctx(opts(0.1));
+  Group& g = ctx.createGroup("p", 1);
+  const float e = 0.5f, mu = 0.25f;
+  g.setActions({Bounce{Domain::plane(Vec3(0), Vec3(0, 1, 0)), e, mu, 0.0f}, Move{}});
+  Particle p;
+  p.position = Vec3(0, 0.1f, 0);  // hits the plane after 0.05 s of the 0.1 s step
+  p.velocity = Vec3(2, -2, 0);
+  g.add(p);
+  ctx.step();
+  const Particle q = g.particle(0);
+  EXPECT_NEAR(q.velocity.x, 2 * (1 - mu), 1e-6);
+  EXPECT_NEAR(q.velocity.y, 2 * e, 1e-6);
+  // Impact at t = 0.05 at x = 0.1, then 0.05 s of the reflected motion.
+  EXPECT_NEAR(q.position.x, 0.1 + 0.05 * 2 * (1 - mu), 1e-5);
+  EXPECT_NEAR(q.position.y, 0.05 * 2 * e, 1e-5);
+}
+
+TEST(Bounce, CutoffSparesSlowSlidingFromFriction) {
+  Context ctx(opts(0.1));
+  Group& g = ctx.createGroup("p", 1);
+  g.setActions({Bounce{Domain::plane(Vec3(0), Vec3(0, 1, 0)), 1.0f, 0.5f, 1.0f}, Move{}});
+  Particle p;
+  p.position = Vec3(0, 0.1f, 0);
+  p.velocity = Vec3(0.5f, -2, 0);  // tangential speed 0.5 < cutoff 1
+  g.add(p);
+  ctx.step();
+  EXPECT_NEAR(g.particle(0).velocity.x, 0.5, 1e-6);
+}
+
+TEST(Bounce, MissesOutsideAFinitePieceAndHitsInside) {
+  for (const Domain& d :
+       {Domain::rectangle(Vec3(-1, 0, -1), Vec3(2, 0, 0), Vec3(0, 0, 2)),
+        Domain::disc(Vec3(0), Vec3(0, 1, 0), 1.0f), Domain::triangle(Vec3(-1, 0, -1), Vec3(1, 0, -1), Vec3(0, 0, 1))}) {
+    Context ctx(opts(0.1));
+    Group& g = ctx.createGroup("p", 2);
+    g.setActions({Bounce{d, 1.0f, 0.0f, 0.0f}, Move{}});
+    Particle in, out;
+    in.position = Vec3(0, 0.1f, 0);
+    in.velocity = Vec3(0, -2, 0);
+    out.position = Vec3(5, 0.1f, 5);
+    out.velocity = Vec3(0, -2, 0);
+    g.add(in);
+    g.add(out);
+    ctx.step();
+    EXPECT_GT(g.particle(0).position.y, 0.0f) << d.name();
+    EXPECT_NEAR(g.particle(0).velocity.y, 2.0f, 1e-6) << d.name();
+    EXPECT_LT(g.particle(1).position.y, 0.0f) << d.name();
+  }
+}
+
+TEST(Bounce, SphereFromOutside) {
+  Context ctx(opts(0.1));
+  Group& g = ctx.createGroup("p", 1);
+  g.setActions({Bounce{Domain::sphere(Vec3(0), 1.0f), 1.0f, 0.0f, 0.0f}, Move{}});
+  Particle p;
+  p.position = Vec3(0, 1.1f, 0);
+  p.velocity = Vec3(0, -2, 0);
+  g.add(p);
+  ctx.step();
+  EXPECT_NEAR(g.particle(0).velocity.y, 2.0f, 1e-5);
+  EXPECT_NEAR(g.particle(0).position.y, 1.1f, 1e-5);
+}
+
+// No tunnelling: at speeds up to 1e4 units/s with dt = 1/30 no particle ends a step behind
+// a deflector, from any direction, over many steps.
+TEST(Bounce, NoTunnellingAtHighSpeed) {
+  for (float speed : {10.0f, 1e3f, 1e4f}) {
+    for (const Domain& d : {Domain::plane(Vec3(0, 0.5f, 0), Vec3(0, 1, 0)),
+                            Domain::rectangle(Vec3(-1e5f, 0.5f, -1e5f), Vec3(2e5f, 0, 0), Vec3(0, 0, 2e5f)),
+                            Domain::sphere(Vec3(0), 50.0f)}) {
+      Context ctx(opts(1.0 / 30.0, 2));
+      Group& g = ctx.createGroup("p", 4096);
+      g.setActions({Gravity{Vec3(0, -9.81f, 0)}, Bounce{d, 0.7f, 0.1f, 0.0f}, Move{}});
+      Random rng(5, 0, 0, 0);
+      const bool sphere = std::holds_alternative<SphereDomain>(d.shape());
+      for (int i = 0; i < 4096; ++i) {
+        Particle p;
+        Vec3 dir = Domain::sphere(Vec3(0), 1.0f, 1.0f).sample(rng);
+        p.position = sphere ? dir * (50.0f + 200.0f * rng.uniform()) : Vec3(0, 0.5f + 1e3f * rng.uniform(), 0);
+        p.velocity = sphere ? -dir * speed + Vec3(rng.uniform(), 0, 0) : dir * speed;
+        g.add(p);
+      }
+      for (int s = 0; s < 60; ++s) {
+        ctx.step();
+        const auto px = g.lane(Attribute::Position, 0), py = g.lane(Attribute::Position, 1),
+                   pz = g.lane(Attribute::Position, 2);
+        for (std::size_t i = 0; i < g.size(); ++i) {
+          if (sphere)
+            ASSERT_GE(px[i] * px[i] + py[i] * py[i] + pz[i] * pz[i], 50.0f * 50.0f * (1 - 1e-6f))
+                << "speed " << speed << " step " << s;
+          else
+            ASSERT_GE(py[i], 0.5f) << d.name() << " speed " << speed << " step " << s;
+        }
+      }
+    }
+  }
+}
+
+TEST(Sink, KillsInsideOrOutsideAndCountsIt) {
+  Context ctx(opts());
+  Group& g = ctx.createGroup("p", 100);
+  g.setActions({Sink{Domain::box(Vec3(-1), Vec3(1)), true, 0.0f}});
+  for (int i = 0; i < 10; ++i) {
+    Particle p;
+    p.position = Vec3(i < 4 ? 0.0f : 5.0f, 0, 0);
+    g.add(p);
+  }
+  ctx.step();
+  EXPECT_EQ(g.size(), 6u);
+  EXPECT_EQ(g.stats().absorbed, 4u);
+  EXPECT_EQ(g.stats().killedByAction[0], 4u);
+  for (std::size_t i = 0; i < g.size(); ++i) EXPECT_EQ(g.particle(i).position.x, 5.0f);
+
+  Group& h = ctx.createGroup("q", 100);
+  h.setActions({Sink{Domain::sphere(Vec3(0), 1.0f), false, 0.0f}});
+  Particle a, b;
+  b.position = Vec3(3, 0, 0);
+  h.add(a);
+  h.add(b);
+  ctx.step();
+  ASSERT_EQ(h.size(), 1u);
+  EXPECT_EQ(h.particle(0).position.x, 0.0f);
+}
+
+TEST(Sink, PassThroughFractionIsRespected) {
+  Context ctx(opts());
+  const int n = 20000;
+  Group& g = ctx.createGroup("p", n);
+  g.setActions({Sink{Domain::box(Vec3(-1), Vec3(1)), true, 0.3f}});
+  for (int i = 0; i < n; ++i) g.add(Particle{});
+  ctx.step();
+  const double passed = double(g.size()) / n;
+  const double sigma = std::sqrt(0.3 * 0.7 / n);
+  EXPECT_NEAR(passed, 0.3, 2 * sigma);
+}
+
+TEST(KillOld, KillsPastLifetimeAndCountsByAge) {
+  Context ctx(opts(0.1));
+  Group& g = ctx.createGroup("p", 10);
+  g.setActions({Move{}, KillOld{}});
+  for (int i = 0; i < 5; ++i) {
+    Particle p;
+    p.lifetime = 0.25f + 0.1f * i;  // 0.25 .. 0.65
+    g.add(p);
+  }
+  ctx.run(3);  // age 0.3
+  EXPECT_EQ(g.size(), 4u);
+  ctx.run(2);  // age 0.5
+  EXPECT_EQ(g.size(), 2u);
+  EXPECT_EQ(g.stats().killedByAge, 3u);
+}
+
+TEST(Actions, InvalidParametersNameTheField) {
+  auto expectParam = [](auto&& f, const std::string& param) {
+    try {
+      f();
+      FAIL() << "no exception for " << param;
+    } catch (const InvalidArgument& e) {
+      EXPECT_EQ(e.parameter(), param) << e.what();
+    }
+  };
+  expectParam([] { ActionList{Gravity{Vec3(0, NAN, 0)}}; }, "actions[0].Gravity.acceleration");
+  expectParam([] { ActionList{Move{}, Damping{Vec3(-1)}}; }, "actions[1].Damping.rate");
+  expectParam([] { ActionList{Bounce{Domain::plane(Vec3(0), Vec3(0, 1, 0)), -1.0f}}; },
+              "actions[0].Bounce.restitution");
+  expectParam([] { ActionList{Bounce{Domain::plane(Vec3(0), Vec3(0, 1, 0)), 1.0f, 2.0f}}; },
+              "actions[0].Bounce.friction");
+  expectParam([] { ActionList{Bounce{Domain::box(Vec3(0), Vec3(1))}}; }, "actions[0].Bounce.surface");
+  expectParam([] { ActionList{Sink{Domain::box(Vec3(0), Vec3(1)), true, 1.5f}}; },
+              "actions[0].Sink.passThrough");
+  expectParam([] { Domain::sphere(Vec3(0), 0.0f); }, "sphere.outerRadius");
+  expectParam([] { Context c(opts()); c.createGroup("g", 0); }, "capacity");
+  expectParam([] { Context c(opts(std::nan(""))); }, "dt");
+}

@@ -1,0 +1,167 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "flurry/flurry.hpp"
+
+using namespace flurry;
+
+namespace {
+std::uint64_t emittedAfter(double rate, double seconds, double dt) {
+  ContextOptions o;
+  o.dt = dt;
+  o.threads = 1;
+  Context ctx(o);
+  Group& g = ctx.createGroup("g", 1 << 20);
+  Emitter e;
+  e.rate = rate;
+  g.addEmitter(e);
+  ctx.run(std::size_t(std::llround(seconds / dt)));
+  EXPECT_EQ(g.size(), g.stats().emitted);
+  return g.stats().emitted;
+}
+}  // namespace
+
+TEST(Emitter, FractionalRatesAreExactOverLongRuns) {
+  EXPECT_EQ(emittedAfter(10.5, 10.0, 1.0 / 30.0), 105u);
+  EXPECT_EQ(emittedAfter(10.5, 10.0, 1.0 / 60.0), 105u);
+  EXPECT_EQ(emittedAfter(10.5, 10.0, 1.0 / 24.0), 105u);
+  EXPECT_EQ(emittedAfter(0.3, 100.0, 0.01), 30u);
+  EXPECT_EQ(emittedAfter(1000.0 / 3.0, 60.0, 1.0 / 30.0), 20000u);
+  EXPECT_EQ(emittedAfter(7.25, 3600.0, 1.0 / 30.0), 26100u);
+}
+
+TEST(Emitter, BirthTimesDoNotDependOnTheStep) {
+  // A particle's age at the end tells its birth time: the same at any dt.
+  for (double dt : {1.0 / 24.0, 1.0 / 60.0, 1.0 / 240.0}) {
+    ContextOptions o;
+    o.dt = dt;
+    Context ctx(o);
+    Group& g = ctx.createGroup("g", 100);
+    g.require({Attribute::Age});
+    Emitter e;
+    e.rate = 4.0;  // births at 0.25, 0.5, 0.75, 1.0
+    g.addEmitter(e);
+    g.setActions({Move{}});
+    ctx.run(std::size_t(std::llround(1.0 / dt)));
+    ASSERT_EQ(g.size(), 4u);
+    for (std::size_t i = 0; i < 4; ++i) {
+      const Particle p = g.particle(i);
+      EXPECT_NEAR(p.age, 1.0 - 0.25 * (p.id + 1), 1e-5) << "dt " << dt;
+    }
+  }
+}
+
+TEST(Emitter, BurstsFireOnceOrRepeat) {
+  ContextOptions o;
+  o.dt = 0.1;
+  Context ctx(o);
+  Group& g = ctx.createGroup("g", 1000);
+  Emitter e;
+  e.bursts = {{0.0, 50, 0.0, 1}, {0.45, 10, 0.3, 3}};  // at 0; at 0.45, 0.75, 1.05
+  g.addEmitter(e);
+  ctx.step();
+  EXPECT_EQ(g.size(), 50u);
+  ctx.run(4);  // to 0.5
+  EXPECT_EQ(g.size(), 60u);
+  ctx.run(10);
+  EXPECT_EQ(g.size(), 80u);
+}
+
+TEST(Emitter, MovingEmitterLeavesAnEvenTrail) {
+  ContextOptions o;
+  o.dt = 0.1;
+  Context ctx(o);
+  Group& g = ctx.createGroup("g", 1000);
+  Emitter e;
+  e.rate = 100.0;
+  e.velocity = Vec3(10, 0, 0);  // 0.1 units between births
+  g.addEmitter(e);
+  g.setActions({Move{}});
+  ctx.run(10);
+  ASSERT_EQ(g.size(), 100u);
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const Particle p = g.particle(i);
+    EXPECT_NEAR(p.position.x, 0.1 * (p.id + 1), 1e-4);  // where the emitter was at birth
+  }
+}
+
+TEST(Emitter, PathKeyframesAreInterpolated) {
+  Emitter e;
+  e.path = {{0.0, Vec3(0)}, {1.0, Vec3(10, 0, 0)}, {3.0, Vec3(10, 20, 0)}};
+  EXPECT_EQ(e.positionAt(-1.0), Vec3(0));
+  EXPECT_EQ(e.positionAt(0.5), Vec3(5, 0, 0));
+  EXPECT_EQ(e.positionAt(2.0), Vec3(10, 10, 0));
+  EXPECT_EQ(e.positionAt(9.0), Vec3(10, 20, 0));
+}
+
+TEST(Emitter, CapacityOverflowIsCountedNotACrash) {
+  Context ctx;
+  Group& g = ctx.createGroup("g", 100);
+  Emitter e;
+  e.bursts = {{0.0, 250, 0.0, 1}};
+  g.addEmitter(e);
+  ctx.run(3);
+  EXPECT_EQ(g.size(), 100u);
+  EXPECT_EQ(g.stats().emitted, 250u);
+  EXPECT_EQ(g.stats().droppedAtCapacity, 150u);
+  Particle p;
+  EXPECT_FALSE(g.add(p));
+  EXPECT_EQ(g.stats().droppedAtCapacity, 151u);
+}
+
+TEST(Emitter, AttributesComeFromTheParticleType) {
+  Context ctx;
+  Group& g = ctx.createGroup("g", 5000);
+  g.require({Attribute::Color, Attribute::Size, Attribute::Lifetime, Attribute::Velocity});
+  Emitter e;
+  e.shape = Domain::box(Vec3(-1), Vec3(1));
+  ParticleType t;
+  t.velocity = Domain::point(Vec3(0, 5, 0));
+  t.color = Domain::point(Vec3(1, 0, 0));
+  t.size = Fuzzy(0.5f, 0.1f);
+  t.lifetime = Fuzzy::percent(2.0f, 25.0f);
+  e.types = {t};
+  e.bursts = {{0.0, 4000, 0, 1}};
+  g.addEmitter(e);
+  ctx.step();
+  ASSERT_EQ(g.size(), 4000u);
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const Particle p = g.particle(i);
+    EXPECT_EQ(p.velocity, Vec3(0, 5, 0));
+    EXPECT_EQ(p.color, Vec4(1, 0, 0, 1));
+    EXPECT_GE(p.size, 0.4f);
+    EXPECT_LE(p.size, 0.6f);
+    EXPECT_GE(p.lifetime, 1.5f);
+    EXPECT_LE(p.lifetime, 2.5f);
+    EXPECT_TRUE(std::abs(p.position.x) <= 1 && std::abs(p.position.z) <= 1);
+  }
+}
+
+TEST(Emitter, InvalidParametersNameTheField) {
+  Context ctx;
+  Group& g = ctx.createGroup("g", 10);
+  auto expectParam = [&](Emitter e, const std::string& param) {
+    try {
+      g.addEmitter(e);
+      FAIL() << "accepted " << param;
+    } catch (const InvalidArgument& err) {
+      EXPECT_EQ(err.parameter(), param) << err.what();
+    }
+  };
+  Emitter a;
+  a.rate = -1;
+  expectParam(a, "emitters[0].rate");
+  Emitter b;
+  b.rate = NAN;
+  expectParam(b, "emitters[0].rate");
+  Emitter c;
+  c.types[0].lifetime = Fuzzy(NAN);
+  expectParam(c, "emitters[0].types[0].lifetime");
+  Emitter d;
+  d.types.clear();
+  expectParam(d, "emitters[0].types");
+  Emitter f;
+  f.path = {{1.0, Vec3(0)}, {0.5, Vec3(1)}};
+  expectParam(f, "emitters[0].path[1].time");
+}
