@@ -7,6 +7,7 @@
 
 #include "builtin.hpp"
 #include "flurry/flurry.hpp"
+#include "outputs.hpp"
 
 namespace fs = std::filesystem;
 
@@ -22,7 +23,23 @@ struct RunOptions {
   unsigned threads = 0;
   std::size_t capacity = 1'000'000;
   bool quiet = false;
+  std::string backend = "cpu";
+  std::string device;
 };
+
+std::vector<std::unique_ptr<flurry::cli::Plugin>> makePlugins() {
+  std::vector<std::unique_ptr<flurry::cli::Plugin>> plugins;
+#ifdef FLURRY_CLI_PNG
+  plugins.push_back(flurry::cli::makePngPlugin());
+#endif
+#ifdef FLURRY_CLI_VDB
+  plugins.push_back(flurry::cli::makeVdbPlugin());
+#endif
+#ifdef FLURRY_CLI_OPENCL
+  plugins.push_back(flurry::cli::makeOpenCLPlugin());
+#endif
+  return plugins;
+}
 
 std::string frameName(const std::string& base, int frame, const char* ext) {
   char buf[32];
@@ -30,7 +47,7 @@ std::string frameName(const std::string& base, int frame, const char* ext) {
   return base + buf;
 }
 
-int run(const RunOptions& o) {
+int run(const RunOptions& o, std::vector<std::unique_ptr<flurry::cli::Plugin>>& plugins) {
   const flurry::samples::Sample* sample = flurry::samples::findSample(o.effect);
   if (!sample) {
     std::cerr << "flurry: no built-in effect named '" << o.effect << "' (see `flurry list`)\n";
@@ -48,9 +65,15 @@ int run(const RunOptions& o) {
   opts.seed = o.seed;
   opts.dt = o.dt;
   opts.threads = o.threads;
+  opts.backend = o.backend == "opencl" ? flurry::Backend::OpenCL
+                 : o.backend == "auto" ? flurry::Backend::Auto
+                                       : flurry::Backend::Cpu;
+  opts.device = o.device;
   flurry::Context ctx(opts);
   sample->build(ctx, o.capacity);
-  for (flurry::Group* g : ctx.groups()) g->require({flurry::Attribute::Color, flurry::Attribute::Size});
+  const flurry::cli::RunInfo info{o.effect, o.frames, o.quiet};
+  for (auto& p : plugins)
+    if (p->enabled()) p->begin(ctx, info);
 
   const auto start = std::chrono::steady_clock::now();
   int written = 0;
@@ -72,7 +95,11 @@ int run(const RunOptions& o) {
         ++written;
       }
     }
+    for (auto& p : plugins)
+      if (p->enabled()) p->frame(ctx, frame);
   }
+  for (auto& p : plugins)
+    if (p->enabled()) p->end(ctx);
   const double secs =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   for (flurry::Group* g : ctx.groups()) {
@@ -104,7 +131,12 @@ int main(int argc, char** argv) {
   runCmd->add_option("--capacity", o.capacity, "particles per group at most")
       ->check(CLI::Range(std::size_t(1), std::size_t(1) << 31));
   runCmd->add_flag("--quiet", o.quiet, "print only the summary");
+  runCmd->add_option("--backend", o.backend, "cpu, opencl or auto")
+      ->check(CLI::IsMember({"cpu", "opencl", "auto"}));
+  runCmd->add_option("--device", o.device, "OpenCL platform or device name (a substring)");
   app.add_subcommand("list", "list the built-in effects");
+  auto plugins = makePlugins();
+  for (auto& p : plugins) p->addOptions(app, *runCmd);
 
   try {
     app.parse(argc, argv);
@@ -112,12 +144,16 @@ int main(int argc, char** argv) {
     return app.exit(e);
   }
   try {
+    for (auto& p : plugins) {
+      int code = 0;
+      if (p->runCommand(app, code)) return code;
+    }
     if (app.got_subcommand("list")) {
       for (const auto& s : flurry::samples::builtinSamples())
         std::printf("%-12s %s\n", s.name.c_str(), s.description.c_str());
       return 0;
     }
-    return run(o);
+    return run(o, plugins);
   } catch (const flurry::Error& e) {
     std::cerr << "flurry: " << e.what() << "\n";
     return 1;

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <memory>
 
+#include "flurry/context.hpp"
 #include "group_impl.hpp"
 #include "thread_pool.hpp"
 
@@ -28,6 +29,11 @@ class BackendImpl {
 };
 
 std::unique_ptr<BackendImpl> makeCpuBackend();
+#ifdef FLURRY_WITH_OPENCL
+/// The OpenCL backend on the device `options` names (or the first one). Throws Error, saying
+/// why, when there is no OpenCL platform or device.
+std::unique_ptr<BackendImpl> makeOpenCLBackend(const ContextOptions& options);
+#endif
 
 /// Runs the group's action list over [0, size) as one fused pass and gathers the dead into
 /// group.holes (ascending) with their kill counts tallied into group.stats.

@@ -41,12 +41,28 @@ Context::Context(ContextOptions options) : impl_(std::make_unique<Impl>()) {
     case Backend::Cpu:
       break;
     case Backend::OpenCL:
-      throw Error("backend opencl: this build of Flurry has no OpenCL backend yet");
+#ifdef FLURRY_WITH_OPENCL
+      impl_->backend = detail::makeOpenCLBackend(options);  // throws, saying why, if none
+      impl_->backendKind = Backend::OpenCL;
+#else
+      throw Error("backend opencl: this build of Flurry has no OpenCL backend (FLURRY_OPENCL=OFF)");
+#endif
+      break;
     case Backend::Auto:
-      break;  // OpenCL when a device is there (once the backend exists), else the CPU
+#ifdef FLURRY_WITH_OPENCL
+      try {
+        impl_->backend = detail::makeOpenCLBackend(options);
+        impl_->backendKind = Backend::OpenCL;
+      } catch (const Error& e) {
+        std::fprintf(stderr, "flurry: %s; using the CPU backend\n", e.what());
+      }
+#endif
+      break;
   }
-  impl_->backend = detail::makeCpuBackend();
-  impl_->backendKind = Backend::Cpu;
+  if (!impl_->backend) {
+    impl_->backend = detail::makeCpuBackend();
+    impl_->backendKind = Backend::Cpu;
+  }
 }
 
 Context::~Context() = default;

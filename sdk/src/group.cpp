@@ -187,19 +187,26 @@ Group::Group(std::unique_ptr<detail::GroupImpl> impl) : impl_(std::move(impl)) {
 Group::~Group() = default;
 
 const std::string& Group::name() const { return impl_->name; }
-std::size_t Group::size() const { return impl_->size; }
+std::size_t Group::size() const {
+  impl_->syncHost();
+  return impl_->size;
+}
 std::size_t Group::capacity() const { return impl_->capacity; }
 AttributeSet Group::attributes() const { return impl_->wanted(); }
 
 void Group::require(AttributeSet attributes) {
+  impl_->syncHost();
   impl_->required.insert(attributes);
   impl_->ensureStorage();
+  impl_->hostChanged();
 }
 
 Group& Group::setActions(ActionList actions) {
+  impl_->syncHost();
   impl_->actions = std::move(actions);
   impl_->stats.killedByAction.assign(impl_->actions.size(), 0);
   impl_->ensureStorage();
+  impl_->hostChanged();
   return *this;
 }
 
@@ -216,6 +223,7 @@ std::span<Emitter> Group::emitters() { return impl_->emitters; }
 
 bool Group::add(const Particle& p) {
   auto& g = *impl_;
+  g.syncHost();
   g.ensureStorage();
   ++g.stats.emitted;
   if (g.size >= g.capacity) {
@@ -225,10 +233,12 @@ bool Group::add(const Particle& p) {
   Particle q = p;
   q.id = g.nextId++;
   g.write(g.size++, q);
+  g.hostChanged();
   return true;
 }
 
 Particle Group::particle(std::size_t i) const {
+  impl_->syncHost();
   if (i >= impl_->size)
     throw InvalidArgument("index", std::to_string(i) + " is past the live count " +
                                        std::to_string(impl_->size));
@@ -250,20 +260,25 @@ void checkFloatLane(const detail::GroupImpl& g, Attribute a, int component) {
 }  // namespace
 
 std::span<const float> Group::lane(Attribute a, int component) const {
+  impl_->syncHost();
   checkFloatLane(*impl_, a, component);
   return {impl_->lanes[std::size_t(a)][component].f(), impl_->size};
 }
 
 std::span<float> Group::lane(Attribute a, int component) {
+  impl_->syncHost();
   checkFloatLane(*impl_, a, component);
+  impl_->hostChanged();  // the caller may write through the span
   return {impl_->lanes[std::size_t(a)][component].f(), impl_->size};
 }
 
 std::span<const std::uint32_t> Group::ids() const {
+  impl_->syncHost();
   return {impl_->lanes[std::size_t(Attribute::Id)][0].u(), impl_->size};
 }
 
 std::span<const std::uint32_t> Group::visible() const {
+  impl_->syncHost();
   if (!impl_->stored.has(Attribute::Visible))
     throw Error("group '" + impl_->name + "' does not store attribute visible");
   return {impl_->lanes[std::size_t(Attribute::Visible)][0].u(), impl_->size};
@@ -273,6 +288,7 @@ const GroupStats& Group::stats() const { return impl_->stats; }
 
 Bounds Group::bounds() const {
   Bounds b;
+  impl_->syncHost();
   const auto& g = *impl_;
   if (g.size == 0) return b;
   const detail::Lanes l = g.lanePointers();
@@ -290,6 +306,10 @@ Bounds Group::bounds() const {
   return b;
 }
 
-void Group::clear() { impl_->size = 0; }
+void Group::clear() {
+  impl_->syncHost();
+  impl_->size = 0;
+  impl_->hostChanged();
+}
 
 }  // namespace flurry

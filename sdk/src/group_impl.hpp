@@ -61,6 +61,19 @@ struct EmitterState {
   std::uint64_t emittedByRate = 0;  ///< particles the rate has produced so far
 };
 
+struct GroupImpl;
+
+/// Set by a backend that keeps a group's particles on its device between steps (OpenCL):
+/// the host lanes are then brought up to date only when someone reads them.
+class DeviceMirror {
+ public:
+  virtual ~DeviceMirror() = default;
+  /// Copies the device's particles and live count into the host lanes, if the device's are newer.
+  virtual void pullToHost(GroupImpl& group) = 0;
+  /// The host changed the particles or the storage: the device must take the host's copy.
+  virtual void hostChanged(GroupImpl& group) = 0;
+};
+
 struct GroupImpl {
   std::string name;
   std::uint32_t index = 0;  ///< creation order in the context: keeps groups' random streams apart
@@ -81,6 +94,15 @@ struct GroupImpl {
   std::vector<std::uint32_t> deadCount;  ///< per block
   std::vector<std::uint32_t> holes;      ///< sorted dead indices of this step
   std::vector<std::uint32_t> deadFlags;  ///< the unfused baseline's per-particle kill codes
+
+  std::unique_ptr<DeviceMirror> mirror;  ///< null on the CPU backend
+
+  void syncHost() {
+    if (mirror) mirror->pullToHost(*this);
+  }
+  void hostChanged() {
+    if (mirror) mirror->hostChanged(*this);
+  }
 
   /// The attributes the group must store now.
   AttributeSet wanted() const { return required | actions.attributes(); }

@@ -18,6 +18,9 @@ struct ContextOptions {
   double dt = 1.0 / 30.0;  ///< seconds per step
   unsigned threads = 0;    ///< 0: one per hardware thread
   Backend backend = Backend::Cpu;
+  /// OpenCL: a substring of the platform or device name to use; empty takes the first GPU,
+  /// else the first device.
+  std::string device;
   /// Particles per block of the fused pass: every action runs over a block while it is in
   /// cache, so memory is read and written once per step. 0 picks the default.
   std::size_t blockSize = 0;

@@ -1,0 +1,43 @@
+// Optional parts of the `flurry` tool (PNG frames, VDB export, the viewer, OpenCL devices)
+// plug in here, each from its own source file, so the tool builds with whatever parts the
+// library was built with.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "flurry/flurry.hpp"
+
+namespace flurry::cli {
+
+struct RunInfo {
+  std::string effect;  ///< the effect's name, used to name output files
+  int frames = 0;
+  bool quiet = false;
+};
+
+class Plugin {
+ public:
+  virtual ~Plugin() = default;
+  /// Adds the plugin's flags to `flurry run` and any subcommands of its own to `app`.
+  virtual void addOptions(CLI::App& app, CLI::App& run) = 0;
+  /// Runs the plugin's own subcommand if it was given; returns true if it handled the call.
+  virtual bool runCommand(CLI::App& /*app*/, int& /*exitCode*/) { return false; }
+  /// Whether a flag of `flurry run` asked for this output.
+  virtual bool enabled() const = 0;
+  /// After the effect is built, before the first step: require the attributes it reads.
+  virtual void begin(Context& /*ctx*/, const RunInfo& /*info*/) {}
+  /// After each step; frame counts from 1.
+  virtual void frame(Context& ctx, int frame) = 0;
+  /// After the last step (wait for background work, print costs).
+  virtual void end(Context& /*ctx*/) {}
+};
+
+// Each factory is defined by its part's source file, compiled in when that part is built.
+std::unique_ptr<Plugin> makePngPlugin();     // png_output.cpp   (FLURRY_VIEWER)
+std::unique_ptr<Plugin> makeVdbPlugin();     // vdb_output.cpp   (FLURRY_VDB)
+std::unique_ptr<Plugin> makeOpenCLPlugin();  // opencl_devices.cpp (FLURRY_OPENCL)
+
+}  // namespace flurry::cli
