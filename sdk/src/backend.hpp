@@ -38,6 +38,8 @@ std::unique_ptr<BackendImpl> makeOpenCLBackend(const ContextOptions& options);
 /// Runs the group's action list over [0, size) as one fused pass and gathers the dead into
 /// group.holes (ascending) with their kill counts tallied into group.stats.
 void actFused(GroupImpl& group, const StepParams& params);
+/// The instruction set the fused pass runs with here: "avx512", "avx2" or "baseline".
+const char* fusedPassIsa();
 /// Creates the step's newborns from the emitters: first into holes, then at the end.
 /// Remaining holes are filled from the tail, so [0, size) is dense again.
 void emitAndCompact(GroupImpl& group, const StepParams& params);

@@ -11,13 +11,13 @@
 #include <glm/common.hpp>
 
 #include "flurry/error.hpp"
+#include "sampling.hpp"
 #include "shape_math.hpp"
 
 namespace flurry {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr float kTwoPi = 6.28318530717958647692f;
 
 // ---- validation --------------------------------------------------------------------------
 
@@ -132,16 +132,6 @@ Vec3 closestOnTriangle(Vec3 a, Vec3 b, Vec3 c, Vec3 p) {
 
 // Radius of a point drawn uniformly by area from the annulus ri <= r <= ro (double: r² and
 // r³ of large radii would overflow or lose bits in float).
-float annulusRadius(float u, float ri, float ro) {
-  const double ri2 = double(ri) * ri, ro2 = double(ro) * ro;
-  return float(std::sqrt(u * (ro2 - ri2) + ri2));
-}
-
-Vec3 onCircle(float u, Vec3 e1, Vec3 e2) {
-  const float phi = kTwoPi * u;
-  return e1 * std::cos(phi) + e2 * std::sin(phi);
-}
-
 // Cylinders and cones are surfaces of revolution: the nearest point lies in the half-plane
 // through the axis and p, so the problem reduces to 2-D coordinates (a along the axis, rho
 // away from it) and the shape to a few boundary segments, each with its outward normal.
@@ -224,76 +214,6 @@ Vec3 solidNormal(bool inside, Vec3 p, Vec3 c, Vec3 faceNormal, float scale) {
 }
 
 // ---- per-shape operations ----------------------------------------------------------------
-
-Vec3 sampleShape(const PointDomain& d, Random&) {
-  return d.p;
-}
-Vec3 sampleShape(const LineDomain& d, Random& rng) {
-  return d.p0 + (d.p1 - d.p0) * rng.uniform();
-}
-Vec3 sampleShape(const TriangleDomain& d, Random& rng) {
-  // su is how far the point lies from p0 towards the opposite edge; the cross-section there
-  // is su long, so su's density must grow linearly: su = sqrt(uniform).
-  const float su = std::sqrt(rng.uniform());
-  const float v = rng.uniform();
-  return d.p0 + (d.p1 - d.p0) * (su * (1.0f - v)) + (d.p2 - d.p0) * (su * v);
-}
-Vec3 sampleShape(const PlaneDomain& d, Random&) {
-  return d.point;
-}
-Vec3 sampleShape(const RectangleDomain& d, Random& rng) {
-  const float s = rng.uniform();
-  const float t = rng.uniform();
-  return d.origin + d.u * s + d.v * t;
-}
-Vec3 sampleShape(const DiscDomain& d, Random& rng) {
-  Vec3 e1, e2;
-  basis(d.normal, e1, e2);
-  const float r = annulusRadius(rng.uniform(), d.innerRadius, d.outerRadius);
-  return d.center + onCircle(rng.uniform(), e1, e2) * r;
-}
-Vec3 sampleShape(const BoxDomain& d, Random& rng) {
-  const Vec3 u(rng.uniform(), rng.uniform(), rng.uniform());
-  // The clamp undoes a rounding step past max, so samples always pass contains().
-  return glm::min(d.min + (d.max - d.min) * u, d.max);
-}
-Vec3 sampleShape(const SphereDomain& d, Random& rng) {
-  const double ri3 = std::pow(double(d.innerRadius), 3), ro3 = std::pow(double(d.outerRadius), 3);
-  // The volume inside radius r grows with r³; inner == outer gives r = outer, the surface.
-  const float r = float(std::cbrt(rng.uniform() * (ro3 - ri3) + ri3));
-  const float z = 1.0f - 2.0f * rng.uniform();  // uniform cos(theta): uniform on the sphere
-  const float s = std::sqrt(std::max(0.0f, 1.0f - z * z));
-  const float phi = kTwoPi * rng.uniform();
-  return d.center + Vec3(s * std::cos(phi), s * std::sin(phi), z) * r;
-}
-Vec3 sampleShape(const CylinderDomain& d, Random& rng) {
-  const Vec3 axis = d.p1 - d.p0;
-  Vec3 e1, e2;
-  basis(glm::normalize(axis), e1, e2);
-  const float t = rng.uniform();
-  const float r = annulusRadius(rng.uniform(), d.innerRadius, d.outerRadius);
-  return d.p0 + axis * t + onCircle(rng.uniform(), e1, e2) * r;
-}
-Vec3 sampleShape(const ConeDomain& d, Random& rng) {
-  const Vec3 axis = d.base - d.apex;
-  Vec3 e1, e2;
-  basis(glm::normalize(axis), e1, e2);
-  float t, r;
-  if (d.innerRadius < d.outerRadius) {
-    // The cross-section's area grows with t², so the volume up to t with t³.
-    t = std::cbrt(rng.uniform());
-    r = t * annulusRadius(rng.uniform(), d.innerRadius, d.outerRadius);
-  } else {
-    // The lateral surface's circumference grows with t, so its area up to t with t².
-    t = std::sqrt(rng.uniform());
-    r = t * d.outerRadius;
-  }
-  return d.apex + axis * t + onCircle(rng.uniform(), e1, e2) * r;
-}
-Vec3 sampleShape(const BlobDomain& d, Random& rng) {
-  const float x = rng.normal(), y = rng.normal(), z = rng.normal();
-  return d.center + Vec3(x, y, z) * d.stddev;
-}
 
 Vec3 closestShape(const PointDomain& d, Vec3) {
   return d.p;
@@ -579,7 +499,17 @@ Domain Domain::blob(Vec3 center, float stddev) {
 // ---- queries -------------------------------------------------------------------------------
 
 Vec3 Domain::sample(Random& rng) const {
-  return std::visit([&](const auto& s) { return sampleShape(s, rng); }, shape_);
+  // A batch of one through the emitters' batch samplers: the same formulas either way.
+  float u[6];
+  const float* rows[6];
+  const int k = detail::drawCount(*this);
+  for (int j = 0; j < k; ++j) {
+    u[j] = rng.uniform();
+    rows[j] = &u[j];
+  }
+  float x, y, z;
+  detail::sampleBatch(*this, rows, 1, &x, &y, &z);
+  return {x, y, z};
 }
 
 bool Domain::contains(Vec3 p) const {

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "backend.hpp"
+#include "sampling.hpp"
 
 namespace flurry::detail {
 
@@ -21,7 +22,7 @@ struct BirthRun {
   std::uint64_t count;
 };
 
-constexpr std::size_t kNewbornsPerTask = 8192;
+constexpr std::size_t kNewbornsPerTask = 8192;  // a multiple of kBatch
 
 // Particles a rate has produced by time t: floor(rate·elapsed), with a relative guard so
 // that 10.5/s over 10 s gives 105 despite the rounding of the accumulated time.
@@ -42,6 +43,202 @@ std::size_t chooseType(const Emitter& e, Random& rng) {
     u -= e.types[k].weight;
   }
   return e.types.size() - 1;
+}
+
+constexpr std::size_t kBatch = 256;
+constexpr int kMaxDraws = 48;
+
+struct NewbornContext {
+  GroupImpl& g;
+  Lanes L;
+  const StepParams& sp;
+  double t1;               // end of the step: newborns are aged to it
+  std::uint32_t firstId;   // id of newborn 0 of this step
+  std::size_t oldSize;     // appended newborns start here
+  const std::uint32_t* holes;
+  std::size_t holeCount;   // newborns [0, holeCount) fill these slots
+
+  std::size_t slot(std::size_t i) const { return i < holeCount ? holes[i] : oldSize + (i - holeCount); }
+};
+
+double birthTime(const BirthRun& run, const Emitter& em, std::uint64_t q) {
+  return run.burst ? run.burstTime : em.start + double(run.first + q + 1) / em.rate;
+}
+
+// Writes one newborn: born at tb where the emitter was then, carried on for the rest of the
+// step with its initial velocity.
+struct Newborn {
+  Vec3 pos, vel;
+  float lifetime, r, gr, bl, alpha, size, mass, charge;
+  Vec3 up, rot;
+};
+
+void store(const NewbornContext& nc, std::size_t slot, std::uint32_t id, float age,
+           const Newborn& b) {
+  const Lanes& L = nc.L;
+  for (int c = 0; c < 3; ++c) {
+    L.p[c][slot] = b.pos[c];
+    if (L.v[c]) L.v[c][slot] = b.vel[c];
+    if (L.prev[c]) L.prev[c][slot] = b.pos[c];
+    if (L.up[c]) L.up[c][slot] = b.up[c];
+    if (L.rot[c]) L.rot[c][slot] = b.rot[c];
+  }
+  if (L.lifetime) L.lifetime[slot] = std::max(b.lifetime, 0.0f);
+  if (L.color[0]) {
+    L.color[0][slot] = b.r;
+    L.color[1][slot] = b.gr;
+    L.color[2][slot] = b.bl;
+    L.color[3][slot] = b.alpha;
+  }
+  if (L.size) L.size[slot] = std::max(b.size, 0.0f);
+  if (L.mass) L.mass[slot] = b.mass;
+  if (L.charge) L.charge[slot] = b.charge;
+  if (L.age) L.age[slot] = age;
+  L.id[slot] = id;
+  if (L.visible) L.visible[slot] = 1u;
+  if (L.user) L.user[slot] = 0.0f;
+}
+
+// Emitters with one particle type: every draw of a batch at once (see sampling.hpp).
+void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
+               std::uint64_t q0, std::size_t i0, std::size_t m) {
+  const Lanes& L = nc.L;
+  const ParticleType& type = em.types[0];
+  // Scratch per thread, looked up once: in a shared library every thread_local access in a
+  // loop would go through __tls_get_addr.
+  struct Scratch {
+    float rows[kMaxDraws][kBatch];
+    float attr[16][kBatch];
+    float up[3][kBatch], rot[3][kBatch];
+    float age[kBatch];
+    std::uint32_t slot[kBatch];
+  };
+  thread_local Scratch scratch;
+  Scratch& sc = scratch;
+  auto& rows = sc.rows;
+  auto& attr = sc.attr;
+  auto& up = sc.up;
+  auto& rot = sc.rot;
+  auto& age = sc.age;
+  auto& slot = sc.slot;
+  const float* row[kMaxDraws];
+  for (int k = 0; k < kMaxDraws; ++k) row[k] = rows[k];
+
+  // The draws in the order the one-by-one path makes them.
+  int draws = drawCount(type.velocity) + drawCount(em.shape);
+  if (L.lifetime) draws += drawCount(type.lifetime);
+  if (L.color[0]) draws += drawCount(type.color) + drawCount(type.alpha);
+  if (L.size) draws += drawCount(type.size);
+  if (L.mass) draws += drawCount(type.mass);
+  if (L.charge) draws += drawCount(type.charge);
+  if (L.up[0]) draws += drawCount(type.up);
+  if (L.rot[0]) draws += drawCount(type.rotVelocity);
+  const std::uint32_t firstId = nc.firstId + std::uint32_t(i0);
+  for (int blk = 0; blk * 4 < draws; ++blk)
+    uniformBatch(nc.sp.seed, firstId, nc.g.index, stream::kEmission, std::uint32_t(blk), m,
+                 rows[4 * blk], rows[4 * blk + 1], rows[4 * blk + 2], rows[4 * blk + 3]);
+
+  int cur = 0;
+  auto vec = [&](const Domain& d, int a) {
+    sampleBatch(d, row + cur, m, attr[a], attr[a + 1], attr[a + 2]);
+    cur += drawCount(d);
+  };
+  auto scalar = [&](const Fuzzy& f, int a) {
+    sampleBatch(f, row + cur, m, attr[a]);
+    cur += drawCount(f);
+  };
+  vec(type.velocity, 0);  // attr 0-2
+  vec(em.shape, 3);       // 3-5
+  if (L.lifetime) scalar(type.lifetime, 6);
+  if (L.color[0]) {
+    vec(type.color, 7);  // 7-9
+    scalar(type.alpha, 10);
+  }
+  if (L.size) scalar(type.size, 11);
+  if (L.mass) scalar(type.mass, 12);
+  if (L.charge) scalar(type.charge, 13);
+  if (L.up[0]) {
+    sampleBatch(type.up, row + cur, m, up[0], up[1], up[2]);
+    cur += drawCount(type.up);
+  }
+  if (L.rot[0]) sampleBatch(type.rotVelocity, row + cur, m, rot[0], rot[1], rot[2]);
+
+  // Birth times and ages; positions where the emitter was at birth, carried on for the rest
+  // of the step.
+  float* const px = attr[3];
+  float* const py = attr[4];
+  float* const pz = attr[5];
+  const float* const vx = attr[0];
+  const float* const vy = attr[1];
+  const float* const vz = attr[2];
+  for (std::size_t k = 0; k < m; ++k) {
+    const double tb = birthTime(run, em, q0 + k);
+    age[k] = float(std::max(0.0, nc.t1 - tb));
+    const Vec3 e = em.path.empty() ? em.position + em.velocity * float(tb - em.start)
+                                   : em.positionAt(tb);
+    px[k] += e.x + vx[k] * age[k];
+    py[k] += e.y + vy[k] * age[k];
+    pz[k] += e.z + vz[k] * age[k];
+    slot[k] = std::uint32_t(nc.slot(i0 + k));
+  }
+  // Scatter into the slots, one lane at a time.
+  auto put = [&](float* lane, const float* src) {
+    if (lane)
+      for (std::size_t k = 0; k < m; ++k) lane[slot[k]] = src[k];
+  };
+  auto putNonNegative = [&](float* lane, float* src) {
+    if (!lane) return;
+    for (std::size_t k = 0; k < m; ++k) src[k] = std::max(src[k], 0.0f);
+    put(lane, src);
+  };
+  for (int c = 0; c < 3; ++c) {
+    put(L.p[c], attr[3 + c]);
+    put(L.v[c], attr[c]);
+    put(L.prev[c], attr[3 + c]);
+    put(L.up[c], up[c]);
+    put(L.rot[c], rot[c]);
+  }
+  putNonNegative(L.lifetime, attr[6]);
+  for (int c = 0; c < 4; ++c) put(L.color[c], attr[7 + c]);
+  putNonNegative(L.size, attr[11]);
+  put(L.mass, attr[12]);
+  put(L.charge, attr[13]);
+  put(L.age, age);
+  for (std::size_t k = 0; k < m; ++k) L.id[slot[k]] = firstId + std::uint32_t(k);
+  if (L.visible)
+    for (std::size_t k = 0; k < m; ++k) L.visible[slot[k]] = 1u;
+  if (L.user)
+    for (std::size_t k = 0; k < m; ++k) L.user[slot[k]] = 0.0f;
+}
+
+// Several particle types: each newborn picks its type first, then draws as emitBatch does.
+void emitOneByOne(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
+                  std::uint64_t q0, std::size_t i0, std::size_t m) {
+  const Lanes& L = nc.L;
+  for (std::size_t k = 0; k < m; ++k) {
+    const std::uint32_t id = nc.firstId + std::uint32_t(i0 + k);
+    Random rng(nc.sp.seed, id, nc.g.index, stream::kEmission);
+    const ParticleType& type = em.types[chooseType(em, rng)];
+    const double tb = birthTime(run, em, q0 + k);
+    const float age = float(std::max(0.0, nc.t1 - tb));
+    Newborn b{};
+    b.vel = type.velocity.sample(rng);
+    b.pos = em.shape.sample(rng) + em.positionAt(tb) + b.vel * age;
+    if (L.lifetime) b.lifetime = type.lifetime.sample(rng);
+    if (L.color[0]) {
+      const Vec3 rgb = type.color.sample(rng);
+      b.r = rgb.x;
+      b.gr = rgb.y;
+      b.bl = rgb.z;
+      b.alpha = type.alpha.sample(rng);
+    }
+    if (L.size) b.size = type.size.sample(rng);
+    if (L.mass) b.mass = type.mass.sample(rng);
+    if (L.charge) b.charge = type.charge.sample(rng);
+    if (L.up[0]) b.up = type.up.sample(rng);
+    if (L.rot[0]) b.rot = type.rotVelocity.sample(rng);
+    store(nc, nc.slot(i0 + k), id, age, b);
+  }
 }
 
 }  // namespace
@@ -90,58 +287,26 @@ void emitAndCompact(GroupImpl& g, const StepParams& sp) {
   if (accepted > 0) {
     runStart.assign(runs.size() + 1, 0);
     for (std::size_t r = 0; r < runs.size(); ++r) runStart[r + 1] = runStart[r] + runs[r].count;
-    const Lanes L = g.lanePointers();
-    const std::uint32_t firstId = g.nextId;
-    const std::size_t oldSize = g.size;
-    const std::uint32_t* holeIdx = g.holes.data();
-    const std::uint32_t salt = g.index;
+    NewbornContext nc{g, g.lanePointers(), sp, t1, g.nextId, g.size, g.holes.data(), holes};
     const std::size_t tasks = (accepted + kNewbornsPerTask - 1) / kNewbornsPerTask;
     sp.pool->parallelFor(tasks, [&](std::size_t task) {
       const std::size_t a = task * kNewbornsPerTask;
       const std::size_t b = std::min(accepted, a + kNewbornsPerTask);
       std::size_t r = std::size_t(std::upper_bound(runStart.begin(), runStart.end(), a) -
                                   runStart.begin()) - 1;
-      for (std::size_t i = a; i < b; ++i) {
+      // Split the task at run boundaries: a batch shares one emitter and birth rule.
+      for (std::size_t i = a; i < b;) {
         while (i >= runStart[r + 1]) ++r;
-        const BirthRun& run = runs[r];
-        const Emitter& em = g.emitters[run.emitter];
-        const std::uint64_t q = i - runStart[r];
-        const double tb = run.burst ? run.burstTime : em.start + double(run.first + q + 1) / em.rate;
-        const std::uint32_t id = firstId + std::uint32_t(i);
-        const std::size_t slot = i < holes ? holeIdx[i] : oldSize + (i - holes);
-
-        Random rng(sp.seed, id, salt, stream::kEmission);
-        const ParticleType& type = em.types[chooseType(em, rng)];
-        const float age = float(std::max(0.0, t1 - tb));
-        const Vec3 vel = type.velocity.sample(rng);
-        // Born at tb where the emitter was then, and carried on for the rest of the step.
-        const Vec3 pos = em.shape.sample(rng) + em.positionAt(tb) + vel * age;
-        for (int c = 0; c < 3; ++c) {
-          L.p[c][slot] = pos[c];
-          if (L.v[c]) L.v[c][slot] = vel[c];
-          if (L.prev[c]) L.prev[c][slot] = pos[c];
+        const std::size_t end = std::min<std::size_t>(b, runStart[r + 1]);
+        const Emitter& em = g.emitters[runs[r].emitter];
+        for (std::size_t j = i; j < end; j += kBatch) {
+          const std::size_t m = std::min(kBatch, end - j);
+          if (em.types.size() == 1)
+            emitBatch(nc, runs[r], em, j - runStart[r], j, m);
+          else
+            emitOneByOne(nc, runs[r], em, j - runStart[r], j, m);
         }
-        if (L.lifetime) L.lifetime[slot] = std::max(type.lifetime.sample(rng), 0.0f);
-        if (L.color[0]) {
-          const Vec3 rgb = type.color.sample(rng);
-          for (int c = 0; c < 3; ++c) L.color[c][slot] = rgb[c];
-          L.color[3][slot] = type.alpha.sample(rng);
-        }
-        if (L.size) L.size[slot] = std::max(type.size.sample(rng), 0.0f);
-        if (L.mass) L.mass[slot] = type.mass.sample(rng);
-        if (L.charge) L.charge[slot] = type.charge.sample(rng);
-        if (L.up[0]) {
-          const Vec3 up = type.up.sample(rng);
-          for (int c = 0; c < 3; ++c) L.up[c][slot] = up[c];
-        }
-        if (L.rot[0]) {
-          const Vec3 w = type.rotVelocity.sample(rng);
-          for (int c = 0; c < 3; ++c) L.rot[c][slot] = w[c];
-        }
-        if (L.age) L.age[slot] = age;
-        L.id[slot] = id;
-        if (L.visible) L.visible[slot] = 1u;
-        if (L.user) L.user[slot] = 0.0f;
+        i = end;
       }
     });
     g.nextId += std::uint32_t(accepted);

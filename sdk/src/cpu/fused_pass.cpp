@@ -10,7 +10,11 @@
 #include "../backend.hpp"
 #include "kernels.hpp"
 
-namespace flurry::detail {
+#ifndef FLURRY_ISA
+#define FLURRY_ISA baseline
+#endif
+
+namespace flurry::detail::FLURRY_ISA {
 
 namespace {
 
@@ -42,7 +46,7 @@ std::uint32_t collectDead(GroupImpl& g, std::size_t base, std::size_t n,
 
 }  // namespace
 
-void actFused(GroupImpl& g, const StepParams& sp) {
+void actFusedImpl(GroupImpl& g, const StepParams& sp) {
   g.holes.clear();
   const std::size_t n = g.size;
   const auto& acts = g.actions.actions();
@@ -64,7 +68,8 @@ void actFused(GroupImpl& g, const StepParams& sp) {
 
   if (sp.fused) {
     sp.pool->parallelFor(tasks, [&](std::size_t t) {
-      thread_local std::vector<std::uint32_t> dead;
+      thread_local std::vector<std::uint32_t> deadStore;
+      std::vector<std::uint32_t>& dead = deadStore;  // one TLS lookup, not one per use
       if (kills && dead.size() < B) dead.resize(B);
       const std::size_t end = std::min(blocks, (t + 1) * blocksPerTask);
       for (std::size_t b = t * blocksPerTask; b < end; ++b) {
@@ -116,4 +121,4 @@ void actFused(GroupImpl& g, const StepParams& sp) {
   }
 }
 
-}  // namespace flurry::detail
+}  // namespace flurry::detail::FLURRY_ISA
