@@ -221,7 +221,8 @@ TEST(Actions, InvalidParametersNameTheField) {
               "actions[0].Bounce.restitution");
   expectParam([] { ActionList{Bounce{Domain::plane(Vec3(0), Vec3(0, 1, 0)), 1.0f, 2.0f}}; },
               "actions[0].Bounce.friction");
-  expectParam([] { ActionList{Bounce{Domain::box(Vec3(0), Vec3(1))}}; }, "actions[0].Bounce.surface");
+  expectParam([] { ActionList{Bounce{Domain::cylinder(Vec3(0), Vec3(1), 1.0f)}}; },
+              "actions[0].Bounce.surface");
   expectParam([] { ActionList{Sink{Domain::box(Vec3(0), Vec3(1)), true, 1.5f}}; },
               "actions[0].Sink.passThrough");
   expectParam([] { Domain::sphere(Vec3(0), 0.0f); }, "sphere.outerRadius");

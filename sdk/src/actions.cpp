@@ -10,60 +10,272 @@ namespace {
 
 template <class T>
 constexpr const char* nameOf() {
-  if constexpr (std::is_same_v<T, Gravity>) return "Gravity";
-  if constexpr (std::is_same_v<T, Damping>) return "Damping";
-  if constexpr (std::is_same_v<T, Bounce>) return "Bounce";
-  if constexpr (std::is_same_v<T, Sink>) return "Sink";
-  if constexpr (std::is_same_v<T, KillOld>) return "KillOld";
-  if constexpr (std::is_same_v<T, Move>) return "Move";
+#define FLURRY_NAME(X) \
+  if constexpr (std::is_same_v<T, X>) return #X;
+  FLURRY_NAME(Gravity) FLURRY_NAME(Damping) FLURRY_NAME(RotDamping) FLURRY_NAME(OrbitPoint)
+  FLURRY_NAME(OrbitLine) FLURRY_NAME(Gravitate) FLURRY_NAME(Vortex) FLURRY_NAME(Jet)
+  FLURRY_NAME(Explosion) FLURRY_NAME(RandomAccel) FLURRY_NAME(RandomDisplace)
+  FLURRY_NAME(RandomVelocity) FLURRY_NAME(RandomRotVelocity) FLURRY_NAME(Turbulence)
+  FLURRY_NAME(ElectricField) FLURRY_NAME(MagneticField) FLURRY_NAME(SampledField)
+  FLURRY_NAME(Avoid) FLURRY_NAME(Follow) FLURRY_NAME(MatchVelocity) FLURRY_NAME(MatchRotVelocity)
+  FLURRY_NAME(TargetVelocity) FLURRY_NAME(TargetRotVelocity) FLURRY_NAME(TargetColor)
+  FLURRY_NAME(TargetSize) FLURRY_NAME(SpeedClamp) FLURRY_NAME(ColorOverLife)
+  FLURRY_NAME(SizeOverLife) FLURRY_NAME(Bounce) FLURRY_NAME(Sink) FLURRY_NAME(SinkVelocity)
+  FLURRY_NAME(Block) FLURRY_NAME(KillOld) FLURRY_NAME(Move) FLURRY_NAME(Constrain2D)
+  FLURRY_NAME(CopyVertexB) FLURRY_NAME(Restore) FLURRY_NAME(Callback)
+#undef FLURRY_NAME
+  return "Action";
 }
 
 bool finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 struct Validator {
   std::string where;
-  void require(bool ok, const char* field, const char* why) const {
+
+  void require(bool ok, const char* field, const std::string& why) const {
     if (!ok) throw InvalidArgument(where + "." + field, why);
   }
+  void finiteVec(Vec3 v, const char* field) const { require(finite(v), field, "not finite"); }
+  void finiteNum(float x, const char* field) const { require(std::isfinite(x), field, "not finite"); }
+  void nonNegative(float x, const char* field) const {
+    require(std::isfinite(x) && x >= 0, field, "must be finite and >= 0");
+  }
+  void positive(float x, const char* field) const {
+    require(std::isfinite(x) && x > 0, field, "must be finite and > 0");
+  }
+  // A radius may be infinite ("no limit") but must be > 0.
+  void radius(float x, const char* field) const {
+    require(!std::isnan(x) && x > 0, field, "must be > 0 (infinity: no limit)");
+  }
+  void axis(Vec3 v, const char* field) const {
+    finiteVec(v, field);
+    require(glm::dot(v, v) > 0, field, "zero length");
+  }
+  void falloff(const Falloff& f) const {
+    finiteVec(f.center, "falloff.center");
+    radius(f.radius, "falloff.radius");
+    nonNegative(f.power, "falloff.power");
+  }
+  void rate(Vec3 r, const char* field) const {
+    finiteVec(r, field);
+    require(r.x >= 0 && r.y >= 0 && r.z >= 0, field, "must be >= 0");
+  }
+  void orbit(float magnitude, float epsilon, float maxRadius) const {
+    finiteNum(magnitude, "magnitude");
+    positive(epsilon, "epsilon");  // softening: finite at r = 0
+    radius(maxRadius, "maxRadius");
+  }
+
   void operator()(const Gravity& a) const {
-    require(finite(a.acceleration), "acceleration", "not finite");
+    finiteVec(a.acceleration, "acceleration");
+    falloff(a.falloff);
   }
   void operator()(const Damping& a) const {
-    require(finite(a.rate), "rate", "not finite");
-    require(a.rate.x >= 0 && a.rate.y >= 0 && a.rate.z >= 0, "rate", "must be >= 0");
+    rate(a.rate, "rate");
+    falloff(a.falloff);
+  }
+  void operator()(const RotDamping& a) const { rate(a.rate, "rate"); }
+  void operator()(const OrbitPoint& a) const {
+    finiteVec(a.center, "center");
+    orbit(a.magnitude, a.epsilon, a.maxRadius);
+  }
+  void operator()(const OrbitLine& a) const {
+    finiteVec(a.point, "point");
+    axis(a.axis, "axis");
+    orbit(a.magnitude, a.epsilon, a.maxRadius);
+  }
+  void operator()(const Gravitate& a) const { orbit(a.magnitude, a.epsilon, a.maxRadius); }
+  void operator()(const Vortex& a) const {
+    finiteVec(a.center, "center");
+    axis(a.axis, "axis");
+    finiteNum(a.aroundSpeed, "aroundSpeed");
+    positive(a.coreRadius, "coreRadius");
+    nonNegative(a.tightness, "tightness");
+    finiteNum(a.inSpeed, "inSpeed");
+    finiteNum(a.upSpeed, "upSpeed");
+    nonNegative(a.responsiveness, "responsiveness");
+    radius(a.maxRadius, "maxRadius");
+  }
+  void operator()(const Jet& a) const {
+    finiteVec(a.center, "center");
+    radius(a.radius, "radius");
+  }
+  void operator()(const Explosion& a) const {
+    finiteVec(a.center, "center");
+    nonNegative(a.speed, "speed");
+    finiteNum(a.magnitude, "magnitude");
+    positive(a.stddev, "stddev");
+    positive(a.epsilon, "epsilon");
+    finiteNum(a.time, "time");
+  }
+  void operator()(const RandomAccel& a) const { falloff(a.falloff); }
+  void operator()(const RandomDisplace&) const {}
+  void operator()(const RandomVelocity&) const {}
+  void operator()(const RandomRotVelocity&) const {}
+  void operator()(const Turbulence& a) const {
+    finiteNum(a.amplitude, "amplitude");
+    positive(a.frequency, "frequency");
+    require(a.octaves >= 1 && a.octaves <= 8, "octaves", "must be in [1, 8]");
+    finiteVec(a.drift, "drift");
+    falloff(a.falloff);
+  }
+  void operator()(const ElectricField& a) const {
+    finiteVec(a.field, "field");
+    falloff(a.falloff);
+  }
+  void operator()(const MagneticField& a) const { finiteVec(a.field, "field"); }
+  void operator()(const SampledField& a) const {
+    require(a.field != nullptr, "field", "no field given");
+    a.field->validate((where + ".field").c_str());
+    finiteNum(a.strength, "strength");
+    nonNegative(a.responsiveness, "responsiveness");
+  }
+  void operator()(const Avoid& a) const {
+    finiteNum(a.magnitude, "magnitude");
+    positive(a.epsilon, "epsilon");
+    nonNegative(a.lookAhead, "lookAhead");
+  }
+  void operator()(const Follow& a) const { orbit(a.magnitude, a.epsilon, a.maxRadius); }
+  void operator()(const MatchVelocity& a) const { orbit(a.magnitude, a.epsilon, a.maxRadius); }
+  void operator()(const MatchRotVelocity& a) const { orbit(a.magnitude, a.epsilon, a.maxRadius); }
+  void operator()(const TargetVelocity& a) const {
+    finiteVec(a.velocity, "velocity");
+    nonNegative(a.rate, "rate");
+  }
+  void operator()(const TargetRotVelocity& a) const {
+    finiteVec(a.rotVelocity, "rotVelocity");
+    nonNegative(a.rate, "rate");
+  }
+  void operator()(const TargetColor& a) const {
+    finiteVec(a.color, "color");
+    finiteNum(a.alpha, "alpha");
+    nonNegative(a.rate, "rate");
+  }
+  void operator()(const TargetSize& a) const {
+    nonNegative(a.size, "size");
+    nonNegative(a.rate, "rate");
+  }
+  void operator()(const SpeedClamp& a) const {
+    nonNegative(a.minSpeed, "minSpeed");
+    require(!std::isnan(a.maxSpeed) && a.maxSpeed >= a.minSpeed, "maxSpeed", "must be >= minSpeed");
+  }
+  template <class Keys>
+  void keys(const Keys& k) const {
+    require(!k.empty(), "keys", "needs at least one key");
+    for (std::size_t i = 0; i < k.size(); ++i) {
+      require(std::isfinite(k[i].t) && k[i].t >= 0 && k[i].t <= 1, "keys",
+              "key " + std::to_string(i) + ": t must be in [0, 1]");
+      require(i == 0 || k[i].t >= k[i - 1].t, "keys", "key times must not decrease");
+    }
+  }
+  void operator()(const ColorOverLife& a) const {
+    keys(a.keys);
+    for (const auto& k : a.keys)
+      require(std::isfinite(k.color.r) && std::isfinite(k.color.g) && std::isfinite(k.color.b) &&
+                  std::isfinite(k.color.a),
+              "keys", "a color is not finite");
+  }
+  void operator()(const SizeOverLife& a) const {
+    keys(a.keys);
+    for (const auto& k : a.keys) nonNegative(k.size, "keys");
   }
   void operator()(const Bounce& a) const {
     const auto& s = a.surface.shape();
-    const bool ok = std::holds_alternative<PlaneDomain>(s) ||
-                    std::holds_alternative<RectangleDomain>(s) ||
-                    std::holds_alternative<DiscDomain>(s) ||
-                    std::holds_alternative<TriangleDomain>(s) ||
-                    std::holds_alternative<SphereDomain>(s);
+    const bool closed = std::holds_alternative<SphereDomain>(s) || std::holds_alternative<BoxDomain>(s);
+    const bool ok = a.surface.isPlanar() || closed || std::holds_alternative<LineDomain>(s);
     if (!ok)
       throw InvalidArgument(where + ".surface",
                             std::string("a ") + a.surface.name() +
-                                " cannot deflect (use a plane, rectangle, disc, triangle or sphere)");
-    require(std::isfinite(a.restitution) && a.restitution >= 0, "restitution",
-            "must be finite and >= 0");
+                                " cannot deflect (use a plane, rectangle, disc, triangle, sphere, "
+                                "box, or a line segment in 2-D)");
+    require(!a.inside || closed, "inside", "only a sphere or a box can keep particles inside");
+    nonNegative(a.restitution, "restitution");
     require(std::isfinite(a.friction) && a.friction >= 0 && a.friction <= 1, "friction",
             "must be in [0, 1]");
-    require(std::isfinite(a.cutoff) && a.cutoff >= 0, "cutoff", "must be finite and >= 0");
+    nonNegative(a.cutoff, "cutoff");
+    if (std::holds_alternative<LineDomain>(s)) {
+      axis(a.planeNormal, "planeNormal");
+      const auto& l = std::get<LineDomain>(s);
+      const Vec3 n = glm::cross(l.p1 - l.p0, a.planeNormal);
+      require(glm::dot(n, n) > 0, "planeNormal", "the segment lies along the plane's normal");
+    }
   }
   void operator()(const Sink& a) const {
     require(std::isfinite(a.passThrough) && a.passThrough >= 0 && a.passThrough <= 1,
             "passThrough", "must be in [0, 1]");
+    require(a.mode != Sink::Mode::Hit || a.region.isPlanar(), "mode",
+            "Hit needs a plane piece (plane, rectangle, disc, triangle)");
   }
+  void operator()(const SinkVelocity&) const {}
+  void operator()(const Block&) const {}
   void operator()(const KillOld&) const {}
   void operator()(const Move&) const {}
+  void operator()(const Constrain2D& a) const {
+    finiteVec(a.point, "point");
+    axis(a.normal, "normal");
+  }
+  void operator()(const CopyVertexB&) const {}
+  void operator()(const Restore& a) const {
+    finiteNum(a.start, "start");
+    positive(a.duration, "duration");
+  }
+  void operator()(const Callback& a) const {
+    require(bool(a.function), "function", "no function given");
+  }
 };
 
+using A = Attribute;
+
 struct Uses {
-  AttributeSet operator()(const Gravity&) const { return {Attribute::Velocity}; }
-  AttributeSet operator()(const Damping&) const { return {Attribute::Velocity}; }
-  AttributeSet operator()(const Bounce&) const { return {Attribute::Position, Attribute::Velocity}; }
-  AttributeSet operator()(const Sink&) const { return {Attribute::Position}; }
-  AttributeSet operator()(const KillOld&) const { return {Attribute::Age, Attribute::Lifetime}; }
-  AttributeSet operator()(const Move&) const { return {Attribute::Position, Attribute::Velocity}; }
+  AttributeSet operator()(const Gravity&) const { return {A::Position, A::Velocity}; }
+  AttributeSet operator()(const Damping&) const { return {A::Position, A::Velocity}; }
+  AttributeSet operator()(const RotDamping&) const { return {A::RotVelocity}; }
+  AttributeSet operator()(const OrbitPoint&) const { return {A::Position, A::Velocity}; }
+  AttributeSet operator()(const OrbitLine&) const { return {A::Position, A::Velocity}; }
+  AttributeSet operator()(const Gravitate&) const { return {A::Position, A::Velocity}; }
+  AttributeSet operator()(const Vortex&) const { return {A::Position, A::Velocity}; }
+  AttributeSet operator()(const Jet&) const { return {A::Position, A::Velocity, A::Id}; }
+  AttributeSet operator()(const Explosion&) const { return {A::Position, A::Velocity}; }
+  AttributeSet operator()(const RandomAccel&) const { return {A::Position, A::Velocity, A::Id}; }
+  AttributeSet operator()(const RandomDisplace&) const { return {A::Position, A::Id}; }
+  AttributeSet operator()(const RandomVelocity&) const { return {A::Velocity, A::Id}; }
+  AttributeSet operator()(const RandomRotVelocity&) const { return {A::RotVelocity, A::Id}; }
+  AttributeSet operator()(const Turbulence&) const { return {A::Position, A::Velocity}; }
+  AttributeSet operator()(const ElectricField&) const {
+    return {A::Position, A::Velocity, A::Charge, A::Mass};
+  }
+  AttributeSet operator()(const MagneticField&) const { return {A::Velocity, A::Charge, A::Mass}; }
+  AttributeSet operator()(const SampledField&) const { return {A::Position, A::Velocity}; }
+  AttributeSet operator()(const Avoid&) const { return {A::Position, A::Velocity}; }
+  AttributeSet operator()(const Follow&) const { return {A::Position, A::Velocity}; }
+  AttributeSet operator()(const MatchVelocity&) const { return {A::Position, A::Velocity}; }
+  AttributeSet operator()(const MatchRotVelocity&) const { return {A::Position, A::RotVelocity}; }
+  AttributeSet operator()(const TargetVelocity&) const { return {A::Velocity}; }
+  AttributeSet operator()(const TargetRotVelocity&) const { return {A::RotVelocity}; }
+  AttributeSet operator()(const TargetColor&) const { return {A::Color}; }
+  AttributeSet operator()(const TargetSize&) const { return {A::Size}; }
+  AttributeSet operator()(const SpeedClamp&) const { return {A::Velocity}; }
+  AttributeSet operator()(const ColorOverLife&) const { return {A::Color, A::Age, A::Lifetime}; }
+  AttributeSet operator()(const SizeOverLife&) const { return {A::Size, A::Age, A::Lifetime}; }
+  AttributeSet operator()(const Bounce&) const { return {A::Position, A::Velocity}; }
+  AttributeSet operator()(const Sink& a) const {
+    AttributeSet s{A::Position};
+    if (a.mode == Sink::Mode::Enter || a.mode == Sink::Mode::Leave || a.mode == Sink::Mode::Hit)
+      s.insert(A::Velocity);
+    return s;
+  }
+  AttributeSet operator()(const SinkVelocity&) const { return {A::Velocity}; }
+  AttributeSet operator()(const Block&) const { return {A::Position, A::Visible}; }
+  AttributeSet operator()(const KillOld&) const { return {A::Age, A::Lifetime}; }
+  AttributeSet operator()(const Move&) const { return {A::Position, A::Velocity}; }
+  AttributeSet operator()(const Constrain2D&) const { return {A::Position, A::Velocity}; }
+  AttributeSet operator()(const CopyVertexB& a) const {
+    AttributeSet s{A::Position, A::PositionB};
+    if (a.copyVelocity) s.insert(A::Velocity).insert(A::VelocityB);
+    return s;
+  }
+  AttributeSet operator()(const Restore&) const { return {A::Position, A::Velocity, A::PositionB}; }
+  AttributeSet operator()(const Callback& a) const { return AttributeSet{A::Position} | a.attributes; }
 };
 
 }  // namespace
@@ -90,7 +302,17 @@ AttributeSet ActionList::attributes() const {
 
 bool ActionList::kills() const {
   for (const Action& a : actions_)
-    if (std::holds_alternative<Sink>(a) || std::holds_alternative<KillOld>(a)) return true;
+    if (std::holds_alternative<Sink>(a) || std::holds_alternative<KillOld>(a) ||
+        std::holds_alternative<SinkVelocity>(a))
+      return true;
+  return false;
+}
+
+bool ActionList::readsNeighbours() const {
+  for (const Action& a : actions_)
+    if (std::holds_alternative<Gravitate>(a) || std::holds_alternative<Follow>(a) ||
+        std::holds_alternative<MatchVelocity>(a) || std::holds_alternative<MatchRotVelocity>(a))
+      return true;
   return false;
 }
 

@@ -38,6 +38,9 @@ std::unique_ptr<BackendImpl> makeOpenCLBackend(const ContextOptions& options);
 /// Runs the group's action list over [0, size) as one fused pass and gathers the dead into
 /// group.holes (ascending) with their kill counts tallied into group.stats.
 void actFused(GroupImpl& group, const StepParams& params);
+/// Hair mode: runs the group's newborns to their deaths through its action list, recording
+/// their paths as strands; the group keeps no live particles.
+void simulateHair(GroupImpl& group, const StepParams& params);
 /// The instruction set the fused pass runs with here: "avx512", "avx2" or "baseline".
 const char* fusedPassIsa();
 /// Creates the step's newborns from the emitters: first into holes, then at the end.

@@ -18,6 +18,7 @@ namespace flurry {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+constexpr float kInfinityF = std::numeric_limits<float>::infinity();
 
 // ---- validation --------------------------------------------------------------------------
 
@@ -369,6 +370,54 @@ Vec3 normalShape(const ConeDomain& d, Vec3 p) {
                      f.length + d.outerRadius);
 }
 
+Vec3 closestShape(const MeshDomain& d, Vec3 p) {
+  const MeshData& m = *d.mesh;
+  Vec3 best = m.vertices[m.triangles[0].x];
+  float bestD2 = kInfinityF;
+  for (const glm::uvec3& t : m.triangles) {
+    const Vec3 c = closestOnTriangle(m.vertices[t.x], m.vertices[t.y], m.vertices[t.z], p);
+    const float d2 = glm::dot(c - p, c - p);
+    if (d2 < bestD2) {
+      bestD2 = d2;
+      best = c;
+    }
+  }
+  return best;
+}
+Vec3 normalShape(const MeshDomain& d, Vec3 p) {
+  const MeshData& m = *d.mesh;
+  std::size_t best = 0;
+  float bestD2 = kInfinityF;
+  for (std::size_t k = 0; k < m.triangles.size(); ++k) {
+    const glm::uvec3& t = m.triangles[k];
+    const Vec3 c = closestOnTriangle(m.vertices[t.x], m.vertices[t.y], m.vertices[t.z], p);
+    const float d2 = glm::dot(c - p, c - p);
+    if (d2 < bestD2) {
+      bestD2 = d2;
+      best = k;
+    }
+  }
+  return m.normals[best];
+}
+double measureShape(const MeshDomain& d) { return d.mesh->cumulativeArea.back(); }
+
+// The part whose surface is nearest decides a union's closest point and normal.
+const Domain& nearestPart(const UnionDomain& d, Vec3 p) {
+  const Domain* best = &d.parts->parts.front();
+  float bestD = kInfinityF;
+  for (const Domain& part : d.parts->parts) {
+    const float dist = part.distance(p);
+    if (dist < bestD) {
+      bestD = dist;
+      best = &part;
+    }
+  }
+  return *best;
+}
+Vec3 closestShape(const UnionDomain& d, Vec3 p) { return nearestPart(d, p).closestPoint(p); }
+Vec3 normalShape(const UnionDomain& d, Vec3 p) { return nearestPart(d, p).normal(p); }
+double measureShape(const UnionDomain& d) { return d.parts->cumulativeMeasure.back(); }
+
 double measureShape(const PointDomain&) {
   return 0.0;
 }
@@ -498,10 +547,95 @@ Domain Domain::blob(Vec3 center, float stddev) {
 
 // ---- queries -------------------------------------------------------------------------------
 
+Domain Domain::mesh(std::vector<Vec3> vertices, std::vector<glm::uvec3> triangles) {
+  if (triangles.empty()) throw InvalidArgument("mesh.triangles", "a mesh needs at least one triangle");
+  for (std::size_t i = 0; i < vertices.size(); ++i)
+    if (!finite(vertices[i]))
+      throw InvalidArgument("mesh.vertices[" + std::to_string(i) + "]", "not finite");
+  auto data = std::make_shared<MeshData>();
+  data->normals.reserve(triangles.size());
+  data->cumulativeArea.reserve(triangles.size());
+  double area = 0;
+  for (std::size_t k = 0; k < triangles.size(); ++k) {
+    const glm::uvec3 t = triangles[k];
+    const std::string where = "mesh.triangles[" + std::to_string(k) + "]";
+    if (t.x >= vertices.size() || t.y >= vertices.size() || t.z >= vertices.size())
+      throw InvalidArgument(where, "vertex index out of range (" + std::to_string(vertices.size()) +
+                                       " vertices)");
+    const Vec3 a = vertices[t.x], b = vertices[t.y], c = vertices[t.z];
+    data->normals.push_back(spanNormal(b - a, c - a, where.c_str()));
+    area += 0.5 * double(glm::length(glm::cross(b - a, c - a)));
+    data->cumulativeArea.push_back(area);
+  }
+  data->min = data->max = vertices[triangles[0].x];
+  for (const glm::uvec3& t : triangles)
+    for (unsigned v : {t.x, t.y, t.z}) {
+      data->min = glm::min(data->min, vertices[v]);
+      data->max = glm::max(data->max, vertices[v]);
+    }
+  data->vertices = std::move(vertices);
+  data->triangles = std::move(triangles);
+  return Domain(MeshDomain{std::move(data)});
+}
+
+Domain Domain::unite(std::vector<Domain> parts) {
+  if (parts.empty()) throw InvalidArgument("union.parts", "a union needs at least one part");
+  auto data = std::make_shared<UnionData>();
+  double total = 0;
+  for (const Domain& part : parts) {
+    total += part.measure();
+    data->cumulativeMeasure.push_back(total);
+  }
+  if (!(total > 0)) {  // points, or infinite planes: pick parts equally often
+    for (std::size_t i = 0; i < parts.size(); ++i) data->cumulativeMeasure[i] = double(i + 1);
+  }
+  data->parts = std::move(parts);
+  Domain d(UnionDomain{std::move(data)});
+  if (detail::drawCount(d) > detail::kMaxDomainDraws)
+    throw InvalidArgument("union.parts", "unions nested too deeply to sample");
+  return d;
+}
+
+namespace detail {
+
+bool inside(const MeshDomain& d, Vec3 p) {
+  const MeshData& m = *d.mesh;
+  if (p.x < m.min.x || p.y < m.min.y || p.z < m.min.z || p.x > m.max.x || p.y > m.max.y ||
+      p.z > m.max.z)
+    return false;
+  // Count crossings of a ray from p (Möller-Trumbore). The direction is skewed so that it
+  // does not run along the axis-aligned edges and faces that meshes are full of.
+  const Vec3 dir = glm::normalize(Vec3(1.0f, 0.1234567f, 0.0765432f));
+  int crossings = 0;
+  for (const glm::uvec3& t : m.triangles) {
+    const Vec3 a = m.vertices[t.x], e1 = m.vertices[t.y] - a, e2 = m.vertices[t.z] - a;
+    const Vec3 h = glm::cross(dir, e2);
+    const float det = glm::dot(e1, h);
+    if (std::abs(det) < 1e-12f) continue;
+    const float inv = 1.0f / det;
+    const Vec3 s = p - a;
+    const float u = glm::dot(s, h) * inv;
+    if (u < 0.0f || u > 1.0f) continue;
+    const Vec3 q = glm::cross(s, e1);
+    const float v = glm::dot(dir, q) * inv;
+    if (v < 0.0f || u + v > 1.0f) continue;
+    if (glm::dot(e2, q) * inv > 0.0f) ++crossings;
+  }
+  return (crossings & 1) != 0;
+}
+
+bool inside(const UnionDomain& d, Vec3 p) {
+  for (const Domain& part : d.parts->parts)
+    if (part.contains(p)) return true;
+  return false;
+}
+
+}  // namespace detail
+
 Vec3 Domain::sample(Random& rng) const {
   // A batch of one through the emitters' batch samplers: the same formulas either way.
-  float u[6];
-  const float* rows[6];
+  float u[detail::kMaxDomainDraws];
+  const float* rows[detail::kMaxDomainDraws];
   const int k = detail::drawCount(*this);
   for (int j = 0; j < k; ++j) {
     u[j] = rng.uniform();
@@ -537,9 +671,9 @@ bool Domain::isPlanar() const {
 
 const char* Domain::name() const {
   // In the order of Domain::Shape's alternatives.
-  static constexpr const char* kNames[] = {"point",     "line", "triangle", "plane",
-                                           "rectangle", "disc", "box",      "sphere",
-                                           "cylinder",  "cone", "blob"};
+  static constexpr const char* kNames[] = {"point",    "line", "triangle", "plane", "rectangle",
+                                           "disc",     "box",  "sphere",   "cylinder", "cone",
+                                           "blob",     "mesh", "union"};
   static_assert(std::size(kNames) == std::variant_size_v<Shape>);
   return kNames[shape_.index()];
 }

@@ -13,13 +13,16 @@ namespace flurry::detail {
 
 namespace {
 
-// One run of births of one emitter: by rate (birth times first/rate apart) or a burst.
+// One run of births of one emitter: by rate (birth times first/rate apart), a burst, or by
+// distance travelled (births `spacing` apart along the step's path).
 struct BirthRun {
-  std::uint32_t emitter;
-  bool burst;
-  std::uint64_t first;  // rate: index of the first birth since the emitter's start
-  double burstTime;
+  enum Kind { Rate, Burst, Distance } kind;
+  bool live;             // the emitter is g.live[index], else g.emitters[index]
+  std::uint32_t index;
+  std::uint64_t first;   // Rate: index of the first birth since the emitter's start
+  double time;           // Burst: its time; Distance: the step's start
   std::uint64_t count;
+  double s0 = 0, spacing = 0, span = 0, dt = 0;  // Distance: first birth at s0 of span
 };
 
 constexpr std::size_t kNewbornsPerTask = 8192;  // a multiple of kBatch
@@ -62,7 +65,18 @@ struct NewbornContext {
 };
 
 double birthTime(const BirthRun& run, const Emitter& em, std::uint64_t q) {
-  return run.burst ? run.burstTime : em.start + double(run.first + q + 1) / em.rate;
+  switch (run.kind) {
+    case BirthRun::Rate:
+      return em.start + double(run.first + q + 1) / em.rate;
+    case BirthRun::Burst:
+      return run.time;
+    default:
+      return run.time + run.dt * (run.s0 + double(q) * run.spacing) / run.span;
+  }
+}
+
+const Emitter& emitterOf(const GroupImpl& g, const BirthRun& run) {
+  return run.live ? g.live[run.index].emitter : g.emitters[run.index];
 }
 
 // Writes one newborn: born at tb where the emitter was then, carried on for the rest of the
@@ -125,7 +139,9 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
   for (int k = 0; k < kMaxDraws; ++k) row[k] = rows[k];
 
   // The draws in the order the one-by-one path makes them.
+  const bool alongNormal = !(em.normalSpeed.constant() && em.normalSpeed.center == 0.0f);
   int draws = drawCount(type.velocity) + drawCount(em.shape);
+  if (alongNormal) draws += drawCount(em.normalSpeed);
   if (L.lifetime) draws += drawCount(type.lifetime);
   if (L.color[0]) draws += drawCount(type.color) + drawCount(type.alpha);
   if (L.size) draws += drawCount(type.size);
@@ -149,6 +165,14 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
   };
   vec(type.velocity, 0);  // attr 0-2
   vec(em.shape, 3);       // 3-5
+  if (alongNormal) {
+    // Every face emits along its normal: the shape's normal where the particle was born.
+    scalar(em.normalSpeed, 15);
+    for (std::size_t k = 0; k < m; ++k) {
+      const Vec3 nrm = em.shape.normal(Vec3(attr[3][k], attr[4][k], attr[5][k]));
+      for (int d = 0; d < 3; ++d) attr[d][k] += nrm[d] * attr[15][k];
+    }
+  }
   if (L.lifetime) scalar(type.lifetime, 6);
   if (L.color[0]) {
     vec(type.color, 7);  // 7-9
@@ -223,7 +247,10 @@ void emitOneByOne(const NewbornContext& nc, const BirthRun& run, const Emitter& 
     const float age = float(std::max(0.0, nc.t1 - tb));
     Newborn b{};
     b.vel = type.velocity.sample(rng);
-    b.pos = em.shape.sample(rng) + em.positionAt(tb) + b.vel * age;
+    const Vec3 local = em.shape.sample(rng);
+    if (!(em.normalSpeed.constant() && em.normalSpeed.center == 0.0f))
+      b.vel += em.shape.normal(local) * em.normalSpeed.sample(rng);
+    b.pos = local + em.positionAt(tb) + b.vel * age;
     if (L.lifetime) b.lifetime = type.lifetime.sample(rng);
     if (L.color[0]) {
       const Vec3 rgb = type.color.sample(rng);
@@ -241,10 +268,171 @@ void emitOneByOne(const NewbornContext& nc, const BirthRun& run, const Emitter& 
   }
 }
 
+
+// ---- Planning: who is born this step, by which emitter, when -----------------------------
+
+// The births of one emitter (static or live) over (t0, t1]: its rate, its bursts in
+// [t0, t1), and one birth per `spacing` of the path it travels.
+std::uint64_t planEmitter(const Emitter& em, EmitterState& state, bool live, std::uint32_t index,
+                          double t0, double t1, std::vector<BirthRun>& runs) {
+  std::uint64_t total = 0;
+  if (em.rate > 0) {
+    const std::uint64_t target = producedBy(em, t1);
+    if (target > state.emittedByRate) {
+      runs.push_back({BirthRun::Rate, live, index, state.emittedByRate, 0.0,
+                      target - state.emittedByRate});
+      total += target - state.emittedByRate;
+      state.emittedByRate = target;
+    }
+  }
+  for (const Burst& b : em.bursts) {
+    for (std::uint32_t r = 0; r < b.repeat; ++r) {
+      const double tb = b.time + r * b.interval;
+      if (tb >= t0 && tb < t1 && tb >= em.start && tb <= em.stop && b.count > 0) {
+        runs.push_back({BirthRun::Burst, live, index, 0, tb, b.count});
+        total += b.count;
+      }
+    }
+  }
+  if (em.spacing > 0) {
+    const double a = std::max(t0, em.start), b = std::min(t1, em.stop);
+    if (b > a) {
+      const double span = glm::length(em.positionAt(b) - em.positionAt(a));
+      // Births at distances spacing - travelled, + spacing, ... along this step's path.
+      const double s0 = em.spacing - state.travelled;
+      if (span >= s0) {
+        const auto count = std::uint64_t(std::floor((span - s0) / em.spacing)) + 1;
+        BirthRun run{BirthRun::Distance, live, index, 0, a, count};
+        run.s0 = s0;
+        run.spacing = em.spacing;
+        run.span = span;
+        run.dt = b - a;
+        runs.push_back(run);
+        total += count;
+        state.travelled = span - (s0 + double(count - 1) * em.spacing);
+      } else {
+        state.travelled += span;
+      }
+    }
+  }
+  return total;
+}
+
+// Exact motion under constant acceleration and linear drag over time t.
+void fly(const EmitterSpec& spec, Vec3 p0, Vec3 v0, double t, Vec3& p, Vec3& v) {
+  const float k = spec.drag, tf = float(t);
+  const Vec3 a = spec.acceleration;
+  if (k > 0.0f) {
+    const float e = std::exp(-k * tf);
+    const Vec3 terminal = a / k;
+    v = terminal + (v0 - terminal) * e;
+    p = p0 + terminal * tf + (v0 - terminal) * ((1.0f - e) / k);
+  } else {
+    v = v0 + a * tf;
+    p = p0 + v0 * tf + a * (0.5f * tf * tf);
+  }
+}
+
+void spawn(GroupImpl& g, const StepParams& sp, std::shared_ptr<const EmitterSpec> spec,
+           double birth, Vec3 place, Vec3 parentVelocity, std::uint32_t generation,
+           const Domain* shape) {
+  const std::uint32_t id = g.nextEmitterId++;
+  Random rng(sp.seed, id, g.index, stream::kEmitterEvent);
+  LiveEmitter e;
+  e.id = id;
+  e.position = place + (shape ? shape->sample(rng) : Vec3(0.0f));
+  e.velocity = spec->velocity.sample(rng) + parentVelocity * spec->inheritVelocity;
+  const double life = std::max(1e-6f, spec->lifetime.sample(rng));
+  e.birth = birth;
+  e.death = birth + life;
+  e.generation = generation;
+  e.emitter = spec->emitter;
+  e.emitter.start = birth;
+  e.emitter.stop = std::min(e.death, birth + (spec->emitter.stop - spec->emitter.start));
+  for (Burst& b : e.emitter.bursts) b.time += birth;  // a spec's bursts are timed from birth
+  e.spec = spec.get();
+  e.keepAlive = std::move(spec);
+  g.live.push_back(std::move(e));
+  ++g.stats.emittersSpawned;
+}
+
+void countGeneration(GroupImpl& g, std::uint32_t generation, std::uint64_t n) {
+  if (g.stats.emittedByGeneration.size() <= generation)
+    g.stats.emittedByGeneration.resize(generation + 1, 0);
+  g.stats.emittedByGeneration[generation] += n;
+}
+
+std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, std::vector<BirthRun>& runs) {
+  const double t0 = sp.time, t1 = sp.time + sp.dt;
+  std::uint64_t total = 0;
+  for (std::uint32_t e = 0; e < g.emitters.size(); ++e) {
+    const std::uint64_t n = planEmitter(g.emitters[e], g.emitterState[e], false, e, t0, t1, runs);
+    countGeneration(g, 0, n);
+    total += n;
+  }
+  // Prime emitters spawn emitters at their birth times, where the prime was then.
+  if (g.primeSpecs.size() != g.primes.size()) {
+    g.primeSpecs.clear();
+    for (const PrimeEmitter& p : g.primes) g.primeSpecs.push_back(std::make_shared<EmitterSpec>(p.child));
+  }
+  for (std::size_t k = 0; k < g.primes.size(); ++k) {
+    const PrimeEmitter& prime = g.primes[k];
+    Emitter counter;  // counts like an emitter
+    counter.rate = prime.rate;
+    counter.bursts = prime.bursts;
+    counter.start = prime.start;
+    counter.stop = prime.stop;
+    std::vector<BirthRun> spawns;
+    planEmitter(counter, g.primeState[k], false, 0, t0, t1, spawns);
+    for (const BirthRun& run : spawns)
+      for (std::uint64_t q = 0; q < run.count; ++q) {
+        const double tb = birthTime(run, counter, q);
+        spawn(g, sp, g.primeSpecs[k], tb, prime.positionAt(tb), prime.velocity, 1, &prime.shape);
+      }
+  }
+  // Live emitters (those spawned just now too, and their death children): move, emit, die.
+  for (std::size_t k = 0; k < g.live.size(); ++k) {
+    LiveEmitter& e = g.live[k];
+    const double a = std::max(t0, e.birth), b = std::min(t1, e.death);
+    if (b < a) continue;
+    const double stateTime = std::max(t0, e.birth);
+    Vec3 pb, vb, pm, vm;
+    fly(*e.spec, e.position, e.velocity, b - stateTime, pb, vb);
+    fly(*e.spec, e.position, e.velocity, 0.5 * (b - stateTime), pm, vm);
+    // This step's curved flight as three keys: births inside the step sit on it.
+    e.emitter.path = {{a, e.position}, {0.5 * (a + b), pm}, {b, pb}};
+    if (!(b > a)) e.emitter.path.resize(1);
+    const std::uint64_t n = planEmitter(e.emitter, e.state, true, std::uint32_t(k), a, b + 1e-12, runs);
+    countGeneration(g, e.generation, n);
+    total += n;
+    e.position = pb;
+    e.velocity = vb;
+    if (e.death <= t1) {
+      const EmitterSpec& spec = *e.spec;
+      if (spec.deathBurst > 0) {
+        runs.push_back({BirthRun::Burst, true, std::uint32_t(k), 0, e.death, spec.deathBurst});
+        countGeneration(g, e.generation, spec.deathBurst);
+        total += spec.deathBurst;
+      }
+      // spawn() grows g.live, which moves `e`: take what the children need first.
+      const double death = e.death;
+      const std::uint32_t generation = e.generation + 1;
+      for (std::uint32_t c = 0; c < spec.deathChildren; ++c)
+        spawn(g, sp, spec.next, death, pb, vb, generation, nullptr);
+    }
+  }
+  return total;
+}
+
+// Live emitters that died this step go after their last births are written.
+void retireDead(GroupImpl& g, double t1) {
+  std::erase_if(g.live, [&](const LiveEmitter& e) { return e.death <= t1; });
+}
+
 }  // namespace
 
 void emitAndCompact(GroupImpl& g, const StepParams& sp) {
-  const double t0 = sp.time, t1 = sp.time + sp.dt;
+  const double t1 = sp.time + sp.dt;
 
   // 1. How many are born, by which emitter, when.
   // Scratch kept between steps; named through references because the worker threads below
@@ -254,33 +442,11 @@ void emitAndCompact(GroupImpl& g, const StepParams& sp) {
   auto& runs = runsStore;
   auto& runStart = runStartStore;
   runs.clear();
-  std::uint64_t total = 0;
-  for (std::uint32_t e = 0; e < g.emitters.size(); ++e) {
-    const Emitter& em = g.emitters[e];
-    auto& state = g.emitterState[e];
-    if (em.rate > 0) {
-      const std::uint64_t target = producedBy(em, t1);
-      if (target > state.emittedByRate) {
-        runs.push_back({e, false, state.emittedByRate, 0.0, target - state.emittedByRate});
-        total += target - state.emittedByRate;
-        state.emittedByRate = target;
-      }
-    }
-    for (const Burst& b : em.bursts) {
-      for (std::uint32_t r = 0; r < b.repeat; ++r) {
-        const double tb = b.time + r * b.interval;
-        if (tb >= t0 && tb < t1 && b.count > 0) {
-          runs.push_back({e, true, 0, tb, b.count});
-          total += b.count;
-        }
-      }
-    }
-  }
-
+  const std::uint64_t total = planBirths(g, sp, runs);
   g.stats.emitted += total;
   const std::size_t holes = g.holes.size();
-  const std::size_t live = g.size - holes;
-  const std::size_t accepted = std::size_t(std::min<std::uint64_t>(total, g.capacity - live));
+  const std::size_t alive = g.size - holes;
+  const std::size_t accepted = std::size_t(std::min<std::uint64_t>(total, g.capacity - alive));
   g.stats.droppedAtCapacity += total - accepted;
 
   // 2. The newborns, in parallel: each one's attributes depend only on its id.
@@ -298,7 +464,7 @@ void emitAndCompact(GroupImpl& g, const StepParams& sp) {
       for (std::size_t i = a; i < b;) {
         while (i >= runStart[r + 1]) ++r;
         const std::size_t end = std::min<std::size_t>(b, runStart[r + 1]);
-        const Emitter& em = g.emitters[runs[r].emitter];
+        const Emitter& em = emitterOf(g, runs[r]);
         for (std::size_t j = i; j < end; j += kBatch) {
           const std::size_t m = std::min(kBatch, end - j);
           if (em.types.size() == 1)
@@ -311,6 +477,8 @@ void emitAndCompact(GroupImpl& g, const StepParams& sp) {
     });
     g.nextId += std::uint32_t(accepted);
   }
+
+  retireDead(g, t1);
 
   // 3. Close the holes no newborn filled, with the live particles at the tail.
   if (accepted >= holes) {

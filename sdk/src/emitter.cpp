@@ -56,6 +56,47 @@ void Emitter::validate(const std::string& where) const {
     if (t.lifetime.center <= 0) fail(f + ".lifetime", "must be > 0");
   }
   if (!(total > 0)) fail("types", "the weights add up to 0");
+  if (!std::isfinite(spacing) || spacing < 0) fail("spacing", "must be finite and >= 0");
+  normalSpeed.validate((where + ".normalSpeed").c_str());
+}
+
+void EmitterSpec::validate(const std::string& where) const {
+  emitter.validate(where + ".emitter");
+  lifetime.validate((where + ".lifetime").c_str());
+  if (lifetime.center <= 0) throw InvalidArgument(where + ".lifetime", "must be > 0");
+  if (!finite(acceleration)) throw InvalidArgument(where + ".acceleration", "not finite");
+  if (!std::isfinite(drag) || drag < 0) throw InvalidArgument(where + ".drag", "must be >= 0");
+  if (!std::isfinite(inheritVelocity))
+    throw InvalidArgument(where + ".inheritVelocity", "not finite");
+  if (deathChildren > 0 && !next)
+    throw InvalidArgument(where + ".next", "deathChildren > 0 needs a next level");
+  // Showers of showers, but not forever: a cycle of levels would never end.
+  int depth = 0;
+  for (const EmitterSpec* s = next.get(); s; s = s->next.get())
+    if (++depth > 16) throw InvalidArgument(where + ".next", "more than 16 levels (a cycle?)");
+  if (next) next->validate(where + ".next");
+}
+
+Vec3 PrimeEmitter::positionAt(double t) const {
+  Emitter e;
+  e.position = position;
+  e.velocity = velocity;
+  e.path = path;
+  e.start = start;
+  return e.positionAt(t);
+}
+
+void PrimeEmitter::validate(const std::string& where) const {
+  Emitter e;  // the counting and motion fields are an emitter's
+  e.rate = rate;
+  e.bursts = bursts;
+  e.position = position;
+  e.velocity = velocity;
+  e.path = path;
+  e.start = start;
+  e.stop = stop;
+  e.validate(where);
+  child.validate(where + ".child");
 }
 
 }  // namespace flurry

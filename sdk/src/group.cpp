@@ -14,7 +14,7 @@ namespace flurry {
 std::string_view attributeName(Attribute a) {
   static constexpr std::string_view names[] = {
       "position", "velocity", "color",  "size",    "mass",     "age",      "lifetime",
-      "id",       "prevPosition", "up", "rotVelocity", "charge", "visible", "userData"};
+      "id",       "prevPosition", "up", "rotVelocity", "charge", "visible", "userData", "positionB", "velocityB"};
   const auto i = std::size_t(a);
   return i < std::size(names) ? names[i] : "unknown";
 }
@@ -61,6 +61,8 @@ Lanes Lanes::offset(std::size_t b) const {
   for (auto& q : r.prev) shift(q);
   for (auto& q : r.up) shift(q);
   for (auto& q : r.rot) shift(q);
+  for (auto& q : r.posB) shift(q);
+  for (auto& q : r.velB) shift(q);
   shift(r.size);
   shift(r.mass);
   shift(r.age);
@@ -81,6 +83,8 @@ Lanes GroupImpl::lanePointers() const {
     l.prev[c] = f(Attribute::PrevPosition, c);
     l.up[c] = f(Attribute::Up, c);
     l.rot[c] = f(Attribute::RotVelocity, c);
+    l.posB[c] = f(Attribute::PositionB, c);
+    l.velB[c] = f(Attribute::VelocityB, c);
   }
   for (int c = 0; c < 4; ++c) l.color[c] = f(Attribute::Color, c);
   l.size = f(Attribute::Size, 0);
@@ -94,14 +98,15 @@ Lanes GroupImpl::lanePointers() const {
   return l;
 }
 
-void GroupImpl::write(std::size_t i, const Particle& q) {
-  const Lanes l = lanePointers();
+void writeParticle(const Lanes& l, std::size_t i, const Particle& q) {
   for (int c = 0; c < 3; ++c) {
     l.p[c][i] = q.position[c];
     if (l.v[c]) l.v[c][i] = q.velocity[c];
     if (l.prev[c]) l.prev[c][i] = q.prevPosition[c];
     if (l.up[c]) l.up[c][i] = q.up[c];
     if (l.rot[c]) l.rot[c][i] = q.rotVelocity[c];
+    if (l.posB[c]) l.posB[c][i] = q.positionB[c];
+    if (l.velB[c]) l.velB[c][i] = q.velocityB[c];
   }
   for (int c = 0; c < 4; ++c)
     if (l.color[c]) l.color[c][i] = q.color[c];
@@ -115,8 +120,7 @@ void GroupImpl::write(std::size_t i, const Particle& q) {
   if (l.user) l.user[i] = q.userData;
 }
 
-Particle GroupImpl::read(std::size_t i) const {
-  const Lanes l = lanePointers();
+Particle readParticle(const Lanes& l, std::size_t i) {
   Particle q;
   for (int c = 0; c < 3; ++c) {
     q.position[c] = l.p[c][i];
@@ -124,6 +128,8 @@ Particle GroupImpl::read(std::size_t i) const {
     if (l.prev[c]) q.prevPosition[c] = l.prev[c][i];
     if (l.up[c]) q.up[c] = l.up[c][i];
     if (l.rot[c]) q.rotVelocity[c] = l.rot[c][i];
+    if (l.posB[c]) q.positionB[c] = l.posB[c][i];
+    if (l.velB[c]) q.velocityB[c] = l.velB[c][i];
   }
   for (int c = 0; c < 4; ++c)
     if (l.color[c]) q.color[c] = l.color[c][i];
@@ -145,7 +151,9 @@ void GroupImpl::move(std::size_t from, std::size_t to) {
 }
 
 void GroupImpl::ensureStorage() {
-  const AttributeSet want = wanted();
+  // While particles exist, lanes are kept even when no action reads them any more: they hold
+  // state (a rest pose, a charge) that a later action list may read again.
+  const AttributeSet want = size > 0 ? wanted() | stored : wanted();
   if (want == stored) return;
   const Particle defaults;
   for (int a = 0; a < int(Attribute::Count); ++a) {
@@ -168,6 +176,8 @@ void GroupImpl::ensureStorage() {
       if (!before.has(Attribute::PrevPosition) && l.prev[c]) l.prev[c][i] = l.p[c][i];
       if (!before.has(Attribute::Up) && l.up[c]) l.up[c][i] = defaults.up[c];
       if (!before.has(Attribute::RotVelocity) && l.rot[c]) l.rot[c][i] = 0.0f;
+      if (!before.has(Attribute::PositionB) && l.posB[c]) l.posB[c][i] = l.p[c][i];
+      if (!before.has(Attribute::VelocityB) && l.velB[c]) l.velB[c][i] = 0.0f;
     }
     for (int c = 0; c < 4; ++c)
       if (!before.has(Attribute::Color) && l.color[c]) l.color[c][i] = defaults.color[c];
@@ -220,6 +230,32 @@ Emitter& Group::addEmitter(Emitter emitter) {
 }
 
 std::span<Emitter> Group::emitters() { return impl_->emitters; }
+
+PrimeEmitter& Group::addPrimeEmitter(PrimeEmitter prime) {
+  prime.validate("primeEmitters[" + std::to_string(impl_->primes.size()) + "]");
+  impl_->primes.push_back(std::move(prime));
+  impl_->primeState.emplace_back();
+  return impl_->primes.back();
+}
+
+std::size_t Group::liveEmitterCount() const { return impl_->live.size(); }
+
+Group& Group::setHair(HairOptions options) {
+  if (options.every == 0) throw InvalidArgument("hair.every", "must be >= 1");
+  if (options.maxVertices < 2) throw InvalidArgument("hair.maxVertices", "must be >= 2");
+  impl_->syncHost();
+  impl_->hair = options;
+  if (options.enabled) impl_->size = 0;  // a hair group keeps strands, not live particles
+  impl_->hostChanged();
+  return *this;
+}
+
+const HairOptions& Group::hair() const { return impl_->hair; }
+const Strands& Group::strands() const {
+  impl_->syncHost();
+  return impl_->strands;
+}
+void Group::clearStrands() { impl_->strands.clear(); }
 
 bool Group::add(const Particle& p) {
   auto& g = *impl_;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "flurry/group.hpp"
+#include "flurry/strands.hpp"
 
 namespace flurry::detail {
 
@@ -52,13 +53,33 @@ struct Lanes {
   float* charge = nullptr;
   std::uint32_t* visible = nullptr;
   float* user = nullptr;
+  float* posB[3] = {};
+  float* velB[3] = {};
 
   Lanes offset(std::size_t b) const;
 };
 
+/// Gathers / scatters one particle's stored attributes (others read as Particle's defaults).
+Particle readParticle(const Lanes& L, std::size_t i);
+void writeParticle(const Lanes& L, std::size_t i, const Particle& p);
+
 /// Per-emitter progress.
 struct EmitterState {
   std::uint64_t emittedByRate = 0;  ///< particles the rate has produced so far
+  double travelled = 0.0;           ///< distance since the last birth by spacing
+};
+
+/// An emitter spawned by a prime emitter (or at another one's death): it moves under its
+/// spec's acceleration and drag, emits like an Emitter, and dies at `death`.
+struct LiveEmitter {
+  Emitter emitter;  ///< start = birth, stop = death; its path is set to this step's motion
+  EmitterState state;
+  const EmitterSpec* spec = nullptr;
+  std::shared_ptr<const EmitterSpec> keepAlive;  ///< holds spec when it is a `next` level
+  Vec3 position{0.0f}, velocity{0.0f};           ///< at the start of the current step
+  double birth = 0.0, death = 0.0;
+  std::uint32_t generation = 1;
+  std::uint32_t id = 0;  ///< keys its random numbers
 };
 
 struct GroupImpl;
@@ -84,6 +105,13 @@ struct GroupImpl {
   ActionList actions;
   std::vector<Emitter> emitters;
   std::vector<EmitterState> emitterState;
+  std::vector<PrimeEmitter> primes;
+  std::vector<EmitterState> primeState;
+  std::vector<std::shared_ptr<const EmitterSpec>> primeSpecs;  ///< primes[k].child, shared
+  std::vector<LiveEmitter> live;
+  std::uint32_t nextEmitterId = 0;
+  HairOptions hair;
+  Strands strands;
   std::array<std::array<LaneBuffer, 4>, std::size_t(Attribute::Count)> lanes;
   GroupStats stats;
   std::uint32_t nextId = 0;
@@ -94,6 +122,7 @@ struct GroupImpl {
   std::vector<std::uint32_t> deadCount;  ///< per block
   std::vector<std::uint32_t> holes;      ///< sorted dead indices of this step
   std::vector<std::uint32_t> deadFlags;  ///< the unfused baseline's per-particle kill codes
+  std::vector<float> snapshot;           ///< positions/velocities at the step's start
 
   std::unique_ptr<DeviceMirror> mirror;  ///< null on the CPU backend
 
@@ -111,8 +140,8 @@ struct GroupImpl {
   void ensureStorage();
   Lanes lanePointers() const;
   /// Writes particle p's stored attributes at index i.
-  void write(std::size_t i, const Particle& p);
-  Particle read(std::size_t i) const;
+  void write(std::size_t i, const Particle& p) { writeParticle(lanePointers(), i, p); }
+  Particle read(std::size_t i) const { return readParticle(lanePointers(), i); }
   /// Copies every stored lane's element `from` to `to`.
   void move(std::size_t from, std::size_t to);
 };

@@ -133,6 +133,12 @@ int drawCount(const Domain& d) {
                       std::is_same_v<S, CylinderDomain> || std::is_same_v<S, ConeDomain>)
           return 3;
         if constexpr (std::is_same_v<S, BlobDomain>) return 6;
+        if constexpr (std::is_same_v<S, MeshDomain>) return 3;
+        if constexpr (std::is_same_v<S, UnionDomain>) {
+          int most = 0;
+          for (const Domain& part : s.parts->parts) most = std::max(most, drawCount(part));
+          return 1 + most;
+        }
       },
       d.shape());
 }
@@ -177,6 +183,37 @@ void sampleBatch(const Domain& d, const float* const* u, std::size_t n, float* x
           else
             cone<true>(u[0], u[1], u[2], x, y, z, n, s.apex, axis, e1, e2, s.innerRadius,
                        s.outerRadius);
+        } else if constexpr (std::is_same_v<S, MeshDomain>) {
+          // A triangle in proportion to its area, then a point uniform on it.
+          const MeshData& m = *s.mesh;
+          const double total = m.cumulativeArea.back();
+          for (std::size_t i = 0; i < n; ++i) {
+            const double target = double(u[0][i]) * total;
+            std::size_t k = std::size_t(std::upper_bound(m.cumulativeArea.begin(),
+                                                         m.cumulativeArea.end(), target) -
+                                        m.cumulativeArea.begin());
+            k = std::min(k, m.triangles.size() - 1);
+            const glm::uvec3 t = m.triangles[k];
+            const Vec3 a = m.vertices[t.x];
+            triangle(u[1] + i, u[2] + i, x + i, y + i, z + i, 1, a, m.vertices[t.y] - a,
+                     m.vertices[t.z] - a);
+          }
+        } else if constexpr (std::is_same_v<S, UnionDomain>) {
+          // A part in proportion to its measure; the part's draws follow (a fixed count per
+          // sample: 1 + the most any part needs).
+          const UnionData& un = *s.parts;
+          const double total = un.cumulativeMeasure.back();
+          const float* rest[kMaxDomainDraws];
+          for (std::size_t i = 0; i < n; ++i) {
+            const double target = double(u[0][i]) * total;
+            std::size_t k = std::size_t(std::upper_bound(un.cumulativeMeasure.begin(),
+                                                         un.cumulativeMeasure.end(), target) -
+                                        un.cumulativeMeasure.begin());
+            k = std::min(k, un.parts.size() - 1);
+            const int draws = drawCount(un.parts[k]);
+            for (int j = 0; j < draws; ++j) rest[j] = u[1 + j] + i;
+            sampleBatch(un.parts[k], rest, 1, x + i, y + i, z + i);
+          }
         } else if constexpr (std::is_same_v<S, BlobDomain>) {
           for (std::size_t i = 0; i < n; ++i) {
             x[i] = s.center.x + s.stddev * normalFrom(u[0][i], u[1][i]);

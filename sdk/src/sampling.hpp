@@ -58,8 +58,9 @@ inline void orthonormalBasis(Vec3 n, Vec3& b1, Vec3& b2) {
   b2 = Vec3(b, s + n.y * n.y * a, -n.y);
 }
 
-/// Uniform numbers a shape consumes per sample.
+/// Uniform numbers a shape consumes per sample (at most kMaxDomainDraws).
 int drawCount(const Domain& d);
+inline constexpr int kMaxDomainDraws = 16;
 /// Uniform numbers a fuzzy value consumes per sample (0 if constant, 2 if normal).
 inline int drawCount(const Fuzzy& f) {
   return f.spread == 0.0f ? 0 : f.distribution == Fuzzy::Distribution::Normal ? 2 : 1;

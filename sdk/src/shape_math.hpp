@@ -54,4 +54,8 @@ inline bool inside(const BlobDomain& d, Vec3 p) {
   return glm::dot(r, r) <= d.stddev * d.stddev;
 }
 
+// Not vectorised: a mesh tests ray-crossing parity against its triangles, a union its parts.
+bool inside(const MeshDomain& d, Vec3 p);
+bool inside(const UnionDomain& d, Vec3 p);
+
 }  // namespace flurry::detail

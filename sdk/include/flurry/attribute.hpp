@@ -24,6 +24,8 @@ enum class Attribute : std::uint8_t {
   Charge,        ///< electric charge, for the Lorentz force
   Visible,       ///< 1 visible, 0 hidden by a blocker; stored as uint32
   UserData,      ///< one free float for callbacks
+  PositionB,     ///< a second, rest position (CopyVertexB, Restore)
+  VelocityB,     ///< a second velocity (CopyVertexB)
   Count
 };
 
@@ -35,6 +37,8 @@ constexpr int componentCount(Attribute a) {
     case Attribute::PrevPosition:
     case Attribute::Up:
     case Attribute::RotVelocity:
+    case Attribute::PositionB:
+    case Attribute::VelocityB:
       return 3;
     case Attribute::Color:
       return 4;

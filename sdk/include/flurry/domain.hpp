@@ -8,7 +8,12 @@
 // throw InvalidArgument naming the parameter) and precompute normals.
 #pragma once
 
+#include <cstdint>
+#include <memory>
 #include <variant>
+#include <vector>
+
+#include <glm/vec3.hpp>
 
 #include "flurry/math.hpp"
 #include "flurry/random.hpp"
@@ -75,11 +80,27 @@ struct BlobDomain {
   float stddev;
 };
 
+struct MeshData;
+struct UnionData;
+
+/// The surface of a polyhedron given as vertices and triangles (a mesh). Samples are uniform
+/// over its area; contains() is the inside of the closed surface (ray-crossing parity); the
+/// normal is that of the nearest face, oriented by the triangles' winding.
+struct MeshDomain {
+  std::shared_ptr<const MeshData> mesh;
+};
+
+/// A union of domains. Samples pick a part in proportion to its measure (length, area or
+/// volume: mix parts of one kind); contains() is true inside any part.
+struct UnionDomain {
+  std::shared_ptr<const UnionData> parts;
+};
+
 class Domain {
  public:
   using Shape = std::variant<PointDomain, LineDomain, TriangleDomain, PlaneDomain,
                              RectangleDomain, DiscDomain, BoxDomain, SphereDomain,
-                             CylinderDomain, ConeDomain, BlobDomain>;
+                             CylinderDomain, ConeDomain, BlobDomain, MeshDomain, UnionDomain>;
 
   Domain() : shape_(PointDomain{Vec3(0.0f)}) {}
 
@@ -94,6 +115,10 @@ class Domain {
   static Domain cylinder(Vec3 p0, Vec3 p1, float outerRadius, float innerRadius = 0.0f);
   static Domain cone(Vec3 apex, Vec3 base, float outerRadius, float innerRadius = 0.0f);
   static Domain blob(Vec3 center, float stddev);
+  /// A polyhedron's surface: each triangle is three indices into `vertices`, counter-clockwise
+  /// seen from outside (the normal side).
+  static Domain mesh(std::vector<Vec3> vertices, std::vector<glm::uvec3> triangles);
+  static Domain unite(std::vector<Domain> parts);
 
   /// A point drawn uniformly from the domain (gaussian for a blob).
   Vec3 sample(Random& rng) const;
@@ -120,6 +145,19 @@ class Domain {
  private:
   explicit Domain(Shape s) : shape_(s) {}
   Shape shape_;
+};
+
+struct MeshData {
+  std::vector<Vec3> vertices;
+  std::vector<glm::uvec3> triangles;
+  std::vector<Vec3> normals;           ///< per triangle, unit
+  std::vector<double> cumulativeArea;  ///< per triangle, running sum: area-weighted sampling
+  Vec3 min{0.0f}, max{0.0f};           ///< bounds
+};
+
+struct UnionData {
+  std::vector<Domain> parts;
+  std::vector<double> cumulativeMeasure;  ///< running sum of the parts' measures
 };
 
 }  // namespace flurry

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -58,11 +59,55 @@ struct Emitter {
   double start = 0.0;
   double stop = std::numeric_limits<double>::infinity();
   std::vector<ParticleType> types{ParticleType{}};
+  /// Emission by distance: one particle per `spacing` units the emitter travels, with birth
+  /// times and places interpolated inside the step, so a fast emitter leaves an even trail
+  /// with no gaps. 0 turns it off. Adds to `rate` and `bursts`.
+  float spacing = 0.0f;
+  /// Adds the shape's outward normal where each particle is born, times this speed, to its
+  /// velocity: every face of a polyhedron (Domain::mesh) emits along its normal.
+  Fuzzy normalSpeed = 0.0f;
 
   /// The emitter's position at time t (seconds).
   Vec3 positionAt(double t) const;
   /// Throws InvalidArgument naming the field (prefixed by `where`, e.g. "emitters[2]").
   void validate(const std::string& where = "emitter") const;
+};
+
+/// What a prime emitter creates: emitters that move (initial velocity, gravity, drag), live
+/// a fuzzy time, emit their own particles as `emitter` describes (its shape relative to the
+/// moving emitter, its rate, its bursts timed from its birth, its spacing), and at death burst
+/// `deathBurst` particles and spawn `deathChildren` emitters of the next level: showers of
+/// showers, as deep as the chain of `next` goes.
+struct EmitterSpec {
+  Emitter emitter;
+  Domain velocity = Domain::sphere(Vec3(0.0f), 5.0f);  ///< a spawned emitter's initial velocity
+  float inheritVelocity = 0.0f;  ///< plus this fraction of its parent's velocity
+  Fuzzy lifetime = 1.0f;
+  Vec3 acceleration{0.0f, -9.81f, 0.0f};
+  float drag = 0.0f;  ///< linear drag rate, 1/s
+  std::uint32_t deathBurst = 0;
+  std::uint32_t deathChildren = 0;
+  std::shared_ptr<const EmitterSpec> next;
+
+  void validate(const std::string& where) const;
+};
+
+/// An emitter that emits emitters (the seed's "prime" or "super" emitter). It moves and
+/// counts like an Emitter; each birth is an emitter of `child`.
+struct PrimeEmitter {
+  std::string name;
+  Domain shape = Domain::point(Vec3(0.0f));
+  double rate = 0.0;
+  std::vector<Burst> bursts;
+  Vec3 position{0.0f};
+  Vec3 velocity{0.0f};
+  std::vector<Keyframe> path;
+  double start = 0.0;
+  double stop = std::numeric_limits<double>::infinity();
+  EmitterSpec child;
+
+  Vec3 positionAt(double t) const;
+  void validate(const std::string& where = "primeEmitter") const;
 };
 
 }  // namespace flurry

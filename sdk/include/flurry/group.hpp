@@ -11,6 +11,7 @@
 #include "flurry/actions.hpp"
 #include "flurry/attribute.hpp"
 #include "flurry/emitter.hpp"
+#include "flurry/strands.hpp"
 
 namespace flurry {
 
@@ -34,7 +35,17 @@ struct Particle {
   float charge = 0.0f;
   bool visible = true;
   float userData = 0.0f;
+  Vec3 positionB{0.0f};
+  Vec3 velocityB{0.0f};
   std::uint32_t id = 0;  ///< assigned by the group on add()
+};
+
+/// Hair (static) mode: every particle's whole life is computed when it is born, through the
+/// group's action list, and kept as a strand; the group itself holds no live particles.
+struct HairOptions {
+  bool enabled = false;
+  std::uint32_t every = 1;           ///< a vertex every N steps of the particle's life
+  std::uint32_t maxVertices = 256;   ///< a strand ends here if the particle lives on
 };
 
 /// Where the particles went. emitted == size() + killedByAge + absorbed + droppedAtCapacity.
@@ -44,6 +55,10 @@ struct GroupStats {
   std::uint64_t absorbed = 0;           ///< by Sink (and other absorbers)
   std::uint64_t droppedAtCapacity = 0;  ///< not created: the group was full
   std::vector<std::uint64_t> killedByAction;  ///< per action-list entry
+  /// Particles by the generation of their emitter: 0 from the group's own emitters, 1 from
+  /// emitters a prime emitter spawned, 2 from their children, ...
+  std::vector<std::uint64_t> emittedByGeneration;
+  std::uint64_t emittersSpawned = 0;  ///< by prime emitters and death spawns, all levels
 };
 
 struct Bounds {
@@ -73,6 +88,16 @@ class Group {
   /// Adds an emitter (validated: throws InvalidArgument naming the bad field).
   Emitter& addEmitter(Emitter emitter);
   std::span<Emitter> emitters();
+  /// Adds an emitter of emitters (validated).
+  PrimeEmitter& addPrimeEmitter(PrimeEmitter prime);
+  /// Emitters spawned by prime emitters and still alive.
+  std::size_t liveEmitterCount() const;
+
+  /// Hair mode (see HairOptions). Strands accumulate until clearStrands().
+  Group& setHair(HairOptions options);
+  const HairOptions& hair() const;
+  const Strands& strands() const;
+  void clearStrands();
 
   /// Adds one particle now; returns false (and counts it dropped) when the group is full.
   bool add(const Particle& p);

@@ -9,6 +9,7 @@ class CpuBackend final : public BackendImpl {
   void step(GroupImpl& group, const StepParams& params) override {
     actFused(group, params);
     emitAndCompact(group, params);
+    if (group.hair.enabled) simulateHair(group, params);
   }
 };
 }  // namespace

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "../backend.hpp"
+#include "actions_more.hpp"
 #include "kernels.hpp"
 
 #ifndef FLURRY_ISA
@@ -63,8 +64,32 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
     g.deadCount.assign(blocks, 0);
   }
   const Lanes lanes = g.lanePointers();
-  const cpu::BlockContext base{float(sp.dt), sp.seed, std::uint32_t(sp.step),
-                               g.index << 16, 0, nullptr};
+  cpu::BlockContext base{float(sp.dt), sp.seed, std::uint32_t(sp.step), g.index << 16, 0, nullptr};
+  base.time = sp.time;
+  for (std::size_t k = 0; k < acts.size(); ++k)
+    if (std::holds_alternative<Block>(acts[k])) {
+      base.firstBlocker = std::uint32_t(k);
+      break;
+    }
+  // Actions that read other particles read them as they were at the start of the step, so
+  // the result does not depend on which block ran first.
+  cpu::Snapshot snapshot;
+  if (g.actions.readsNeighbours()) {
+    g.snapshot.resize(9 * n);
+    float* out = g.snapshot.data();
+    auto keep = [&](float* const* src, const float** dst) {
+      for (int d = 0; d < 3; ++d, out += n) {
+        if (!src[d]) continue;
+        std::copy_n(src[d], n, out);
+        dst[d] = out;
+      }
+    };
+    keep(lanes.p, snapshot.p);
+    keep(lanes.v, snapshot.v);
+    keep(lanes.rot, snapshot.rot);
+    snapshot.size = n;
+    base.snapshot = &snapshot;
+  }
 
   if (sp.fused) {
     sp.pool->parallelFor(tasks, [&](std::size_t t) {
@@ -75,6 +100,7 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
       for (std::size_t b = t * blocksPerTask; b < end; ++b) {
         const std::size_t first = b * B, m = std::min(B, n - first);
         cpu::BlockContext ctx = base;
+        ctx.base = first;
         if (kills) {
           std::fill_n(dead.data(), m, 0u);
           ctx.dead = dead.data();
@@ -92,6 +118,7 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
         for (std::size_t b = t * blocksPerTask; b < end; ++b) {
           const std::size_t first = b * B, m = std::min(B, n - first);
           cpu::BlockContext ctx = base;
+          ctx.base = first;
           if (kills) ctx.dead = g.deadFlags.data() + first;
           runActions(acts, k, k + 1, lanes.offset(first), m, ctx);
         }

@@ -9,11 +9,20 @@
 #include <cstdint>
 
 #include "../group_impl.hpp"
+#include "../noise.hpp"
 #include "../shape_math.hpp"
 #include "flurry/actions.hpp"
 #include "flurry/random.hpp"
 
 namespace flurry::detail::cpu {
+
+/// Positions and velocities at the start of the step, for actions that read other particles.
+struct Snapshot {
+  const float* p[3] = {};
+  const float* v[3] = {};
+  const float* rot[3] = {};
+  std::size_t size = 0;
+};
 
 struct BlockContext {
   float dt;
@@ -22,6 +31,10 @@ struct BlockContext {
   std::uint32_t streamBase;  ///< keeps the random streams of different groups apart
   std::uint32_t action;      ///< index in the list: the random stream and the kill code
   std::uint32_t* dead;       ///< per particle of the block: 0 alive, else 1 + killing action
+  double time = 0.0;         ///< at the start of the step
+  std::size_t base = 0;      ///< index of the block's first particle in the group
+  const Snapshot* snapshot = nullptr;
+  std::uint32_t firstBlocker = ~0u;  ///< index of the list's first Block action
 };
 
 // The loops take their arrays as __restrict parameters: GCC 12 vectorises these, but not
@@ -89,12 +102,17 @@ inline void sinkLoop(const Shape& shape, const float* __restrict px, const float
   }
 }
 
+inline void applyWeighted(const Gravity& a, const Lanes& L, std::size_t n, const BlockContext& c);
+inline void applyWeighted(const Damping& a, const Lanes& L, std::size_t n, const BlockContext& c);
+
 inline void apply(const Gravity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  if (a.falloff.radius < kInfinity) return applyWeighted(a, L, n, c);
   addLoop(L.v[0], L.v[1], L.v[2], n, a.acceleration.x * c.dt, a.acceleration.y * c.dt,
           a.acceleration.z * c.dt);
 }
 
 inline void apply(const Damping& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  if (a.falloff.radius < kInfinity) return applyWeighted(a, L, n, c);
   // The exact solution of dv/dt = -k v over the step: independent of the step size.
   scaleLoop(L.v[0], L.v[1], L.v[2], n, std::exp(-a.rate.x * c.dt), std::exp(-a.rate.y * c.dt),
             std::exp(-a.rate.z * c.dt));
@@ -104,24 +122,24 @@ inline void apply(const Move&, const Lanes& L, std::size_t n, const BlockContext
   if (L.prev[0]) copyLoop(L.prev[0], L.prev[1], L.prev[2], L.p[0], L.p[1], L.p[2], n);
   moveLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, c.dt);
   if (L.age) ageLoop(L.age, n, c.dt);
+  if (L.up[0] && L.rot[0]) {
+    // The up vector turns with the angular velocity: exactly, about ω by |ω|·dt.
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3 w(L.rot[0][i], L.rot[1][i], L.rot[2][i]);
+      const float speed = glm::length(w);
+      if (!(speed > 0.0f)) continue;
+      const Vec3 k = w / speed, u(L.up[0][i], L.up[1][i], L.up[2][i]);
+      const float ct = std::cos(speed * c.dt), st = std::sin(speed * c.dt);
+      const Vec3 r = u * ct + glm::cross(k, u) * st + k * (glm::dot(k, u) * (1.0f - ct));
+      L.up[0][i] = r.x;
+      L.up[1][i] = r.y;
+      L.up[2][i] = r.z;
+    }
+  }
 }
 
 inline void apply(const KillOld&, const Lanes& L, std::size_t n, const BlockContext& c) {
   killOldLoop(L.age, L.lifetime, c.dead, n, c.action + 1);
-}
-
-inline void apply(const Sink& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const std::uint32_t code = c.action + 1;
-  std::visit([&](const auto& shape) { sinkLoop(shape, L.p[0], L.p[1], L.p[2], c.dead, n, code, a.killInside); },
-             a.region.shape());
-  if (a.passThrough > 0.0f) {
-    // Only the particles this sink just took draw a number: random numbers are compute-bound.
-    for (std::size_t i = 0; i < n; ++i) {
-      if (c.dead[i] != code) continue;
-      Random rng(c.seed, L.id[i], c.step, c.streamBase + c.action);
-      if (rng.uniform() < a.passThrough) c.dead[i] = 0u;
-    }
-  }
 }
 
 /// Reflects the velocity and places the particle so that the following Move ends it at the
@@ -193,7 +211,8 @@ inline void bouncePlanarLoop(float* __restrict px, float* __restrict py, float* 
   }
 }
 
-/// A sphere deflecting from outside.
+/// A sphere deflecting from outside (Inside = false) or keeping particles in (Inside = true).
+template <bool Inside>
 inline void bounceSphereLoop(float* __restrict px, float* __restrict py, float* __restrict pz,
                              float* __restrict vxs, float* __restrict vys, float* __restrict vzs,
                              std::size_t n, float dt, const SphereDomain& s, const Bounce& b) {
@@ -209,17 +228,22 @@ inline void bounceSphereLoop(float* __restrict px, float* __restrict py, float* 
     const float bb = rx * vx + ry * vy + rz * vz;
     const float aa = vx * vx + vy * vy + vz * vz;
     const float disc = bb * bb - aa * c2;
-    const float tHit = (-bb - std::sqrt(std::max(disc, 0.0f))) / aa;  // inf/NaN: a miss
-    const bool hit = (c2 >= 0.0f) & (disc >= 0.0f) & (bb < 0.0f) & (tHit <= dt);
+    const float root = std::sqrt(std::max(disc, 0.0f));
+    // Outside: the entry root; inside: the exit root. inf/NaN (aa = 0) is a miss.
+    const float tHit = Inside ? (-bb + root) / aa : (-bb - root) / aa;
+    const bool hit = Inside ? (c2 <= 0.0f) & (tHit <= dt)
+                            : (c2 >= 0.0f) & (disc >= 0.0f) & (bb < 0.0f) & (tHit <= dt);
     const float tau = std::max(tHit, 0.0f);
     const float hx = x + vx * tau, hy = y + vy * tau, hz = z + vz * tau;
     const float nnx = (hx - C.x) * invR, nny = (hy - C.y) * invR, nnz = (hz - C.z) * invR;
     float nx = x, ny = y, nz = z, nvx = vx, nvy = vy, nvz = vz;
     reflect(nx, ny, nz, nvx, nvy, nvz, hx, hy, hz, nnx, nny, nnz, tau);
     const float qx = nx + nvx * dt - C.x, qy = ny + nvy * dt - C.y, qz = nz + nvz * dt - C.z;
-    const float qd = std::sqrt(qx * qx + qy * qy + qz * qz) - R;
+    // Signed clearance on the allowed side: outside it is |q| - R, inside R - |q|.
+    const float qd = Inside ? R - std::sqrt(qx * qx + qy * qy + qz * qz)
+                            : std::sqrt(qx * qx + qy * qy + qz * qz) - R;
     const float margin = 4e-7f * (std::abs(qx) + std::abs(qy) + std::abs(qz) + scaleC) + 1e-30f;
-    const float push = std::max(2.0f * margin - qd, 0.0f);
+    const float push = std::max(2.0f * margin - qd, 0.0f) * (Inside ? -1.0f : 1.0f);
     float ox = x, oy = y, oz = z, ovx = vx, ovy = vy, ovz = vz;
     if (hit) {
       ox = nx + push * nnx;
@@ -235,6 +259,131 @@ inline void bounceSphereLoop(float* __restrict px, float* __restrict py, float* 
     vxs[i] = ovx;
     vys[i] = ovy;
     vzs[i] = ovz;
+  }
+  if constexpr (Inside) {
+    // A particle that crosses the sphere more than once in a step (|v|·dt > the diameter)
+    // bounces again for what is left of the step; if it still would leave, it ends inside.
+    for (std::size_t i = 0; i < n; ++i) {
+      Vec3 p(px[i], py[i], pz[i]), v(vxs[i], vys[i], vzs[i]);
+      auto out = [&](Vec3 q) { return glm::length(q - C) > R * (1.0f - 1e-6f); };
+      if (!out(p + v * dt)) continue;
+      Vec3 pos = p + v * dt;  // recover where the reflected path starts: at the last hit
+      float left = dt;
+      Vec3 cur = p;
+      for (int bounce = 0; bounce < 16 && out(cur + v * left); ++bounce) {
+        const Vec3 r = cur - C;
+        const float bb = glm::dot(r, v), aa = glm::dot(v, v);
+        const float c2 = glm::dot(r, r) - R2;
+        const float t = std::clamp((-bb + std::sqrt(std::max(bb * bb - aa * c2, 0.0f))) / aa, 0.0f, left);
+        cur += v * t;
+        left -= t;
+        const Vec3 nrm = glm::normalize(cur - C);
+        float qx = cur.x, qy = cur.y, qz = cur.z, nvx = v.x, nvy = v.y, nvz = v.z;
+        reflect(qx, qy, qz, nvx, nvy, nvz, cur.x, cur.y, cur.z, nrm.x, nrm.y, nrm.z, 0.0f);
+        v = Vec3(nvx, nvy, nvz);
+      }
+      pos = cur + v * left;
+      if (out(pos)) pos = C + (pos - C) * (R * (1.0f - 4e-6f) / glm::length(pos - C));
+      p = pos - v * dt;
+      px[i] = p.x;
+      py[i] = p.y;
+      pz[i] = p.z;
+      vxs[i] = v.x;
+      vys[i] = v.y;
+      vzs[i] = v.z;
+    }
+  }
+}
+
+/// A box keeping particles inside: each axis is its own pair of walls (exact for an
+/// axis-aligned box, also in corners); friction acts on the other two axes on a hit.
+inline void bounceBoxInside(float* __restrict px, float* __restrict py, float* __restrict pz,
+                            float* __restrict vxs, float* __restrict vys, float* __restrict vzs,
+                            std::size_t n, float dt, const BoxDomain& box, const Bounce& b) {
+  float* p[3] = {px, py, pz};
+  float* v[3] = {vxs, vys, vzs};
+  const float e = b.restitution, keep = 1.0f - b.friction, cut2 = b.cutoff * b.cutoff;
+  for (std::size_t i = 0; i < n; ++i) {
+    bool hit[3];
+    float wall[3], tau[3];
+    for (int k = 0; k < 3; ++k) {
+      const float x = p[k][i], vk = v[k][i];
+      const float q = x + vk * dt;
+      hit[k] = q < box.min[k] || q > box.max[k];
+      wall[k] = q > box.max[k] ? box.max[k] : box.min[k];
+      tau[k] = hit[k] ? std::clamp((wall[k] - x) / vk, 0.0f, dt) : 0.0f;
+    }
+    if (!(hit[0] || hit[1] || hit[2])) continue;
+    // The final velocity first: reflected on the axes that hit, slowed by friction on the
+    // others; then positions that Move will carry to their reflected places.
+    float nv[3];
+    for (int k = 0; k < 3; ++k) {
+      nv[k] = hit[k] ? -v[k][i] * e : v[k][i];
+      for (int j = 0; j < 3; ++j) {
+        if (j == k || !hit[j]) continue;
+        const int a1 = (j + 1) % 3, a2 = (j + 2) % 3;
+        const float t2 = v[a1][i] * v[a1][i] + v[a2][i] * v[a2][i];
+        if (t2 > cut2) nv[k] *= keep;
+      }
+    }
+    for (int k = 0; k < 3; ++k) {
+      if (hit[k]) {
+        const float margin = 4e-7f * (std::abs(wall[k]) + std::abs(nv[k] * dt)) + 1e-30f;
+        const float end = std::clamp(wall[k] + nv[k] * (dt - tau[k]), box.min[k] + margin,
+                                     box.max[k] - margin);
+        p[k][i] = end - nv[k] * dt;
+      }
+      // A slower velocity on an axis that did not hit stays between here and the old end.
+      v[k][i] = nv[k];
+    }
+  }
+}
+
+/// A box deflecting from outside: the segment's entry face (slab method).
+inline void bounceBoxOutside(float* __restrict px, float* __restrict py, float* __restrict pz,
+                             float* __restrict vxs, float* __restrict vys, float* __restrict vzs,
+                             std::size_t n, float dt, const BoxDomain& box, const Bounce& b) {
+  const Reflect reflect{b.restitution, 1.0f - b.friction, b.cutoff * b.cutoff};
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 p(px[i], py[i], pz[i]), v(vxs[i], vys[i], vzs[i]);
+    if (detail::inside(box, p)) continue;  // already in: not this deflector's business
+    float tEnter = 0.0f, tExit = dt;
+    int axis = -1;
+    bool miss = false;
+    for (int k = 0; k < 3 && !miss; ++k) {
+      if (v[k] == 0.0f) {
+        miss = p[k] < box.min[k] || p[k] > box.max[k];
+        continue;
+      }
+      float t0 = (box.min[k] - p[k]) / v[k], t1 = (box.max[k] - p[k]) / v[k];
+      if (t0 > t1) std::swap(t0, t1);
+      if (t0 > tEnter) {
+        tEnter = t0;
+        axis = k;
+      }
+      tExit = std::min(tExit, t1);
+      miss = tEnter > tExit;
+    }
+    if (miss || axis < 0) continue;
+    Vec3 nrm(0.0f);
+    nrm[axis] = v[axis] > 0.0f ? -1.0f : 1.0f;
+    const Vec3 h = p + v * tEnter;
+    float nx = p.x, ny = p.y, nz = p.z, nvx = v.x, nvy = v.y, nvz = v.z;
+    reflect(nx, ny, nz, nvx, nvy, nvz, h.x, h.y, h.z, nrm.x, nrm.y, nrm.z, tEnter);
+    Vec3 np(nx, ny, nz);
+    const Vec3 nv(nvx, nvy, nvz);
+    // Keep the end of the step outside the entry face.
+    const float face = nrm[axis] > 0.0f ? box.max[axis] : box.min[axis];
+    const float q = np[axis] + nv[axis] * dt;
+    const float margin = 4e-7f * (std::abs(face) + std::abs(q)) + 1e-30f;
+    const float clearance = (q - face) * nrm[axis];
+    if (clearance < margin) np[axis] += (2.0f * margin - clearance) * nrm[axis];
+    px[i] = np.x;
+    py[i] = np.y;
+    pz[i] = np.z;
+    vxs[i] = nv.x;
+    vys[i] = nv.y;
+    vzs[i] = nv.z;
   }
 }
 
@@ -288,7 +437,28 @@ inline void apply(const Bounce& a, const Lanes& L, std::size_t n, const BlockCon
         },
         a, L, n, c.dt);
   } else if (const auto* s = std::get_if<SphereDomain>(&shape)) {
-    bounceSphereLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, c.dt, *s, a);
+    if (a.inside)
+      bounceSphereLoop<true>(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, c.dt, *s, a);
+    else
+      bounceSphereLoop<false>(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, c.dt, *s, a);
+  } else if (const auto* bx = std::get_if<BoxDomain>(&shape)) {
+    if (a.inside)
+      bounceBoxInside(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, c.dt, *bx, a);
+    else
+      bounceBoxOutside(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, c.dt, *bx, a);
+  } else if (const auto* ln = std::get_if<LineDomain>(&shape)) {
+    // 2-D: the segment is a wall standing on the group's plane; its normal lies in the plane.
+    const Vec3 dir = ln->p1 - ln->p0;
+    const float len2 = glm::dot(dir, dir);
+    const Vec3 nrm = glm::normalize(glm::cross(dir, a.planeNormal));
+    const Vec3 o = ln->p0;
+    bouncePlanar(
+        o, nrm,
+        [=](float x, float y, float z) {
+          const float t = ((x - o.x) * dir.x + (y - o.y) * dir.y + (z - o.z) * dir.z) / len2;
+          return (t >= 0.0f) & (t <= 1.0f);
+        },
+        a, L, n, c.dt);
   }
 }
 

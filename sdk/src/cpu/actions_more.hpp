@@ -1,0 +1,454 @@
+// The CPU kernels of the force fields, absorbers, blockers and the rest of the vocabulary.
+// Those that are plain arithmetic keep the branch-free, __restrict style of kernels.hpp;
+// those that sample domains, draw random numbers or call user code run per particle.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+#include "kernels.hpp"
+
+namespace flurry::detail::cpu {
+
+namespace {
+inline Vec3 at(const float* const* a, std::size_t i) { return Vec3(a[0][i], a[1][i], a[2][i]); }
+inline void put(float* const* a, std::size_t i, Vec3 v) {
+  a[0][i] = v.x;
+  a[1][i] = v.y;
+  a[2][i] = v.z;
+}
+// (1 - r/radius)^power inside the radius, 0 outside; 1 everywhere for an infinite radius.
+inline float falloffWeight(const Falloff& f, Vec3 p) {
+  if (!(f.radius < kInfinity)) return 1.0f;
+  const float t = std::max(0.0f, 1.0f - glm::length(p - f.center) / f.radius);
+  return f.power == 1.0f ? t : std::pow(t, f.power);
+}
+// The fraction of the way an exponential approach covers in dt: never more than 1.
+inline float approach(float rate, float dt) { return 1.0f - std::exp(-rate * dt); }
+// Softened inverse-square pull towards d: magnitude·d / (|d|² + eps)^(3/2), zero beyond maxR.
+inline Vec3 softPull(Vec3 d, float magnitude, float eps, float maxR) {
+  const float r2 = glm::dot(d, d);
+  if (!(r2 <= maxR * maxR)) return Vec3(0.0f);
+  const float s = r2 + eps;
+  return d * (magnitude / (s * std::sqrt(s)));
+}
+inline void kill(const BlockContext& c, std::size_t i) {
+  if (c.dead[i] == 0u) c.dead[i] = c.action + 1;
+}
+// The particles this action would kill survive with probability passThrough.
+inline void passThrough(const BlockContext& c, const Lanes& L, std::size_t n, float fraction) {
+  if (fraction <= 0.0f) return;
+  const std::uint32_t code = c.action + 1;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (c.dead[i] != code) continue;
+    Random rng(c.seed, L.id[i], c.step, c.streamBase + c.action);
+    if (rng.uniform() < fraction) c.dead[i] = 0u;
+  }
+}
+inline Random actionRandom(const BlockContext& c, const Lanes& L, std::size_t i) {
+  return Random(c.seed, L.id[i], c.step, c.streamBase + c.action);
+}
+}  // namespace
+
+// ---- Absorbers, blockers -----------------------------------------------------------------
+
+template <class Shape>
+inline void sinkMotionLoop(const Shape& shape, const float* __restrict px,
+                           const float* __restrict py, const float* __restrict pz,
+                           const float* __restrict vx, const float* __restrict vy,
+                           const float* __restrict vz, std::uint32_t* __restrict dead,
+                           std::size_t n, float dt, std::uint32_t code, bool enter) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool now = detail::inside(shape, Vec3(px[i], py[i], pz[i]));
+    const bool next =
+        detail::inside(shape, Vec3(px[i] + vx[i] * dt, py[i] + vy[i] * dt, pz[i] + vz[i] * dt));
+    const bool k = enter ? (!now & next) : (now & !next);
+    const std::uint32_t kk = k ? code : 0u;
+    dead[i] = dead[i] != 0u ? dead[i] : kk;
+  }
+}
+
+inline void apply(const Sink& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const std::uint32_t code = c.action + 1;
+  using M = Sink::Mode;
+  if (a.mode == M::Inside || a.mode == M::Outside) {
+    const bool killInside = a.mode == M::Inside ? a.killInside : !a.killInside;
+    std::visit([&](const auto& shape) {
+      sinkLoop(shape, L.p[0], L.p[1], L.p[2], c.dead, n, code, killInside);
+    }, a.region.shape());
+  } else if (a.mode == M::Enter || a.mode == M::Leave) {
+    std::visit([&](const auto& shape) {
+      sinkMotionLoop(shape, L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], c.dead, n, c.dt, code,
+                     a.mode == M::Enter);
+    }, a.region.shape());
+  } else {  // Hit: the coming Move crosses the plane piece
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3 p = at(L.p, i), v = at(L.v, i);
+      const Vec3 q = p + v * c.dt;
+      const Vec3 nrm = a.region.normal(p);
+      const Vec3 origin = a.region.closestPoint(p);
+      const float d0 = glm::dot(p - origin, nrm), d1 = glm::dot(q - origin, nrm);
+      if (!((d0 >= 0.0f) != (d1 >= 0.0f))) continue;
+      const Vec3 h = p + (q - p) * (d0 / (d0 - d1));
+      if (a.region.distance(h) <= 1e-5f * (1.0f + glm::length(h))) kill(c, i);
+    }
+  }
+  passThrough(c, L, n, a.passThrough);
+}
+
+inline void apply(const SinkVelocity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  std::visit([&](const auto& shape) {
+    sinkLoop(shape, L.v[0], L.v[1], L.v[2], c.dead, n, c.action + 1, a.killInside);
+  }, a.velocity.shape());
+}
+
+inline void apply(const Block& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  // The list's first blocker starts from "visible"; the others can only hide more.
+  std::uint32_t* __restrict vis = L.visible;
+  if (c.action == c.firstBlocker) std::fill_n(vis, n, 1u);
+  std::visit([&](const auto& shape) {
+    const float* __restrict px = L.p[0];
+    const float* __restrict py = L.p[1];
+    const float* __restrict pz = L.p[2];
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::uint32_t in = detail::inside(shape, Vec3(px[i], py[i], pz[i])) ? 1u : 0u;
+      vis[i] &= 1u - in;
+    }
+  }, a.region.shape());
+}
+
+// ---- Forces ------------------------------------------------------------------------------
+
+// Gravity and Damping with a falloff radius (without one they are the vectorised loops).
+inline void applyWeighted(const Gravity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  for (std::size_t i = 0; i < n; ++i)
+    put(L.v, i, at(L.v, i) + a.acceleration * (c.dt * falloffWeight(a.falloff, at(L.p, i))));
+}
+
+inline void applyWeighted(const Damping& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const float w = falloffWeight(a.falloff, at(L.p, i));
+    const Vec3 v = at(L.v, i);
+    put(L.v, i, Vec3(v.x * std::exp(-a.rate.x * c.dt * w), v.y * std::exp(-a.rate.y * c.dt * w),
+                     v.z * std::exp(-a.rate.z * c.dt * w)));
+  }
+}
+
+inline void apply(const RotDamping& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  scaleLoop(L.rot[0], L.rot[1], L.rot[2], n, std::exp(-a.rate.x * c.dt), std::exp(-a.rate.y * c.dt),
+            std::exp(-a.rate.z * c.dt));
+}
+
+inline void apply(const OrbitPoint& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 acc = softPull(a.center - at(L.p, i), a.magnitude, a.epsilon, a.maxRadius);
+    put(L.v, i, at(L.v, i) + acc * c.dt);
+  }
+}
+
+inline void apply(const OrbitLine& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const Vec3 axis = glm::normalize(a.axis);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 w = at(L.p, i) - a.point;
+    const Vec3 d = -(w - axis * glm::dot(w, axis));  // towards the nearest point of the line
+    put(L.v, i, at(L.v, i) + softPull(d, a.magnitude, a.epsilon, a.maxRadius) * c.dt);
+  }
+}
+
+inline void apply(const Gravitate& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const Snapshot& s = *c.snapshot;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 p = at(L.p, i);
+    const std::size_t self = c.base + i;
+    Vec3 acc(0.0f);
+    for (std::size_t j = 0; j < s.size; ++j) {
+      if (j == self) continue;
+      acc += softPull(Vec3(s.p[0][j], s.p[1][j], s.p[2][j]) - p, a.magnitude, a.epsilon, a.maxRadius);
+    }
+    put(L.v, i, at(L.v, i) + acc * c.dt);
+  }
+}
+
+inline void apply(const Vortex& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const Vec3 axis = glm::normalize(a.axis);
+  const float k = approach(a.responsiveness, c.dt);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 w = at(L.p, i) - a.center;
+    const Vec3 radial = w - axis * glm::dot(w, axis);
+    const float r = glm::length(radial);
+    if (!(r <= a.maxRadius)) continue;
+    // On the axis there is no radial direction: no swirl, no inflow (finite, not NaN).
+    const Vec3 rhat = r > 0.0f ? radial / r : Vec3(0.0f);
+    const float around = r < a.coreRadius ? a.aroundSpeed * r / a.coreRadius
+                                          : a.aroundSpeed * std::pow(a.coreRadius / r, a.tightness);
+    const Vec3 u = glm::cross(axis, rhat) * around - rhat * a.inSpeed + axis * a.upSpeed;
+    const Vec3 v = at(L.v, i);
+    put(L.v, i, v + (u - v) * k);
+  }
+}
+
+inline void apply(const Jet& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const bool constant = std::holds_alternative<PointDomain>(a.acceleration.shape());
+  const Vec3 fixed = constant ? std::get<PointDomain>(a.acceleration.shape()).p : Vec3(0.0f);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 d = at(L.p, i) - a.center;
+    if (!(glm::dot(d, d) <= a.radius * a.radius)) continue;
+    Vec3 acc = fixed;
+    if (!constant) {
+      Random rng = actionRandom(c, L, i);
+      acc = a.acceleration.sample(rng);
+    }
+    put(L.v, i, at(L.v, i) + acc * c.dt);
+  }
+}
+
+inline void apply(const Explosion& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const double t = c.time + 0.5 * c.dt;  // the front's radius at mid-step
+  if (t < a.time) return;
+  const float front = a.speed * float(t - a.time);
+  const float inv2s2 = 1.0f / (2.0f * a.stddev * a.stddev);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 d = at(L.p, i) - a.center;
+    const float r = glm::length(d);
+    if (!(r > 0.0f)) continue;
+    const float delta = r - front;
+    const float mag = a.magnitude * std::exp(-delta * delta * inv2s2) / (r * r + a.epsilon);
+    put(L.v, i, at(L.v, i) + d * (mag / r * c.dt));
+  }
+}
+
+inline void apply(const RandomAccel& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  for (std::size_t i = 0; i < n; ++i) {
+    Random rng = actionRandom(c, L, i);
+    const float w = falloffWeight(a.falloff, at(L.p, i));
+    put(L.v, i, at(L.v, i) + a.acceleration.sample(rng) * (c.dt * w));
+  }
+}
+inline void apply(const RandomDisplace& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  for (std::size_t i = 0; i < n; ++i) {
+    Random rng = actionRandom(c, L, i);
+    put(L.p, i, at(L.p, i) + a.displacement.sample(rng) * c.dt);
+  }
+}
+inline void apply(const RandomVelocity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  for (std::size_t i = 0; i < n; ++i) {
+    Random rng = actionRandom(c, L, i);
+    put(L.v, i, a.velocity.sample(rng));
+  }
+}
+inline void apply(const RandomRotVelocity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  for (std::size_t i = 0; i < n; ++i) {
+    Random rng = actionRandom(c, L, i);
+    put(L.rot, i, a.rotVelocity.sample(rng));
+  }
+}
+
+inline void apply(const Turbulence& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const Vec3 shift = a.drift * float(c.time);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 p = at(L.p, i);
+    const Vec3 acc = curlNoise((p - shift) * a.frequency, a.octaves) * a.amplitude;
+    put(L.v, i, at(L.v, i) + acc * (c.dt * falloffWeight(a.falloff, p)));
+  }
+}
+
+// Charge over mass; a particle of zero (or negative) mass does not respond to fields.
+inline float chargePerMass(const Lanes& L, std::size_t i) {
+  const float m = L.mass[i];
+  return m > 0.0f ? L.charge[i] / m : 0.0f;
+}
+
+inline void apply(const ElectricField& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const float w = falloffWeight(a.falloff, at(L.p, i));
+    put(L.v, i, at(L.v, i) + a.field * (chargePerMass(L, i) * c.dt * w));
+  }
+}
+
+inline void apply(const MagneticField& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const float B = glm::length(a.field);
+  if (!(B > 0.0f)) return;
+  const Vec3 k = a.field / B;
+  for (std::size_t i = 0; i < n; ++i) {
+    // dv/dt = (q/m) v × B is a rotation about B at -(q/m)|B|: done exactly (Rodrigues), in
+    // double so that the speed does not drift by float rounding over many steps.
+    const double theta = -double(chargePerMass(L, i)) * B * c.dt;
+    const double ct = std::cos(theta), st = std::sin(theta);
+    const glm::dvec3 v(at(L.v, i)), kd(k);
+    const glm::dvec3 r = v * ct + glm::cross(kd, v) * st + kd * (glm::dot(kd, v) * (1.0 - ct));
+    put(L.v, i, Vec3(r));
+  }
+}
+
+inline void apply(const SampledField& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const VectorField& f = *a.field;
+  const float k = approach(a.responsiveness, c.dt);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 u = f.sample(at(L.p, i)) * a.strength;
+    const Vec3 v = at(L.v, i);
+    put(L.v, i, a.mode == SampledField::Mode::Acceleration ? v + u * c.dt : v + (u - v) * k);
+  }
+}
+
+inline void apply(const Avoid& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const bool planar = a.obstacle.isPlanar();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 p = at(L.p, i), v = at(L.v, i);
+    const Vec3 ahead = p + v * a.lookAhead;
+    bool threat;
+    if (planar) {
+      const Vec3 nrm = a.obstacle.normal(p);
+      const Vec3 o = a.obstacle.closestPoint(p);
+      const float d0 = glm::dot(p - o, nrm), d1 = glm::dot(ahead - o, nrm);
+      threat = (d0 >= 0.0f) != (d1 >= 0.0f) &&
+               a.obstacle.distance(p + (ahead - p) * (d0 / (d0 - d1))) < 1e-4f * (1.0f + glm::length(p));
+    } else {
+      threat = !a.obstacle.contains(p) && a.obstacle.contains(ahead);
+    }
+    if (!threat) continue;
+    const float dist = a.obstacle.distance(p);
+    Vec3 away = a.obstacle.normal(p);
+    if (planar && glm::dot(p - a.obstacle.closestPoint(p), away) < 0.0f) away = -away;
+    put(L.v, i, v + away * (a.magnitude / (dist * dist + a.epsilon) * c.dt));
+  }
+}
+
+inline void apply(const Follow& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const Snapshot& s = *c.snapshot;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t next = c.base + i + 1;
+    if (next >= s.size) continue;  // the last particle leads
+    const Vec3 d = Vec3(s.p[0][next], s.p[1][next], s.p[2][next]) - at(L.p, i);
+    put(L.v, i, at(L.v, i) + softPull(d, a.magnitude, a.epsilon, a.maxRadius) * c.dt);
+  }
+}
+
+// Towards the mean of the neighbours' values within maxRadius, at `magnitude` per second.
+inline void matchMean(const Snapshot& s, const float* const* self, const float* const* field,
+                      float* const* out, std::size_t n, const BlockContext& c, float rate,
+                      float maxR) {
+  const float k = approach(rate, c.dt);
+  const float r2max = maxR * maxR;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 p = at(self, i);
+    Vec3 sum(0.0f);
+    int count = 0;
+    for (std::size_t j = 0; j < s.size; ++j) {
+      if (j == c.base + i) continue;
+      const Vec3 d = Vec3(s.p[0][j], s.p[1][j], s.p[2][j]) - p;
+      if (glm::dot(d, d) > r2max) continue;
+      sum += Vec3(field[0][j], field[1][j], field[2][j]);
+      ++count;
+    }
+    if (count == 0) continue;
+    const Vec3 v = at(out, i);
+    put(out, i, v + (sum / float(count) - v) * k);
+  }
+}
+inline void apply(const MatchVelocity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  matchMean(*c.snapshot, L.p, c.snapshot->v, L.v, n, c, a.magnitude, a.maxRadius);
+}
+inline void apply(const MatchRotVelocity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  matchMean(*c.snapshot, L.p, c.snapshot->rot, L.rot, n, c, a.magnitude, a.maxRadius);
+}
+
+// ---- Targets, clamps, curves -------------------------------------------------------------
+
+inline void approachLoop(float* __restrict x, std::size_t n, float target, float k) {
+  for (std::size_t i = 0; i < n; ++i) x[i] += (target - x[i]) * k;
+}
+inline void apply(const TargetVelocity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const float k = approach(a.rate, c.dt);
+  for (int d = 0; d < 3; ++d) approachLoop(L.v[d], n, a.velocity[d], k);
+}
+inline void apply(const TargetRotVelocity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const float k = approach(a.rate, c.dt);
+  for (int d = 0; d < 3; ++d) approachLoop(L.rot[d], n, a.rotVelocity[d], k);
+}
+inline void apply(const TargetColor& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const float k = approach(a.rate, c.dt);
+  for (int d = 0; d < 3; ++d) approachLoop(L.color[d], n, a.color[d], k);
+  approachLoop(L.color[3], n, a.alpha, k);
+}
+inline void apply(const TargetSize& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  approachLoop(L.size, n, a.size, approach(a.rate, c.dt));
+}
+
+inline void apply(const SpeedClamp& a, const Lanes& L, std::size_t n, const BlockContext&) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 v = at(L.v, i);
+    const float s = glm::length(v);
+    if (s > a.maxSpeed) put(L.v, i, v * (a.maxSpeed / s));
+    else if (s < a.minSpeed && s > 0.0f) put(L.v, i, v * (a.minSpeed / s));
+  }
+}
+
+template <class Keys, class Value>
+inline Value lookup(const Keys& keys, float t, Value (*value)(const typename Keys::value_type&)) {
+  if (t <= keys.front().t) return value(keys.front());
+  for (std::size_t k = 1; k < keys.size(); ++k) {
+    if (t <= keys[k].t) {
+      const float span = keys[k].t - keys[k - 1].t;
+      const float w = span > 0.0f ? (t - keys[k - 1].t) / span : 1.0f;
+      return value(keys[k - 1]) + (value(keys[k]) - value(keys[k - 1])) * w;
+    }
+  }
+  return value(keys.back());
+}
+inline float lifeFraction(const Lanes& L, std::size_t i) {
+  const float life = L.lifetime[i];
+  return life > 0.0f ? std::clamp(L.age[i] / life, 0.0f, 1.0f) : 1.0f;
+}
+inline void apply(const ColorOverLife& a, const Lanes& L, std::size_t n, const BlockContext&) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec4 col = lookup<std::vector<ColorOverLife::Key>, Vec4>(
+        a.keys, lifeFraction(L, i), [](const ColorOverLife::Key& k) { return k.color; });
+    for (int d = 0; d < 4; ++d) L.color[d][i] = col[d];
+  }
+}
+inline void apply(const SizeOverLife& a, const Lanes& L, std::size_t n, const BlockContext&) {
+  for (std::size_t i = 0; i < n; ++i)
+    L.size[i] = lookup<std::vector<SizeOverLife::Key>, float>(
+        a.keys, lifeFraction(L, i), [](const SizeOverLife::Key& k) { return k.size; });
+}
+
+// ---- Bookkeeping -------------------------------------------------------------------------
+
+inline void apply(const Constrain2D& a, const Lanes& L, std::size_t n, const BlockContext&) {
+  const Vec3 nrm = glm::normalize(a.normal);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 p = at(L.p, i), v = at(L.v, i);
+    put(L.p, i, p - nrm * glm::dot(p - a.point, nrm));
+    put(L.v, i, v - nrm * glm::dot(v, nrm));
+  }
+}
+
+inline void apply(const CopyVertexB& a, const Lanes& L, std::size_t n, const BlockContext&) {
+  if (a.copyPosition) copyLoop(L.posB[0], L.posB[1], L.posB[2], L.p[0], L.p[1], L.p[2], n);
+  if (a.copyVelocity) copyLoop(L.velB[0], L.velB[1], L.velB[2], L.v[0], L.v[1], L.v[2], n);
+}
+
+inline void apply(const Restore& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  if (c.time + 1e-9 < a.start) return;
+  const float left = float(double(a.start) + a.duration - c.time);  // seconds to arrival
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 p = at(L.p, i), home = at(L.posB, i);
+    // The velocity that arrives on time; in the last step, exactly.
+    put(L.v, i, left > c.dt ? (home - p) / left : (home - p) / c.dt);
+    if (left <= 0.0f) {
+      put(L.p, i, home);
+      put(L.v, i, Vec3(0.0f));
+    }
+  }
+}
+
+inline void apply(const Callback& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const CallbackContext ctx{c.dt, c.time, c.step};
+  for (std::size_t i = 0; i < n; ++i) {
+    Particle q = readParticle(L, i);
+    a.function(q, ctx);
+    writeParticle(L, i, q);
+  }
+}
+
+}  // namespace flurry::detail::cpu

@@ -1,0 +1,185 @@
+// Deflectors (closed shapes, 2-D segments), absorbers by mode, and blockers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "flurry/flurry.hpp"
+
+using namespace flurry;
+
+namespace {
+Context makeContext(double dt = 1.0 / 30.0) {
+  ContextOptions o;
+  o.dt = dt;
+  o.threads = 2;
+  return Context(o);
+}
+void fill(Group& g, int n, const Domain& where, const Domain& velocity, std::uint32_t seed = 1) {
+  Random rng(seed, 0, 0, 0);
+  for (int i = 0; i < n; ++i) {
+    Particle p;
+    p.position = where.sample(rng);
+    p.velocity = velocity.sample(rng);
+    g.add(p);
+  }
+}
+}  // namespace
+
+// Closed deflectors hold particles in (or out) at any speed, over many steps.
+TEST(Bounce, ClosedShapesNeverLeakAtHighSpeed) {
+  for (float speed : {1.0f, 1e3f, 1e4f}) {
+    const Domain velocities = Domain::sphere(Vec3(0), speed, speed);
+    {
+      Context ctx = makeContext();
+      Group& g = ctx.createGroup("in-sphere", 2000);
+      g.setActions({Gravity{}, Bounce{Domain::sphere(Vec3(1, 2, 3), 5.0f), 0.9f, 0.1f, 0.0f, true}, Move{}});
+      fill(g, 2000, Domain::sphere(Vec3(1, 2, 3), 4.9f), velocities);
+      for (int s = 0; s < 60; ++s) {
+        ctx.step();
+        for (std::size_t i = 0; i < g.size(); ++i)
+          ASSERT_LE(glm::length(g.particle(i).position - Vec3(1, 2, 3)), 5.0f) << speed;
+      }
+    }
+    {
+      Context ctx = makeContext();
+      Group& g = ctx.createGroup("in-box", 2000);
+      const Domain box = Domain::box(Vec3(-1, -2, -3), Vec3(4, 5, 6));
+      g.setActions({Gravity{}, Bounce{box, 0.8f, 0.2f, 0.0f, true}, Move{}});
+      fill(g, 2000, box, velocities);
+      for (int s = 0; s < 60; ++s) {
+        ctx.step();
+        for (std::size_t i = 0; i < g.size(); ++i)
+          ASSERT_TRUE(box.contains(g.particle(i).position)) << speed << " step " << s;
+      }
+    }
+    {
+      Context ctx = makeContext();
+      Group& g = ctx.createGroup("out-box", 2000);
+      const Domain box = Domain::box(Vec3(-1), Vec3(1));
+      g.setActions({Bounce{box, 1.0f, 0.0f, 0.0f, false}, Move{}});
+      // Aimed at the box from all around.
+      Random rng(7, 0, 0, 0);
+      for (int i = 0; i < 2000; ++i) {
+        Particle p;
+        const Vec3 dir = Domain::sphere(Vec3(0), 1.0f, 1.0f).sample(rng);
+        p.position = dir * (2.0f + 100.0f * rng.uniform());
+        p.velocity = -dir * speed;
+        g.add(p);
+      }
+      for (int s = 0; s < 30; ++s) {
+        ctx.step();
+        for (std::size_t i = 0; i < g.size(); ++i)
+          ASSERT_FALSE(box.contains(g.particle(i).position)) << speed << " step " << s;
+      }
+    }
+  }
+}
+
+TEST(Bounce, BoxFromOutsideReflectsOffTheEntryFace) {
+  Context ctx = makeContext(0.1);
+  Group& g = ctx.createGroup("g", 1);
+  g.setActions({Bounce{Domain::box(Vec3(-1), Vec3(1)), 0.5f, 0.0f, 0.0f}, Move{}});
+  Particle p;
+  p.position = Vec3(0, 1.1f, 0);
+  p.velocity = Vec3(0, -2, 0);
+  g.add(p);
+  ctx.step();
+  EXPECT_NEAR(g.particle(0).velocity.y, 1.0f, 1e-6f);
+  EXPECT_NEAR(g.particle(0).position.y, 1.05f, 1e-5f);
+}
+
+TEST(Bounce, SegmentDeflectsIn2D) {
+  Context ctx = makeContext(0.05);
+  Group& g = ctx.createGroup("g", 200);
+  g.setActions({Gravity{}, Bounce{Domain::line(Vec3(-5, 0, 0), Vec3(5, 0, 0)), 0.5f},
+                Constrain2D{}, Move{}});
+  fill(g, 200, Domain::rectangle(Vec3(-4, 1, 0), Vec3(8, 0, 0), Vec3(0, 3, 0)),
+       Domain::disc(Vec3(0), Vec3(0, 0, 1), 20.0f));
+  for (int s = 0; s < 100; ++s) {
+    ctx.step();
+    for (std::size_t i = 0; i < g.size(); ++i) {
+      const Vec3 p = g.particle(i).position;
+      ASSERT_EQ(p.z, 0.0f);
+      // Above the segment unless it flew past its ends.
+      if (std::abs(p.x) < 4.9f) ASSERT_GE(p.y, 0.0f) << "step " << s;
+    }
+  }
+}
+
+TEST(Sink, EnterLeaveAndHitModes) {
+  const Domain box = Domain::box(Vec3(-1), Vec3(1));
+  auto one = [&](Sink sink, Vec3 p, Vec3 v) {
+    Context ctx = makeContext(0.1);
+    Group& g = ctx.createGroup("g", 1);
+    g.setActions({sink, Move{}});
+    Particle q;
+    q.position = p;
+    q.velocity = v;
+    g.add(q);
+    ctx.step();
+    return g.size();
+  };
+  Sink enter{box, true, 0.0f, Sink::Mode::Enter};
+  EXPECT_EQ(one(enter, Vec3(-1.5f, 0, 0), Vec3(10, 0, 0)), 0u);  // enters
+  EXPECT_EQ(one(enter, Vec3(0, 0, 0), Vec3(1, 0, 0)), 1u);       // already in
+  Sink leave{box, true, 0.0f, Sink::Mode::Leave};
+  EXPECT_EQ(one(leave, Vec3(0.9f, 0, 0), Vec3(10, 0, 0)), 0u);
+  EXPECT_EQ(one(leave, Vec3(0, 0, 0), Vec3(1, 0, 0)), 1u);
+  Sink hit{Domain::disc(Vec3(0), Vec3(0, 1, 0), 1.0f), true, 0.0f, Sink::Mode::Hit};
+  EXPECT_EQ(one(hit, Vec3(0, 0.5f, 0), Vec3(0, -10, 0)), 0u);   // crosses the disc
+  EXPECT_EQ(one(hit, Vec3(5, 0.5f, 0), Vec3(0, -10, 0)), 1u);   // crosses the plane, not the disc
+  Sink outside{box, true, 0.0f, Sink::Mode::Outside};
+  EXPECT_EQ(one(outside, Vec3(5, 0, 0), Vec3(0)), 0u);
+  EXPECT_EQ(one(outside, Vec3(0, 0, 0), Vec3(0)), 1u);
+}
+
+TEST(Sink, EachAbsorberCountsWhatItTook) {
+  Context ctx = makeContext(0.1);
+  Group& g = ctx.createGroup("g", 100);
+  g.setActions({Sink{Domain::sphere(Vec3(-5, 0, 0), 1.0f)}, Sink{Domain::sphere(Vec3(5, 0, 0), 1.0f)}});
+  for (int i = 0; i < 30; ++i) {
+    Particle p;
+    p.position = Vec3(i < 10 ? -5.0f : (i < 30 ? 5.0f : 0.0f), 0, 0);
+    g.add(p);
+  }
+  ctx.step();
+  EXPECT_EQ(g.stats().killedByAction[0], 10u);
+  EXPECT_EQ(g.stats().killedByAction[1], 20u);
+  EXPECT_EQ(g.stats().absorbed, 30u);
+}
+
+TEST(SinkVelocity, KillsTheSlow) {
+  Context ctx = makeContext(0.1);
+  Group& g = ctx.createGroup("g", 2);
+  g.setActions({SinkVelocity{Domain::sphere(Vec3(0), 0.5f)}});
+  Particle a, b;
+  a.velocity = Vec3(0.1f, 0, 0);
+  b.velocity = Vec3(3, 0, 0);
+  g.add(a);
+  g.add(b);
+  ctx.step();
+  ASSERT_EQ(g.size(), 1u);
+  EXPECT_EQ(g.particle(0).velocity.x, 3.0f);
+}
+
+// A blocker hides exactly the particles inside it; they reappear when they leave.
+TEST(Block, HidesExactlyThoseInside) {
+  Context ctx = makeContext(0.1);
+  Group& g = ctx.createGroup("g", 5000);
+  const Domain blocker = Domain::box(Vec3(-1, -10, -10), Vec3(1, 10, 10));
+  const Domain second = Domain::sphere(Vec3(5, 0, 0), 1.0f);
+  g.setActions({Move{}, Block{blocker}, Block{second}});
+  fill(g, 5000, Domain::box(Vec3(-10, -1, -1), Vec3(10, 1, 1)), Domain::point(Vec3(1, 0, 0)));
+  for (int s = 0; s < 5; ++s) {
+    ctx.step();
+    const auto vis = g.visible();
+    std::size_t hidden = 0;
+    for (std::size_t i = 0; i < g.size(); ++i) {
+      const Vec3 p = g.particle(i).position;
+      const bool in = blocker.contains(p) || second.contains(p);
+      ASSERT_EQ(vis[i], in ? 0u : 1u);
+      hidden += in;
+    }
+    EXPECT_GT(hidden, 0u);
+  }
+}

@@ -1,0 +1,333 @@
+// Force fields and the other per-particle actions against their expected behaviour.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "flurry/flurry.hpp"
+#include "noise.hpp"
+
+using namespace flurry;
+
+namespace {
+Context makeContext(double dt = 0.01) {
+  ContextOptions o;
+  o.dt = dt;
+  o.threads = 2;
+  return Context(o);
+}
+Particle at(Vec3 p, Vec3 v = Vec3(0)) {
+  Particle q;
+  q.position = p;
+  q.velocity = v;
+  return q;
+}
+}  // namespace
+
+TEST(OrbitPoint, KeepsACircularOrbitsRadius) {
+  Context ctx = makeContext(0.001);
+  Group& g = ctx.createGroup("g", 1);
+  const float M = 10.0f, eps = 1e-4f, r = 2.0f;
+  g.setActions({OrbitPoint{Vec3(0), M, eps}, Move{}});
+  // Circular speed for the softened pull: v² = M r² / (r² + eps)^(3/2).
+  const float v = std::sqrt(M * r * r / std::pow(r * r + eps, 1.5f));
+  g.add(at(Vec3(r, 0, 0), Vec3(0, v, 0)));
+  const double period = 2 * M_PI * r / v;
+  float lo = r, hi = r;
+  for (int s = 0; s < int(5 * period / 0.001); ++s) {
+    ctx.step();
+    const float rad = glm::length(g.particle(0).position);
+    lo = std::min(lo, rad);
+    hi = std::max(hi, rad);
+  }
+  EXPECT_GT(lo, r * 0.995f);
+  EXPECT_LT(hi, r * 1.005f);
+}
+
+TEST(OrbitPoint, IsFiniteAtTheCenter) {
+  Context ctx = makeContext();
+  Group& g = ctx.createGroup("g", 1);
+  g.setActions({OrbitPoint{Vec3(1, 2, 3), 100.0f, 1e-3f}, Move{}});
+  g.add(at(Vec3(1, 2, 3)));
+  ctx.run(10);
+  const Particle p = g.particle(0);
+  EXPECT_TRUE(std::isfinite(p.position.x) && std::isfinite(p.velocity.x));
+  EXPECT_EQ(p.velocity, Vec3(0));  // d = 0: no pull at all
+}
+
+TEST(OrbitLine, PullsTowardsTheLineOnly) {
+  Context ctx = makeContext();
+  Group& g = ctx.createGroup("g", 1);
+  g.setActions({OrbitLine{Vec3(0), Vec3(0, 1, 0), 1.0f, 1e-3f}});
+  g.add(at(Vec3(2, 5, 0)));
+  ctx.step();
+  const Vec3 v = g.particle(0).velocity;
+  EXPECT_LT(v.x, 0.0f);
+  EXPECT_NEAR(v.y, 0.0f, 1e-7);
+  EXPECT_NEAR(v.z, 0.0f, 1e-7);
+}
+
+TEST(Gravitate, ConservesMomentum) {
+  Context ctx = makeContext();
+  Group& g = ctx.createGroup("g", 50);
+  g.setActions({Gravitate{1.0f, 0.01f}, Move{}});
+  Random rng(3, 0, 0, 0);
+  for (int i = 0; i < 50; ++i) g.add(at(Domain::box(Vec3(-1), Vec3(1)).sample(rng)));
+  ctx.run(20);
+  Vec3 momentum(0);
+  for (std::size_t i = 0; i < g.size(); ++i) momentum += g.particle(i).velocity;
+  EXPECT_LT(glm::length(momentum), 1e-3f);
+  EXPECT_GT(glm::length(g.particle(0).velocity), 0.0f);
+}
+
+TEST(Vortex, SwirlsAroundTheAxisAndIsFiniteOnIt) {
+  Context ctx = makeContext(0.01);
+  Group& g = ctx.createGroup("g", 2);
+  Vortex vx;
+  vx.aroundSpeed = 2.0f;
+  vx.responsiveness = 1000.0f;  // the velocity reaches the field's at once
+  g.setActions({vx, Move{}});
+  g.add(at(Vec3(1, 0, 0)));
+  g.add(at(Vec3(0, 3, 0)));  // on the axis
+  ctx.step();
+  const Vec3 v = g.particle(0).velocity;
+  EXPECT_NEAR(v.z, -1.0f, 1e-3f);  // axis × x̂ = -ẑ; outside the core: 2·(0.5/1)^1
+  EXPECT_TRUE(std::isfinite(g.particle(1).velocity.x));
+  EXPECT_EQ(g.particle(1).velocity, Vec3(0));
+}
+
+TEST(Turbulence, CurlNoiseIsDivergenceFree) {
+  const float h = 1e-3f;
+  Random rng(9, 0, 0, 0);
+  double worstDiv = 0, typicalGrad = 0;
+  for (int k = 0; k < 200; ++k) {
+    const Vec3 p = Domain::box(Vec3(-10), Vec3(10)).sample(rng);
+    const Vec3 dx = (detail::curlNoise(p + Vec3(h, 0, 0), 2) - detail::curlNoise(p - Vec3(h, 0, 0), 2)) / (2 * h);
+    const Vec3 dy = (detail::curlNoise(p + Vec3(0, h, 0), 2) - detail::curlNoise(p - Vec3(0, h, 0), 2)) / (2 * h);
+    const Vec3 dz = (detail::curlNoise(p + Vec3(0, 0, h), 2) - detail::curlNoise(p - Vec3(0, 0, h), 2)) / (2 * h);
+    worstDiv = std::max(worstDiv, double(std::abs(dx.x + dy.y + dz.z)));
+    typicalGrad += std::abs(dx.y) + std::abs(dy.z) + std::abs(dz.x);
+  }
+  typicalGrad /= 600;
+  EXPECT_GT(typicalGrad, 0.1);                // the field does vary...
+  EXPECT_LT(worstDiv, 0.01 * typicalGrad);    // ...with no divergence beyond the differences' error
+}
+
+TEST(MagneticField, DoesNoWorkAndGyratesAtTheLarmorRadius) {
+  Context ctx = makeContext(0.001);
+  Group& g = ctx.createGroup("g", 1);
+  const float q = 2.0f, m = 0.5f, B = 4.0f, speed = 3.0f;
+  g.setActions({MagneticField{Vec3(0, 0, B)}, Move{}});
+  Particle p = at(Vec3(0), Vec3(speed, 0, 0));
+  p.charge = q;
+  p.mass = m;
+  g.add(p);
+  const float radius = m * speed / (q * B);  // 0.1875
+  float xmin = 1e9f, xmax = -1e9f, ymin = 1e9f, ymax = -1e9f;
+  for (int s = 0; s < 10000; ++s) {
+    ctx.step();
+    const Particle c = g.particle(0);
+    ASSERT_NEAR(glm::length(c.velocity), speed, 1e-5f * speed);
+    xmin = std::min(xmin, c.position.x);
+    xmax = std::max(xmax, c.position.x);
+    ymin = std::min(ymin, c.position.y);
+    ymax = std::max(ymax, c.position.y);
+  }
+  EXPECT_NEAR(xmax - xmin, 2 * radius, 0.01f);
+  EXPECT_NEAR(ymax - ymin, 2 * radius, 0.01f);
+}
+
+TEST(ElectricField, AcceleratesByChargeOverMassAndIgnoresZeroMass) {
+  Context ctx = makeContext(0.1);
+  Group& g = ctx.createGroup("g", 2);
+  g.setActions({ElectricField{Vec3(1, 0, 0)}});
+  Particle a = at(Vec3(0));
+  a.charge = 3.0f;
+  a.mass = 2.0f;
+  Particle b = a;
+  b.mass = 0.0f;
+  g.add(a);
+  g.add(b);
+  ctx.run(10);
+  EXPECT_NEAR(g.particle(0).velocity.x, 1.5f, 1e-5f);
+  EXPECT_EQ(g.particle(1).velocity, Vec3(0));
+}
+
+TEST(Targets, ApproachWithoutOvershootAtAnyStep) {
+  for (double dt : {0.01, 1.0, 10.0}) {
+    Context ctx = makeContext(dt);
+    Group& g = ctx.createGroup("g", 1);
+    g.setActions({TargetVelocity{Vec3(5, 0, 0), 2.0f}, TargetColor{Vec3(1, 0, 0), 0.5f, 2.0f},
+                  TargetSize{2.0f, 2.0f}});
+    g.add(at(Vec3(0)));
+    ctx.run(5);
+    const Particle p = g.particle(0);
+    EXPECT_LE(p.velocity.x, 5.0f);
+    EXPECT_GT(p.velocity.x, 0.0f);
+    EXPECT_LE(p.size, 2.0f + 1e-6f);
+    EXPECT_GE(p.color.g, 0.0f);
+  }
+  // Exact exponential: one step of 1 s equals ten of 0.1 s.
+  float v[2];
+  int k = 0;
+  for (double dt : {1.0, 0.1}) {
+    Context ctx = makeContext(dt);
+    Group& g = ctx.createGroup("g", 1);
+    g.setActions({TargetVelocity{Vec3(1, 0, 0), 0.7f}});
+    g.add(at(Vec3(0)));
+    ctx.run(std::size_t(std::lround(1.0 / dt)));
+    v[k++] = g.particle(0).velocity.x;
+  }
+  EXPECT_NEAR(v[0], v[1], 1e-5f);
+  EXPECT_NEAR(v[0], 1.0f - std::exp(-0.7f), 1e-6f);
+}
+
+TEST(SpeedClamp, KeepsSpeedInRange) {
+  Context ctx = makeContext();
+  Group& g = ctx.createGroup("g", 2);
+  g.setActions({SpeedClamp{1.0f, 2.0f}});
+  g.add(at(Vec3(0), Vec3(10, 0, 0)));
+  g.add(at(Vec3(0), Vec3(0, 0.1f, 0)));
+  ctx.step();
+  EXPECT_NEAR(g.particle(0).velocity.x, 2.0f, 1e-6f);
+  EXPECT_NEAR(g.particle(1).velocity.y, 1.0f, 1e-6f);
+}
+
+TEST(OverLife, ColorAndSizeFollowTheirCurves) {
+  Context ctx = makeContext(0.25);
+  Group& g = ctx.createGroup("g", 1);
+  g.setActions({Move{}, ColorOverLife{{{0.0f, Vec4(1, 0, 0, 1)}, {1.0f, Vec4(0, 0, 1, 0)}}},
+                SizeOverLife{{{0.0f, 1.0f}, {0.5f, 3.0f}, {1.0f, 0.0f}}}});
+  Particle p = at(Vec3(0));
+  p.lifetime = 1.0f;
+  g.add(p);
+  ctx.run(2);  // age 0.5
+  const Particle q = g.particle(0);
+  EXPECT_NEAR(q.color.r, 0.5f, 1e-6f);
+  EXPECT_NEAR(q.color.b, 0.5f, 1e-6f);
+  EXPECT_NEAR(q.size, 3.0f, 1e-6f);
+}
+
+TEST(RandomActions, DrawFromTheirDomainsReproducibly) {
+  auto run = [] {
+    Context ctx = makeContext();
+    Group& g = ctx.createGroup("g", 100);
+    g.setActions({RandomVelocity{Domain::box(Vec3(1, 2, 3), Vec3(2, 3, 4))}});
+    for (int i = 0; i < 100; ++i) g.add(at(Vec3(0)));
+    ctx.step();
+    std::vector<Vec3> v;
+    for (std::size_t i = 0; i < g.size(); ++i) v.push_back(g.particle(i).velocity);
+    return v;
+  };
+  const auto a = run(), b = run();
+  EXPECT_EQ(a, b);
+  for (const Vec3& v : a) EXPECT_TRUE(Domain::box(Vec3(1, 2, 3), Vec3(2, 3, 4)).contains(v));
+  EXPECT_NE(a[0], a[1]);
+}
+
+TEST(Jet, AcceleratesOnlyWithinItsRadius) {
+  Context ctx = makeContext(0.1);
+  Group& g = ctx.createGroup("g", 2);
+  g.setActions({Jet{Vec3(0), 1.0f, Domain::point(Vec3(0, 10, 0))}});
+  g.add(at(Vec3(0.5f, 0, 0)));
+  g.add(at(Vec3(5, 0, 0)));
+  ctx.step();
+  EXPECT_NEAR(g.particle(0).velocity.y, 1.0f, 1e-6f);
+  EXPECT_EQ(g.particle(1).velocity.y, 0.0f);
+}
+
+TEST(Explosion, PushesOutwardNearTheFront) {
+  Context ctx = makeContext(0.1);
+  Group& g = ctx.createGroup("g", 2);
+  g.setActions({Explosion{Vec3(0), 10.0f, 100.0f, 0.5f, 1e-3f, 0.0f}});
+  g.add(at(Vec3(0.5f, 0, 0)));   // the front is at 0.5 at mid-step
+  g.add(at(Vec3(0, -20, 0)));    // far from it
+  ctx.step();
+  EXPECT_GT(g.particle(0).velocity.x, 1.0f);
+  EXPECT_NEAR(g.particle(1).velocity.y, 0.0f, 1e-6f);
+}
+
+TEST(SampledField, AcceleratesAlongTheGrid) {
+  auto field = std::make_shared<VectorField>();
+  field->dims = glm::ivec3(2, 2, 2);
+  field->data.assign(8, Vec3(0, 0, 1));
+  field->data[1] = Vec3(0, 0, 3);  // x = 1, y = 0, z = 0
+  Context ctx = makeContext(0.1);
+  Group& g = ctx.createGroup("g", 1);
+  g.setActions({SampledField{field}});
+  g.add(at(Vec3(0.5f, 0, 0)));  // halfway: 2
+  ctx.step();
+  EXPECT_NEAR(g.particle(0).velocity.z, 0.2f, 1e-6f);
+  auto bad = std::make_shared<VectorField>(*field);
+  bad->data[3] = Vec3(NAN);
+  EXPECT_THROW(ActionList{SampledField{bad}}, InvalidArgument);
+}
+
+TEST(Avoid, SteersAwayFromAnObstacleAhead) {
+  Context ctx = makeContext(0.01);
+  Group& g = ctx.createGroup("g", 1);
+  g.setActions({Avoid{Domain::sphere(Vec3(0), 1.0f), 50.0f, 0.1f, 1.0f}, Move{}});
+  g.add(at(Vec3(-3, 0.2f, 0), Vec3(2, 0, 0)));
+  bool entered = false;
+  for (int s = 0; s < 300; ++s) {
+    ctx.step();
+    entered |= glm::length(g.particle(0).position) < 1.0f;
+  }
+  EXPECT_FALSE(entered);
+}
+
+TEST(Follow, TrailsTheNextParticle) {
+  Context ctx = makeContext(0.1);
+  Group& g = ctx.createGroup("g", 2);
+  g.setActions({Follow{1.0f, 0.01f}});
+  g.add(at(Vec3(0)));
+  g.add(at(Vec3(1, 0, 0)));
+  ctx.step();
+  EXPECT_GT(g.particle(0).velocity.x, 0.0f);
+  EXPECT_EQ(g.particle(1).velocity, Vec3(0));  // the leader
+}
+
+TEST(MatchVelocity, NeighboursConverge) {
+  Context ctx = makeContext(0.1);
+  Group& g = ctx.createGroup("g", 2);
+  g.setActions({MatchVelocity{5.0f, 0.01f, 10.0f}});
+  g.add(at(Vec3(0), Vec3(1, 0, 0)));
+  g.add(at(Vec3(1, 0, 0), Vec3(-1, 0, 0)));
+  ctx.run(20);
+  EXPECT_NEAR(g.particle(0).velocity.x, g.particle(1).velocity.x, 1e-3f);
+}
+
+TEST(RestoreAndCopyVertexB, ReturnToTheRestPoseOnTime) {
+  Context ctx = makeContext(0.1);
+  Group& g = ctx.createGroup("g", 1);
+  g.setActions({CopyVertexB{}});
+  g.add(at(Vec3(1, 2, 3)));
+  ctx.step();
+  g.setActions({Gravity{}, Move{}});
+  ctx.run(10);  // falls away
+  EXPECT_GT(glm::length(g.particle(0).position - Vec3(1, 2, 3)), 1.0f);
+  g.setActions({Restore{float(ctx.time()), 1.0f}, Move{}});
+  ctx.run(10);
+  EXPECT_LT(glm::length(g.particle(0).position - Vec3(1, 2, 3)), 1e-4f);
+  ctx.run(5);
+  EXPECT_LT(glm::length(g.particle(0).position - Vec3(1, 2, 3)), 1e-4f);
+}
+
+TEST(Callback, RunsAUserFunctionPerParticle) {
+  Context ctx = makeContext(0.5);
+  Group& g = ctx.createGroup("g", 10);
+  g.setActions({Callback{[](Particle& p, const CallbackContext& c) { p.userData += c.dt; },
+                         {Attribute::UserData}}});
+  for (int i = 0; i < 10; ++i) g.add(at(Vec3(0)));
+  ctx.run(4);
+  for (std::size_t i = 0; i < g.size(); ++i) EXPECT_FLOAT_EQ(g.particle(i).userData, 2.0f);
+}
+
+TEST(Constrain2D, KeepsTheGroupInItsPlane) {
+  Context ctx = makeContext(0.05);
+  Group& g = ctx.createGroup("g", 1);
+  g.setActions({Gravity{Vec3(0, -9.81f, 3)}, Constrain2D{}, Move{}});
+  g.add(at(Vec3(0, 5, 0), Vec3(1, 0, 2)));
+  ctx.run(20);
+  EXPECT_EQ(g.particle(0).position.z, 0.0f);
+  EXPECT_EQ(g.particle(0).velocity.z, 0.0f);
+}
