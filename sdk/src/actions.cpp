@@ -2,6 +2,7 @@
 #include <type_traits>
 
 #include "flurry/actions.hpp"
+#include "action_traits.hpp"
 #include "flurry/error.hpp"
 
 namespace flurry {
@@ -280,6 +281,78 @@ struct Uses {
 
 }  // namespace
 
+namespace detail {
+
+bool isForce(const Action& a) {
+  return std::holds_alternative<Gravity>(a) || std::holds_alternative<Damping>(a) ||
+         std::holds_alternative<OrbitPoint>(a) || std::holds_alternative<OrbitLine>(a) ||
+         std::holds_alternative<Gravitate>(a) || std::holds_alternative<Vortex>(a) ||
+         std::holds_alternative<Jet>(a) || std::holds_alternative<Explosion>(a) ||
+         std::holds_alternative<RandomAccel>(a) || std::holds_alternative<Turbulence>(a) ||
+         std::holds_alternative<ElectricField>(a) || std::holds_alternative<MagneticField>(a) ||
+         std::holds_alternative<SampledField>(a) || std::holds_alternative<Follow>(a) ||
+         std::holds_alternative<TargetVelocity>(a);
+}
+
+bool hasClosedForm(const Action& a) {
+  return std::holds_alternative<Gravity>(a) || std::holds_alternative<Damping>(a) ||
+         std::holds_alternative<ElectricField>(a);
+}
+
+}  // namespace detail
+
+namespace {
+
+using detail::hasClosedForm;
+using detail::isForce;
+
+void checkExact(const std::vector<Action>& actions) {
+  for (std::size_t i = 0; i < actions.size(); ++i)
+    if (isForce(actions[i]) && !hasClosedForm(actions[i]))
+      throw InvalidArgument("integrator",
+                            "Exact needs forces with a closed form (Gravity, Damping, "
+                            "ElectricField); actions[" + std::to_string(i) + "] is " +
+                                actionName(actions[i]));
+  for (const Action& a : actions) {
+    const Falloff* f = nullptr;
+    if (const auto* g = std::get_if<Gravity>(&a)) f = &g->falloff;
+    if (const auto* d = std::get_if<Damping>(&a)) f = &d->falloff;
+    if (const auto* e = std::get_if<ElectricField>(&a)) f = &e->falloff;
+    if (f && f->radius < kInfinity)
+      throw InvalidArgument("integrator", "Exact needs forces without a falloff radius");
+  }
+}
+
+}  // namespace
+
+const char* integratorName(Integrator i) {
+  switch (i) {
+    case Integrator::SemiImplicitEuler: return "SemiImplicitEuler";
+    case Integrator::ExplicitEuler: return "ExplicitEuler";
+    case Integrator::VelocityVerlet: return "VelocityVerlet";
+    case Integrator::RK4: return "RK4";
+    case Integrator::Exact: return "Exact";
+  }
+  return "?";
+}
+
+ActionList& ActionList::setIntegrator(Integrator integrator) {
+  if (integrator == Integrator::Exact) checkExact(actions_);
+  integrator_ = integrator;
+  return *this;
+}
+
+ActionList& ActionList::setSubsteps(Substeps substeps) {
+  if (!std::isfinite(substeps.maxStep) || substeps.maxStep < 0)
+    throw InvalidArgument("substeps.maxStep", "must be finite and >= 0");
+  if (!std::isfinite(substeps.maxDistance) || substeps.maxDistance < 0)
+    throw InvalidArgument("substeps.maxDistance", "must be finite and >= 0");
+  if (substeps.maxSubsteps < 1 || substeps.maxSubsteps > 256)
+    throw InvalidArgument("substeps.maxSubsteps", "must be in [1, 256]");
+  substeps_ = substeps;
+  return *this;
+}
+
 std::string actionName(const Action& a) {
   return std::visit([](const auto& x) { return std::string(nameOf<std::decay_t<decltype(x)>>()); },
                     a);
@@ -290,6 +363,11 @@ ActionList& ActionList::add(Action action) {
   if (actions_.size() >= 250)
     throw InvalidArgument("actions", "an action list holds at most 250 actions");
   std::visit(Validator{where}, action);
+  if (integrator_ == Integrator::Exact) {
+    std::vector<Action> next = actions_;
+    next.push_back(action);
+    checkExact(next);
+  }
   actions_.push_back(std::move(action));
   return *this;
 }

@@ -320,7 +320,10 @@ std::span<const std::uint32_t> Group::visible() const {
   return {impl_->lanes[std::size_t(Attribute::Visible)][0].u(), impl_->size};
 }
 
-const GroupStats& Group::stats() const { return impl_->stats; }
+const GroupStats& Group::stats() const {
+  impl_->syncStats();
+  return impl_->stats;
+}
 
 Bounds Group::bounds() const {
   Bounds b;

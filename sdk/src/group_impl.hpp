@@ -93,6 +93,8 @@ class DeviceMirror {
   virtual void pullToHost(GroupImpl& group) = 0;
   /// The host changed the particles or the storage: the device must take the host's copy.
   virtual void hostChanged(GroupImpl& group) = 0;
+  /// Brings the group's statistics up to date (without reading particles back).
+  virtual void syncStats(GroupImpl& /*group*/) {}
 };
 
 struct GroupImpl {
@@ -123,6 +125,7 @@ struct GroupImpl {
   std::vector<std::uint32_t> holes;      ///< sorted dead indices of this step
   std::vector<std::uint32_t> deadFlags;  ///< the unfused baseline's per-particle kill codes
   std::vector<float> snapshot;           ///< positions/velocities at the step's start
+  std::vector<float> stepStart;          ///< positions at the step's start, for the guard
 
   std::unique_ptr<DeviceMirror> mirror;  ///< null on the CPU backend
 
@@ -131,6 +134,9 @@ struct GroupImpl {
   }
   void hostChanged() {
     if (mirror) mirror->hostChanged(*this);
+  }
+  void syncStats() {
+    if (mirror) mirror->syncStats(*this);
   }
 
   /// The attributes the group must store now.

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -335,6 +336,32 @@ using Action =
 /// "Gravity", "Bounce", ...: the names effect files use.
 std::string actionName(const Action& a);
 
+/// How Move integrates the forces before it.
+///
+/// SemiImplicitEuler (the default) applies each force as its own exact update of the
+/// velocity, in list order, then moves with the new velocity: symplectic, first order, and the
+/// behaviour of the classic API's Gravity/Move lists. The others gather the force actions that
+/// come before a Move (Gravity, Damping, OrbitPoint, OrbitLine, Gravitate, Vortex, Jet,
+/// Explosion, RandomAccel, Turbulence, ElectricField, MagneticField, SampledField, Follow,
+/// TargetVelocity) into one acceleration a(p, v, t) and integrate it inside Move:
+/// ExplicitEuler (p += v·dt, v += a·dt: the textbook first-order method), VelocityVerlet
+/// (second order, symplectic for position-only forces), RK4 (fourth order), or Exact (closed
+/// form for constant acceleration with linear drag: Gravity, Damping, ElectricField only).
+enum class Integrator { SemiImplicitEuler, ExplicitEuler, VelocityVerlet, RK4, Exact };
+
+/// "SemiImplicitEuler", "ExplicitEuler", "VelocityVerlet", "RK4", "Exact".
+const char* integratorName(Integrator integrator);
+
+/// Sub-stepping: the step is split into n equal sub-steps, each running the whole action
+/// list, with n the smallest count that keeps the sub-step at most `maxStep` seconds and the
+/// distance the fastest particle of the group travels in one at most `maxDistance`.
+/// 0 turns a bound off; `maxSubsteps` caps n.
+struct Substeps {
+  double maxStep = 0.0;
+  float maxDistance = 0.0f;
+  std::uint32_t maxSubsteps = 64;
+};
+
 /// An ordered list of actions, applied to a group every step.
 class ActionList {
  public:
@@ -357,8 +384,17 @@ class ActionList {
   /// reads them from a snapshot taken at the start of the step.
   bool readsNeighbours() const;
 
+  /// Throws InvalidArgument "integrator" if Exact is asked of forces without a closed form.
+  ActionList& setIntegrator(Integrator integrator);
+  Integrator integrator() const { return integrator_; }
+  /// Throws InvalidArgument "substeps.*" for negative or non-finite bounds.
+  ActionList& setSubsteps(Substeps substeps);
+  const Substeps& substeps() const { return substeps_; }
+
  private:
   std::vector<Action> actions_;
+  Integrator integrator_ = Integrator::SemiImplicitEuler;
+  Substeps substeps_;
 };
 
 }  // namespace flurry

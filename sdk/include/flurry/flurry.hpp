@@ -10,6 +10,7 @@
 #include "flurry/field.hpp"
 #include "flurry/fuzzy.hpp"
 #include "flurry/group.hpp"
+#include "flurry/interop.hpp"
 #include "flurry/io.hpp"
 #include "flurry/math.hpp"
 #include "flurry/random.hpp"

@@ -48,12 +48,16 @@ struct HairOptions {
   std::uint32_t maxVertices = 256;   ///< a strand ends here if the particle lives on
 };
 
-/// Where the particles went. emitted == size() + killedByAge + absorbed + droppedAtCapacity.
+/// Where the particles went:
+/// emitted == size() + killedByAge + absorbed + droppedAtCapacity + killedNonFinite.
 struct GroupStats {
   std::uint64_t emitted = 0;            ///< created by emitters or add(), dropped ones included
   std::uint64_t killedByAge = 0;        ///< by KillOld
   std::uint64_t absorbed = 0;           ///< by Sink (and other absorbers)
   std::uint64_t droppedAtCapacity = 0;  ///< not created: the group was full
+  /// Killed because a step left their position or velocity NaN or infinite (an extreme
+  /// input, a user callback): counted, never propagated.
+  std::uint64_t killedNonFinite = 0;
   std::vector<std::uint64_t> killedByAction;  ///< per action-list entry
   /// Particles by the generation of their emitter: 0 from the group's own emitters, 1 from
   /// emitters a prime emitter spawned, 2 from their children, ...

@@ -3,12 +3,17 @@
 // Actions are built at run time (effect files), so the pass cannot be one compiled loop per
 // list. Instead it is blocked: every action runs over a block of particles small enough to
 // stay in cache, so each particle is read from and written to memory once per step however
-// many actions there are, and each action's loop is vectorised on its own.
+// many actions there are, and each action's loop is vectorised on its own. Sub-steps, the
+// integrator's stages and the NaN guard all happen while the block is in cache.
 #include <algorithm>
+#include <bit>
+#include <cmath>
 #include <vector>
 
+#include "../action_traits.hpp"
 #include "../backend.hpp"
 #include "actions_more.hpp"
+#include "integrate.hpp"
 #include "kernels.hpp"
 
 #ifndef FLURRY_ISA
@@ -22,11 +27,134 @@ namespace {
 constexpr std::size_t kDefaultBlock = 1024;
 constexpr std::size_t kParticlesPerTask = 32768;  // below this a group is stepped inline
 
-void runActions(const std::vector<Action>& acts, std::size_t first, std::size_t last,
-                const Lanes& lanes, std::size_t n, cpu::BlockContext ctx) {
+// How each action of the list runs this step.
+struct Plan {
+  Integrator integrator = Integrator::SemiImplicitEuler;
+  std::vector<std::uint8_t> gathered;                  // a force an integrating Move evaluates
+  std::vector<std::vector<std::uint32_t>> forcesOf;    // per Move: its forces
+  std::vector<std::vector<std::uint32_t>> guardsOf;    // per Move: the Bounces before it
+  std::uint32_t substeps = 1;
+  const float* start[3] = {};  // positions when the step (or sub-step) began, for the guard
+};
+
+Plan makePlan(const GroupImpl& g, const StepParams& sp, ThreadPool& pool) {
+  const auto& acts = g.actions.actions();
+  Plan plan;
+  plan.integrator = g.actions.integrator();
+  plan.gathered.assign(acts.size(), 0);
+  plan.forcesOf.resize(acts.size());
+  plan.guardsOf.resize(acts.size());
+  if (plan.integrator != Integrator::SemiImplicitEuler) {
+    std::vector<std::uint32_t> pending, bounces;
+    for (std::uint32_t k = 0; k < acts.size(); ++k) {
+      if (isForce(acts[k])) pending.push_back(k);
+      if (std::holds_alternative<Bounce>(acts[k])) bounces.push_back(k);
+      if (std::holds_alternative<Move>(acts[k])) {
+        for (std::uint32_t f : pending) plan.gathered[f] = 1;
+        plan.forcesOf[k] = std::move(pending);
+        plan.guardsOf[k] = std::move(bounces);
+        pending.clear();
+        bounces.clear();
+      }
+    }
+  }
+  const Substeps& sub = g.actions.substeps();
+  double n = 1;
+  if (sub.maxStep > 0) n = std::max(n, std::ceil(sp.dt / sub.maxStep));
+  if (sub.maxDistance > 0 && g.stored.has(Attribute::Velocity)) {
+    // The fastest particle decides, for the whole group, so that the result does not depend
+    // on how the group is cut into blocks.
+    const Lanes L = g.lanePointers();
+    const std::size_t chunks = (g.size + 65535) / 65536;
+    std::vector<float> fastest(chunks, 0.0f);
+    pool.parallelFor(chunks, [&](std::size_t c) {
+      float m = 0.0f;
+      for (std::size_t i = c * 65536; i < std::min(g.size, (c + 1) * 65536); ++i)
+        m = std::max(m, L.v[0][i] * L.v[0][i] + L.v[1][i] * L.v[1][i] + L.v[2][i] * L.v[2][i]);
+      fastest[c] = m;
+    });
+    const float vmax = std::sqrt(*std::max_element(fastest.begin(), fastest.end()));
+    if (std::isfinite(vmax)) n = std::max(n, std::ceil(vmax * sp.dt / sub.maxDistance));
+  }
+  plan.substeps = std::uint32_t(std::min<double>(n, sub.maxSubsteps));
+  return plan;
+}
+
+// After an integrating Move, a particle that its curved step (or its bounce) left on the
+// wrong side of a deflector, compared with where it was when the step began, is put back on
+// its side and reflected: no particle ends behind a deflector.
+void guard(const Bounce& b, const Lanes& L, const float* const* start, std::size_t n) {
+  const Domain& d = b.surface;
+  const auto* seg = std::get_if<LineDomain>(&d.shape());
+  const bool planar = d.isPlanar() || seg;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 p0(start[0][i], start[1][i], start[2][i]);
+    Vec3 p1(L.p[0][i], L.p[1][i], L.p[2][i]);
+    Vec3 nrm, back;
+    if (planar) {
+      nrm = seg ? glm::normalize(glm::cross(seg->p1 - seg->p0, b.planeNormal)) : d.normal(p0);
+      const Vec3 o = seg ? seg->p0 : d.closestPoint(p0);
+      const float d0 = glm::dot(p0 - o, nrm);
+      if (d0 < 0.0f) nrm = -nrm;  // towards the side it started on
+      const float d1 = glm::dot(p1 - o, nrm);
+      const float margin = 1e-6f * (1.0f + glm::length(p1));
+      if (d1 >= margin) continue;
+      // Only if the step's chord passes through the piece (a plane: always).
+      const float dd0 = std::abs(d0);
+      const Vec3 hit = p0 + (p1 - p0) * (dd0 / (dd0 - d1));
+      const bool onPiece = seg ? true : d.distance(hit) <= 1e-4f * (1.0f + glm::length(hit));
+      if (!onPiece) continue;
+      back = p1 + nrm * (margin - d1);
+    } else {
+      const bool in0 = d.contains(p0), in1 = d.contains(p1);
+      if (in1 == in0 || in0 != b.inside) continue;
+      const Vec3 c = d.closestPoint(p1);
+      nrm = d.normal(c) * (b.inside ? -1.0f : 1.0f);
+      back = c + nrm * (1e-5f * (1.0f + glm::length(c)));
+    }
+    Vec3 v(L.v[0][i], L.v[1][i], L.v[2][i]);
+    const float vn = glm::dot(v, nrm);
+    if (vn < 0.0f) v -= nrm * (vn * (1.0f + b.restitution));
+    for (int c = 0; c < 3; ++c) {
+      L.p[c][i] = back[c];
+      L.v[c][i] = v[c];
+    }
+  }
+}
+
+// Runs actions [first, last) of the list over one block, as the plan says.
+void runActions(const std::vector<Action>& acts, const Plan& plan, std::size_t first,
+                std::size_t last, const Lanes& lanes, std::size_t n, cpu::BlockContext ctx) {
+  thread_local cpu::IntegratorScratch scratchStore;
   for (std::size_t k = first; k < last; ++k) {
     ctx.action = std::uint32_t(k);
+    if (plan.gathered[k]) continue;  // evaluated inside its Move
+    if (plan.integrator != Integrator::SemiImplicitEuler && std::holds_alternative<Move>(acts[k])) {
+      cpu::IntegratorScratch& scratch = scratchStore;
+      cpu::integrate(plan.integrator, acts, plan.forcesOf[k], lanes, n, ctx, scratch);
+      if (!plan.guardsOf[k].empty()) {
+        const float* start[3];
+        for (int c = 0; c < 3; ++c) start[c] = plan.start[c] + ctx.base;
+        for (std::uint32_t b : plan.guardsOf[k]) guard(std::get<Bounce>(acts[b]), lanes, start, n);
+      }
+      continue;
+    }
     std::visit([&](const auto& a) { cpu::apply(a, lanes, n, ctx); }, acts[k]);
+  }
+}
+
+// Kills what a step left NaN or infinite (an extreme input, a user callback): counted, never
+// propagated. A float is finite when its exponent bits are not all ones.
+void guardFinite(const Lanes& L, std::size_t n, std::uint32_t* __restrict dead) {
+  for (const float* const* lane : {L.p, L.v}) {
+    if (!lane[0]) continue;
+    for (int c = 0; c < 3; ++c) {
+      const std::uint32_t* __restrict bits = reinterpret_cast<const std::uint32_t*>(lane[c]);
+      for (std::size_t i = 0; i < n; ++i) {
+        const bool bad = (bits[i] & 0x7f800000u) == 0x7f800000u;
+        dead[i] = bad ? kNonFiniteCode : dead[i];
+      }
+    }
   }
 }
 
@@ -57,14 +185,23 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
   const std::size_t blocks = (n + B - 1) / B;
   const std::size_t blocksPerTask = std::max<std::size_t>(1, kParticlesPerTask / B);
   const std::size_t tasks = (blocks + blocksPerTask - 1) / blocksPerTask;
-  const bool kills = g.actions.kills();
-  if (kills) {
-    g.deadIndex.resize(n);
-    g.deadCode.resize(n);
-    g.deadCount.assign(blocks, 0);
-  }
+  g.deadIndex.resize(n);
+  g.deadCode.resize(n);
+  g.deadCount.assign(blocks, 0);
   const Lanes lanes = g.lanePointers();
-  cpu::BlockContext base{float(sp.dt), sp.seed, std::uint32_t(sp.step), g.index << 16, 0, nullptr};
+  Plan plan = makePlan(g, sp, *sp.pool);
+  bool guarded = false;
+  for (const auto& gs : plan.guardsOf) guarded |= !gs.empty();
+  if (guarded) {
+    // Where each particle began the step: the guard compares with it.
+    g.stepStart.resize(3 * n);
+    for (int c = 0; c < 3; ++c) {
+      std::copy_n(lanes.p[c], n, g.stepStart.data() + c * n);
+      plan.start[c] = g.stepStart.data() + c * n;
+    }
+  }
+  const float subDt = float(sp.dt / plan.substeps);
+  cpu::BlockContext base{subDt, sp.seed, std::uint32_t(sp.step), g.index << 16, 0, nullptr};
   base.time = sp.time;
   for (std::size_t k = 0; k < acts.size(); ++k)
     if (std::holds_alternative<Block>(acts[k])) {
@@ -90,54 +227,65 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
     snapshot.size = n;
     base.snapshot = &snapshot;
   }
+  // Sub-step s draws its own random numbers: the substep number goes into the stream.
+  auto atSubstep = [&](cpu::BlockContext c, std::uint32_t s) {
+    c.time = sp.time + double(s) * double(subDt);
+    c.streamBase += s << 8;
+    return c;
+  };
 
   if (sp.fused) {
     sp.pool->parallelFor(tasks, [&](std::size_t t) {
       thread_local std::vector<std::uint32_t> deadStore;
       std::vector<std::uint32_t>& dead = deadStore;  // one TLS lookup, not one per use
-      if (kills && dead.size() < B) dead.resize(B);
+      if (dead.size() < B) dead.resize(B);
       const std::size_t end = std::min(blocks, (t + 1) * blocksPerTask);
       for (std::size_t b = t * blocksPerTask; b < end; ++b) {
         const std::size_t first = b * B, m = std::min(B, n - first);
         cpu::BlockContext ctx = base;
         ctx.base = first;
-        if (kills) {
-          std::fill_n(dead.data(), m, 0u);
-          ctx.dead = dead.data();
-        }
-        runActions(acts, 0, acts.size(), lanes.offset(first), m, ctx);
-        if (kills) g.deadCount[b] = collectDead(g, first, m, dead.data());
+        std::fill_n(dead.data(), m, 0u);
+        ctx.dead = dead.data();
+        const Lanes blockLanes = lanes.offset(first);
+        for (std::uint32_t s = 0; s < plan.substeps; ++s)
+          runActions(acts, plan, 0, acts.size(), blockLanes, m, atSubstep(ctx, s));
+        guardFinite(blockLanes, m, dead.data());
+        g.deadCount[b] = collectDead(g, first, m, dead.data());
       }
     });
   } else {
     // The unfused baseline: one parallel pass over the whole group per action.
-    if (kills) g.deadFlags.assign(n, 0u);
-    for (std::size_t k = 0; k < acts.size(); ++k) {
-      sp.pool->parallelFor(tasks, [&](std::size_t t) {
-        const std::size_t end = std::min(blocks, (t + 1) * blocksPerTask);
-        for (std::size_t b = t * blocksPerTask; b < end; ++b) {
-          const std::size_t first = b * B, m = std::min(B, n - first);
-          cpu::BlockContext ctx = base;
-          ctx.base = first;
-          if (kills) ctx.dead = g.deadFlags.data() + first;
-          runActions(acts, k, k + 1, lanes.offset(first), m, ctx);
-        }
-      });
+    g.deadFlags.assign(n, 0u);
+    for (std::uint32_t s = 0; s < plan.substeps; ++s) {
+      for (std::size_t k = 0; k < acts.size(); ++k) {
+        sp.pool->parallelFor(tasks, [&](std::size_t t) {
+          const std::size_t end = std::min(blocks, (t + 1) * blocksPerTask);
+          for (std::size_t b = t * blocksPerTask; b < end; ++b) {
+            const std::size_t first = b * B, m = std::min(B, n - first);
+            cpu::BlockContext ctx = base;
+            ctx.base = first;
+            ctx.dead = g.deadFlags.data() + first;
+            runActions(acts, plan, k, k + 1, lanes.offset(first), m, atSubstep(ctx, s));
+          }
+        });
+      }
     }
-    if (kills) {
-      sp.pool->parallelFor(blocks, [&](std::size_t b) {
-        const std::size_t first = b * B, m = std::min(B, n - first);
-        g.deadCount[b] = collectDead(g, first, m, g.deadFlags.data() + first);
-      });
-    }
+    sp.pool->parallelFor(blocks, [&](std::size_t b) {
+      const std::size_t first = b * B, m = std::min(B, n - first);
+      guardFinite(lanes.offset(first), m, g.deadFlags.data() + first);
+      g.deadCount[b] = collectDead(g, first, m, g.deadFlags.data() + first);
+    });
   }
 
-  if (!kills) return;
   for (std::size_t b = 0; b < blocks; ++b) {
     const std::uint32_t* idx = g.deadIndex.data() + b * B;
     const std::uint8_t* code = g.deadCode.data() + b * B;
     for (std::uint32_t j = 0; j < g.deadCount[b]; ++j) {
       g.holes.push_back(idx[j]);
+      if (code[j] == kNonFiniteCode) {
+        ++g.stats.killedNonFinite;
+        continue;
+      }
       const std::size_t k = code[j] - 1u;
       ++g.stats.killedByAction[k];
       if (std::holds_alternative<KillOld>(acts[k]))

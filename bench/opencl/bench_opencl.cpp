@@ -1,0 +1,300 @@
+// The OpenCL backend on PoCL against the native CPU backend, measured in one run:
+//   - the fused update pass and the whole fountain step at 1M and 4M particles,
+//   - time per step of a small (1k particle) fountain: the launch overhead,
+//   - kernel compile time, cold and cached (in memory, and on disk),
+//   - the machine's in-place read-modify-write bandwidth: the ceiling of an in-place update.
+//
+//   build/release/bench/bench_opencl --benchmark_repetitions=3
+//   --benchmark_report_aggregates_only=true
+//
+// OpenCL steps are queued without waiting; every timed iteration runs a batch of steps and
+// then waits for the device (detail::ocl::finishGroup), so queued work is always counted.
+#include <benchmark/benchmark.h>
+#include <sys/mman.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "builtin.hpp"
+#include "flurry/flurry.hpp"
+#include "flurry/opencl.hpp"
+#include "opencl/backend.hpp"
+#include "opencl/runtime.hpp"
+
+using namespace flurry;
+
+namespace {
+
+unsigned threads() {
+  return std::max(1u, std::thread::hardware_concurrency());
+}
+
+// Bytes the fountain's update reads and writes per particle-step: position and velocity read
+// and written (24 + 24), age read and written (4 + 4), lifetime read (4).
+constexpr double kUpdateBytes = 60.0;
+constexpr int kLanes = 9;  // position 3, velocity 3, age, lifetime, id
+
+bool haveDevice() {
+  try {
+    return !openclDevices().empty();
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+ActionList fountainActions() {
+  return {Gravity{Vec3(0.0f, -9.81f, 0.0f)},
+          Bounce{Domain::plane(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f)), 0.4f, 0.1f, 0.0f}, Move{},
+          KillOld{}};
+}
+
+ContextOptions options(Backend b) {
+  ContextOptions o;
+  o.threads = threads();
+  o.backend = b;
+  return o;
+}
+
+void finish(Group& g) {
+  detail::ocl::finishGroup(g.impl());
+}
+
+// Runs `steps` steps per timed iteration, then waits for the device.
+void timedSteps(benchmark::State& state, Context& ctx, Group& g, int steps) {
+  for (auto _ : state) {
+    for (int s = 0; s < steps; ++s) ctx.step();
+    finish(g);
+  }
+  state.counters["us/step"] =
+      benchmark::Counter(double(state.iterations()) * steps * 1e-6,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+// n immortal fountain particles: the update pass alone, no deaths, no births.
+void UpdatePass(benchmark::State& state, Backend backend) {
+  if (backend == Backend::OpenCL && !haveDevice()) return state.SkipWithError("no OpenCL device");
+  const auto n = std::size_t(state.range(0));
+  Context ctx(options(backend));
+  Group& g = ctx.createGroup("fountain", n);
+  Emitter e;
+  e.shape = Domain::disc(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f), 0.1f);
+  ParticleType t;
+  t.velocity = Domain::cone(Vec3(0.0f), Vec3(0.0f, 8.0f, 0.0f), 1.5f);
+  t.lifetime = 1e30f;
+  e.types = {t};
+  e.bursts = {{0.0, std::uint32_t(n), 0.0, 1}};
+  g.addEmitter(e);
+  g.setActions(fountainActions());
+  ctx.run(4);  // emits all n, builds the program, and launches every kernel once (PoCL
+  finish(g);   // specialises a kernel for its local size at its first launch)
+  const int steps = 10;
+  timedSteps(state, ctx, g, steps);
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * steps * std::int64_t(n));
+  state.SetBytesProcessed(
+      std::int64_t(double(state.iterations()) * steps * double(n) * kUpdateBytes));
+}
+
+// The whole step at steady state: about n alive, n/10 born and dying per step.
+void FountainStep(benchmark::State& state, Backend backend) {
+  if (backend == Backend::OpenCL && !haveDevice()) return state.SkipWithError("no OpenCL device");
+  const auto n = std::size_t(state.range(0));
+  Context ctx(options(backend));
+  Group& g = samples::buildFountain(ctx, n + n / 2, 3.0 * double(n), 1.0f / 3.0f);
+  g.setActions(fountainActions());
+  ctx.run(30);
+  const double live = double(g.size());
+  const int steps = 10;
+  timedSteps(state, ctx, g, steps);
+  state.SetItemsProcessed(std::int64_t(double(state.iterations()) * steps * live));
+  state.SetBytesProcessed(std::int64_t(double(state.iterations()) * steps * live * kUpdateBytes));
+  state.counters["live"] = live;
+}
+
+// A small fountain (~1k alive): what a step costs when there is almost nothing to compute.
+void SmallStep(benchmark::State& state, Backend backend) {
+  if (backend == Backend::OpenCL && !haveDevice()) return state.SkipWithError("no OpenCL device");
+  Context ctx(options(backend));
+  Group& g = samples::buildFountain(ctx, 4096, 1000.0, 1.0f);
+  g.setActions(fountainActions());
+  ctx.run(60);
+  state.counters["live"] = double(g.size());
+  timedSteps(state, ctx, g, 200);
+}
+
+// The ceiling: a[i] = a[i]*s + c over arrays of the same total size as the group's lanes,
+// allocated the same way (huge pages), on the same number of threads.
+void ReadModifyWrite(benchmark::State& state) {
+  const auto n = std::size_t(state.range(0));
+  std::vector<float*> arrays;
+  const std::size_t bytes = (n * 4 + (2u << 20) - 1) / (2u << 20) * (2u << 20);
+  for (int k = 0; k < kLanes; ++k) {
+    auto* a = static_cast<float*>(std::aligned_alloc(2u << 20, bytes));
+    madvise(a, bytes, MADV_HUGEPAGE);
+    for (std::size_t i = 0; i < n; ++i) a[i] = float(i & 1023);
+    arrays.push_back(a);
+  }
+  const unsigned t = threads();
+  for (auto _ : state) {
+    std::vector<std::thread> pool;
+    for (unsigned w = 0; w < t; ++w)
+      pool.emplace_back([&, w] {
+        const std::size_t lo = n * w / t, hi = n * (w + 1) / t;
+        for (float* a : arrays) {
+          float* __restrict p = a;
+          for (std::size_t i = lo; i < hi; ++i) p[i] = p[i] * 0.999f + 0.001f;
+        }
+      });
+    for (auto& th : pool) th.join();
+    benchmark::ClobberMemory();
+  }
+  state.SetBytesProcessed(std::int64_t(double(state.iterations()) * double(n) * kLanes * 8.0));
+  for (float* a : arrays) std::free(a);
+}
+
+// Seconds from a new Context to its first step done (the program build dominates).
+double firstStepSeconds(float gravity) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Context ctx(options(Backend::OpenCL));
+  Group& g = ctx.createGroup("compile", 1024);
+  g.setActions({Gravity{Vec3(0.0f, gravity, 0.0f)}, Damping{Vec3(0.25f)}, Move{}, KillOld{}});
+  Particle p;
+  g.add(p);
+  ctx.step();
+  finish(g);
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+struct CompileTimes {
+  double cold = 0, memory = 0, disk = 0;
+  bool measured = false;
+} gCompile;
+
+void measureCompileTimes() {
+  if (!haveDevice()) return;
+  // Cold: no Flurry disk cache, and PoCL's own kernel cache off (set in main before PoCL
+  // loads), with the program not yet in memory.
+  const auto dir = std::filesystem::temp_directory_path() / "flurry-bench-cl-cache";
+  std::filesystem::remove_all(dir);
+  ::setenv("FLURRY_OPENCL_CACHE", dir.c_str(), 1);
+  detail::ocl::Runtime::clearMemoryCache();
+  gCompile.cold = firstStepSeconds(-9.81f);
+  gCompile.memory = firstStepSeconds(-1.0f);  // other numbers, same program: in memory
+  detail::ocl::Runtime::clearMemoryCache();
+  gCompile.disk = firstStepSeconds(-2.0f);  // a binary from Flurry's disk cache
+  ::setenv("FLURRY_OPENCL_CACHE", "off", 1);
+  std::filesystem::remove_all(dir);
+  gCompile.measured = true;
+}
+
+// Prints the comparisons between the medians (or single runs) of this process's benchmarks.
+class SummaryReporter : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    ConsoleReporter::ReportRuns(runs);
+    for (const Run& r : runs) {
+      const bool median = r.run_type == Run::RT_Aggregate && r.aggregate_name == "median";
+      if (r.run_type == Run::RT_Iteration && r.repetitions > 1) continue;
+      if (r.run_type == Run::RT_Aggregate && !median) continue;
+      const std::string name = r.run_name.function_name + "/" + r.run_name.args;
+      auto get = [&](const char* c) {
+        auto it = r.counters.find(c);
+        return it == r.counters.end() ? 0.0 : double(it->second);
+      };
+      bytes_[name] = get("bytes_per_second");
+      items_[name] = get("items_per_second");
+      usPerStep_[name] = get("us/step");
+    }
+  }
+  void Finalize() override {
+    ConsoleReporter::Finalize();
+    std::printf(
+        "\nSummary (%u threads; OpenCL = PoCL on this CPU; GB/s count the bytes of the "
+        "attributes read and written):\n",
+        threads());
+    for (const char* n : {"1048576", "4194304"}) {
+      const std::string N = n;
+      const double rmw = bytes_["ReadModifyWrite/" + N];
+      if (rmw <= 0) continue;
+      std::printf("  %s particles: read-modify-write %.1f GB/s\n", n, rmw / 1e9);
+      for (const char* b : {"cpu", "opencl"}) {
+        const double upd = bytes_[std::string("UpdatePass/") + b + "/" + N];
+        const double step = items_[std::string("FountainStep/") + b + "/" + N];
+        if (upd > 0)
+          std::printf(
+              "    %-6s update %5.1f GB/s = %3.0f %% of it, %.2f G particle-steps/s; "
+              "whole step %.2f G particle-steps/s\n",
+              b, upd / 1e9, 100 * upd / rmw, items_[std::string("UpdatePass/") + b + "/" + N] / 1e9,
+              step / 1e9);
+      }
+      const double c = items_["UpdatePass/cpu/" + N], o = items_["UpdatePass/opencl/" + N];
+      const double cs = items_["FountainStep/cpu/" + N], os = items_["FountainStep/opencl/" + N];
+      if (c > 0 && o > 0)
+        std::printf("    cpu / opencl: update %.2fx, whole step %.2fx (aim: <= 1.25x)\n", c / o,
+                    os > 0 ? cs / os : 0.0);
+    }
+    const double sc = usPerStep_["SmallStep/cpu/"], so = usPerStep_["SmallStep/opencl/"];
+    if (sc > 0 || so > 0)
+      std::printf(
+          "  small group (~1k particles): cpu %.1f us/step, opencl %.1f us/step "
+          "(aim: opencl <= 20)\n",
+          sc, so);
+    if (gCompile.measured)
+      std::printf(
+          "  kernel program build, first step of a new Context: cold %.0f ms, cached in "
+          "memory %.1f ms, from the disk cache %.0f ms\n",
+          gCompile.cold * 1e3, gCompile.memory * 1e3, gCompile.disk * 1e3);
+  }
+
+ private:
+  std::map<std::string, double> bytes_, items_, usPerStep_;
+};
+
+}  // namespace
+
+BENCHMARK(ReadModifyWrite)
+    ->Arg(1 << 20)
+    ->Arg(1 << 22)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(UpdatePass, cpu, Backend::Cpu)
+    ->Arg(1 << 20)
+    ->Arg(1 << 22)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(UpdatePass, opencl, Backend::OpenCL)
+    ->Arg(1 << 20)
+    ->Arg(1 << 22)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(FountainStep, cpu, Backend::Cpu)
+    ->Arg(1 << 20)
+    ->Arg(1 << 22)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(FountainStep, opencl, Backend::OpenCL)
+    ->Arg(1 << 20)
+    ->Arg(1 << 22)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(SmallStep, cpu, Backend::Cpu)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(SmallStep, opencl, Backend::OpenCL)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+int main(int argc, char** argv) {
+  // Cold compile times mean PoCL's own kernel cache off too; it is read when PoCL loads.
+  ::setenv("POCL_KERNEL_CACHE", "0", 1);
+  ::setenv("FLURRY_OPENCL_CACHE", "off", 1);
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  measureCompileTimes();
+  SummaryReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  benchmark::Shutdown();
+  return 0;
+}

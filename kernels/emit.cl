@@ -1,0 +1,131 @@
+/* The tail of a step: close the holes no newborn fills, then write the newborns
+ * (sdk/src/emission.cpp, draw for draw). Needs, from the generated prologue:
+ *   FL_LANE_PARAMS / FL_LANE_ARGS  the stored lanes as parameters (l_px, l_vx, ...) / names
+ *   FL_COPY_LANES(dst, src)        copies every stored lane's element
+ *   FL_HAS_<ATTRIBUTE>             for each stored attribute
+ * and after this file, the generated fl_emit(): per emitter and particle type, a call of
+ * fl_newborn with the domain kinds and fuzzy modes as literals, so that each newborn's
+ * draws compile to straight-line code. */
+
+#define FL_EMISSION_STREAM 0xFFFF0000u /* flurry::stream::kEmission */
+
+/* mode (a literal in generated code): 0 constant, 1 uniform, 2 normal. */
+FL_INLINE float fl_fuzzy(__global const FlFuzzy* f, uint mode, FlRandom* rng) {
+  if (mode == 0) return f->center;
+  if (mode == 2) {
+    const float ua = fl_uniform(rng), ub = fl_uniform(rng);
+    return f->center + f->spread * fl_normal_from(ua, ub);
+  }
+  return f->center + f->spread * (2.0f * fl_uniform(rng) - 1.0f);
+}
+
+FL_INLINE float fl_fuzzy_nonneg(__global const FlFuzzy* f, uint mode, FlRandom* rng) {
+  const float x = fl_fuzzy(f, mode, rng);
+  return x < 0.0f ? 0.0f : x; /* std::max(x, 0.0f) */
+}
+
+/* Emitter::positionAt. */
+FL_INLINE float3 fl_emitter_at(__global const FlEmitter* e, __global const FlKeyframe* keys,
+                               fl_real t) {
+  if (e->pathCount == 0)
+    return fl_v3(e->position) + fl_v3(e->velocity) * (float)(t - fl_real_from_bits(e->start));
+  __global const FlKeyframe* k = keys + e->pathFirst;
+  const uint last = e->pathCount - 1;
+  if (t <= fl_real_from_bits(k[0].time)) return fl_v3(k[0].position);
+  if (t >= fl_real_from_bits(k[last].time)) return fl_v3(k[last].position);
+  uint b = 1; /* the first key later than t */
+  while (!(t < fl_real_from_bits(k[b].time))) ++b;
+  const fl_real ta = fl_real_from_bits(k[b - 1].time), tb = fl_real_from_bits(k[b].time);
+  const fl_real w = (t - ta) / (tb - ta);
+  const float3 a = fl_v3(k[b - 1].position);
+  return a + (fl_v3(k[b].position) - a) * (float)w;
+}
+
+
+/* emission.cpp chooseType: the first draw of an emitter with several types. */
+FL_INLINE uint fl_choose_type(__global const FlEmitter* em, __global const FlParticleType* types,
+                              FlRandom* rng) {
+  float u = fl_uniform(rng) * em->totalWeight;
+  for (uint j = 0; j < em->typeCount; ++j) {
+    const float w = types[em->typeFirst + j].weight;
+    if (u < w) return j;
+    u -= w;
+  }
+  return em->typeCount - 1;
+}
+
+/* One newborn of type `type`: the draws in emission.cpp's order, skipping what is not
+ * stored. The kinds and modes are literals. */
+FL_INLINE void fl_newborn(FL_LANE_PARAMS, uint slot, uint id, float age, float3 at, int oneType,
+                          __global const FlEmitter* em, __global const FlParticleType* type,
+                          FlRandom* rng, uint shapeKind, uint velKind, uint colorKind,
+                          uint upKind, uint rotKind, uint lifeMode, uint alphaMode,
+                          uint sizeMode, uint massMode, uint chargeMode) {
+  const float3 vel = fl_sample(&type->velocity, velKind, rng);
+  /* Born where the emitter was at its birth time, carried on for the rest of the step. The
+   * CPU adds these in a different order for one type (emitBatch) and several (emitOneByOne). */
+  const float3 shape = fl_sample(&em->shape, shapeKind, rng);
+  const float3 pos = oneType ? shape + (at + vel * age) : shape + at + vel * age;
+  l_px[slot] = pos.x;
+  l_py[slot] = pos.y;
+  l_pz[slot] = pos.z;
+#ifdef FL_HAS_VELOCITY
+  l_vx[slot] = vel.x;
+  l_vy[slot] = vel.y;
+  l_vz[slot] = vel.z;
+#endif
+#ifdef FL_HAS_PREV_POSITION
+  l_prevx[slot] = pos.x;
+  l_prevy[slot] = pos.y;
+  l_prevz[slot] = pos.z;
+#endif
+#ifdef FL_HAS_LIFETIME
+  l_life[slot] = fl_fuzzy_nonneg(&type->lifetime, lifeMode, rng);
+#endif
+#ifdef FL_HAS_COLOR
+  {
+    const float3 rgb = fl_sample(&type->color, colorKind, rng);
+    l_r[slot] = rgb.x;
+    l_g[slot] = rgb.y;
+    l_b[slot] = rgb.z;
+    l_a[slot] = fl_fuzzy(&type->alpha, alphaMode, rng);
+  }
+#endif
+#ifdef FL_HAS_SIZE
+  l_size[slot] = fl_fuzzy_nonneg(&type->size, sizeMode, rng);
+#endif
+#ifdef FL_HAS_MASS
+  l_mass[slot] = fl_fuzzy(&type->mass, massMode, rng);
+#endif
+#ifdef FL_HAS_CHARGE
+  l_charge[slot] = fl_fuzzy(&type->charge, chargeMode, rng);
+#endif
+#ifdef FL_HAS_UP
+  {
+    const float3 up = fl_sample(&type->up, upKind, rng);
+    l_upx[slot] = up.x;
+    l_upy[slot] = up.y;
+    l_upz[slot] = up.z;
+  }
+#endif
+#ifdef FL_HAS_ROT_VELOCITY
+  {
+    const float3 w = fl_sample(&type->rotVelocity, rotKind, rng);
+    l_rotx[slot] = w.x;
+    l_roty[slot] = w.y;
+    l_rotz[slot] = w.z;
+  }
+#endif
+#ifdef FL_HAS_AGE
+  l_age[slot] = age;
+#endif
+  l_id[slot] = id;
+#ifdef FL_HAS_VISIBLE
+  l_vis[slot] = 1u;
+#endif
+#ifdef FL_HAS_USER_DATA
+  l_user[slot] = 0.0f;
+#endif
+  (void)colorKind, (void)upKind, (void)rotKind, (void)lifeMode, (void)alphaMode, (void)sizeMode;
+  (void)massMode, (void)chargeMode;
+}

@@ -1,0 +1,122 @@
+/* The host <-> kernel parameter structs of the OpenCL backend, defined once and compiled by
+ * both sides: the C++ host (sdk/src/opencl/, which static_asserts the layout) and OpenCL C
+ * (the backend prepends this file to every program it builds).
+ *
+ * Only 4- and 8-byte scalars and arrays of them, every struct a multiple of 8 bytes with
+ * its 8-byte fields 8-aligned, so the layout is the same for any host and device compiler.
+ * Doubles travel as their bit patterns (ulong): a device without cl_khr_fp64 can still read
+ * the struct (and converts them to float, losing the exact parity with the CPU backend). */
+#ifndef FLURRY_KERNELS_PARAMS_H
+#define FLURRY_KERNELS_PARAMS_H
+
+#ifdef __OPENCL_VERSION__
+typedef uint fl_u32;
+typedef ulong fl_u64;
+#else
+#include <cstdint>
+namespace flurry::detail::cl {
+typedef std::uint32_t fl_u32;
+typedef std::uint64_t fl_u64;
+#endif
+
+/* Domain kinds, in the order of flurry::Domain::Shape's alternatives. */
+#define FL_DOMAIN_POINT 0
+#define FL_DOMAIN_LINE 1
+#define FL_DOMAIN_TRIANGLE 2
+#define FL_DOMAIN_PLANE 3
+#define FL_DOMAIN_RECTANGLE 4
+#define FL_DOMAIN_DISC 5
+#define FL_DOMAIN_BOX 6
+#define FL_DOMAIN_SPHERE 7
+#define FL_DOMAIN_CYLINDER 8
+#define FL_DOMAIN_CONE 9
+#define FL_DOMAIN_BLOB 10
+
+/* A domain to sample from or to test against. v[] by kind (vectors are 3 floats):
+ *  point p | line p0 p1 | triangle p0 p1 p2 | plane point normal | rectangle origin u v
+ *  disc center e1 e2 outer inner | box min max | sphere center outer inner
+ *  cylinder p0 axis e1 e2 outer inner | cone apex axis e1 e2 outer inner | blob center stddev
+ * (e1, e2: the basis around the normal or axis, computed on the host exactly as the CPU's
+ * sampler does, so both draw the same points.) */
+typedef struct FlDomain {
+  float v[16];
+  fl_u32 kind;
+  fl_u32 pad;
+} FlDomain;
+
+/* A fuzzy scalar: center +- spread, uniform or normal. */
+typedef struct FlFuzzy {
+  float center;
+  float spread;
+  fl_u32 normal;
+  fl_u32 pad;
+} FlFuzzy;
+
+typedef struct FlParticleType {
+  FlDomain velocity, color, up, rotVelocity;
+  FlFuzzy alpha, size, mass, lifetime, charge;
+  float weight;
+  fl_u32 pad;
+} FlParticleType;
+
+typedef struct FlEmitter {
+  FlDomain shape;
+  fl_u64 start;    /* double bits: the emitter's start time */
+  fl_u64 rate;     /* double bits: particles per second */
+  float position[4];
+  float velocity[4];
+  fl_u32 pathFirst, pathCount; /* keyframes [pathFirst, pathFirst + pathCount) */
+  fl_u32 typeFirst, typeCount; /* types [typeFirst, typeFirst + typeCount) */
+  float totalWeight;           /* the types' weights summed in order, as the CPU does */
+  fl_u32 pad;
+} FlEmitter;
+
+typedef struct FlKeyframe {
+  fl_u64 time; /* double bits */
+  float position[4];
+} FlKeyframe;
+
+/* One run of births of one emitter this step: by rate, or one burst. */
+typedef struct FlBirthRun {
+  fl_u64 first;     /* rate: index of the run's first birth since the emitter's start */
+  fl_u64 burstTime; /* double bits */
+  fl_u64 start;     /* index of the run's first newborn among this step's births */
+  fl_u32 emitter;
+  fl_u32 burst;
+} FlBirthRun;
+
+/* One action's constants, computed on the host as the CPU backend computes them (so the
+ * products with dt round the same way). f[] by action:
+ *  Gravity: a*dt | Damping: exp(-k*dt) | Move, KillOld: -
+ *  Bounce: [0..2] plane point, [3..5] unit normal, [6] restitution, [7] 1 - friction,
+ *    [8] cutoff^2, [9] scale (|P.x|+|P.y|+|P.z|, sphere |C|_1 + R), then by surface:
+ *    rectangle/triangle [10..12] dual u, [13..15] dual v | disc [10] outer^2, [11] inner^2
+ *    sphere [10] R, [11] R^2, [12] 1/R (center in [0..2])
+ *  Sink: [0..15] the region as FlDomain.v, u[0] kind, [16] passThrough */
+typedef struct FlActionParams {
+  float f[20];
+  fl_u32 u[4];
+} FlActionParams;
+
+/* The group's device-side state: one small buffer of uints, read back asynchronously after
+ * every step (the host never waits for it, except when someone reads the particles). */
+#define FL_STATE_SIZE 0     /* live particles after the step */
+#define FL_STATE_NEXT_ID 1  /* the next particle id */
+#define FL_STATE_DROPPED 2  /* births dropped at capacity, cumulative (wraps; host sums deltas) */
+#define FL_STATE_OLD_SIZE 3 /* this step: live before it */
+#define FL_STATE_DEAD 4     /* this step: died */
+#define FL_STATE_BORN 5     /* this step: born */
+#define FL_STATE_LOW_HOLES 6 /* this step: holes below the new size */
+#define FL_STATE_FIRST_ID 7 /* this step: the first newborn's id */
+#define FL_STATE_KILLS 8    /* then one cumulative (wrapping) kill counter per action */
+#define FL_STATE_HEADER 8
+
+/* Particles per tile of the death count and the hole list (a multiple of 16: counted as
+ * uint4 words). */
+#define FL_TILE 1024
+
+#ifndef __OPENCL_VERSION__
+}  // namespace flurry::detail::cl
+#endif
+
+#endif /* FLURRY_KERNELS_PARAMS_H */

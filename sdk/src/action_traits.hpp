@@ -1,0 +1,16 @@
+// What the backends need to know about actions beyond running them.
+#pragma once
+
+#include "flurry/actions.hpp"
+
+namespace flurry::detail {
+
+/// A force an integrator can evaluate as an acceleration a(p, v, t) (see Integrator).
+bool isForce(const Action& a);
+/// A force with a closed-form step (constant acceleration, linear drag).
+bool hasClosedForm(const Action& a);
+
+/// The kill code that marks particles whose position or velocity became NaN or infinite.
+inline constexpr std::uint32_t kNonFiniteCode = 255;
+
+}  // namespace flurry::detail

@@ -1,0 +1,250 @@
+// Integrators for Move: the forces before a Move, evaluated together as an acceleration
+// a(p, v, t), integrated by explicit Euler, velocity Verlet, RK4, or in closed form.
+#pragma once
+
+#include <cmath>
+#include <vector>
+
+#include "actions_more.hpp"
+
+namespace flurry::detail::cpu {
+
+/// Arrays an acceleration is evaluated on: positions and velocities of a block (or of an
+/// integrator's intermediate stage), and where it accumulates.
+struct Stage {
+  const float* p[3];
+  const float* v[3];
+  float* a[3];
+};
+
+namespace {
+inline Vec3 get(const float* const* a, std::size_t i) { return Vec3(a[0][i], a[1][i], a[2][i]); }
+inline void add(float* const* a, std::size_t i, Vec3 d) {
+  a[0][i] += d.x;
+  a[1][i] += d.y;
+  a[2][i] += d.z;
+}
+}  // namespace
+
+// Adds one force's acceleration at (p, v, t). `L` gives the per-particle constants (charge,
+// mass, id); `c` the step (its random numbers are the same in every stage of a step).
+inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std::size_t n,
+                       const BlockContext& c, double t) {
+  std::visit(
+      [&](const auto& a) {
+        using A = std::decay_t<decltype(a)>;
+        for (std::size_t i = 0; i < n; ++i) {
+          const Vec3 p = get(s.p, i), v = get(s.v, i);
+          Vec3 acc(0.0f);
+          if constexpr (std::is_same_v<A, Gravity>) {
+            acc = a.acceleration * falloffWeight(a.falloff, p);
+          } else if constexpr (std::is_same_v<A, Damping>) {
+            acc = -a.rate * v * falloffWeight(a.falloff, p);
+          } else if constexpr (std::is_same_v<A, OrbitPoint>) {
+            acc = softPull(a.center - p, a.magnitude, a.epsilon, a.maxRadius);
+          } else if constexpr (std::is_same_v<A, OrbitLine>) {
+            const Vec3 axis = glm::normalize(a.axis), w = p - a.point;
+            acc = softPull(-(w - axis * glm::dot(w, axis)), a.magnitude, a.epsilon, a.maxRadius);
+          } else if constexpr (std::is_same_v<A, Gravitate>) {
+            const Snapshot& sn = *c.snapshot;
+            for (std::size_t j = 0; j < sn.size; ++j)
+              if (j != c.base + i)
+                acc += softPull(Vec3(sn.p[0][j], sn.p[1][j], sn.p[2][j]) - p, a.magnitude,
+                                a.epsilon, a.maxRadius);
+          } else if constexpr (std::is_same_v<A, Follow>) {
+            const Snapshot& sn = *c.snapshot;
+            const std::size_t next = c.base + i + 1;
+            if (next < sn.size)
+              acc = softPull(Vec3(sn.p[0][next], sn.p[1][next], sn.p[2][next]) - p, a.magnitude,
+                             a.epsilon, a.maxRadius);
+          } else if constexpr (std::is_same_v<A, Vortex>) {
+            const Vec3 axis = glm::normalize(a.axis), w = p - a.center;
+            const Vec3 radial = w - axis * glm::dot(w, axis);
+            const float r = glm::length(radial);
+            if (r <= a.maxRadius) {
+              const Vec3 rhat = r > 0.0f ? radial / r : Vec3(0.0f);
+              const float around = r < a.coreRadius
+                                       ? a.aroundSpeed * r / a.coreRadius
+                                       : a.aroundSpeed * std::pow(a.coreRadius / r, a.tightness);
+              const Vec3 u = glm::cross(axis, rhat) * around - rhat * a.inSpeed + axis * a.upSpeed;
+              acc = (u - v) * a.responsiveness;
+            }
+          } else if constexpr (std::is_same_v<A, Jet>) {
+            const Vec3 d = p - a.center;
+            if (glm::dot(d, d) <= a.radius * a.radius) {
+              Random rng = actionRandom(c, L, i);
+              acc = a.acceleration.sample(rng);
+            }
+          } else if constexpr (std::is_same_v<A, Explosion>) {
+            if (t >= a.time) {
+              const Vec3 d = p - a.center;
+              const float r = glm::length(d);
+              if (r > 0.0f) {
+                const float delta = r - a.speed * float(t - a.time);
+                acc = d * (a.magnitude * std::exp(-delta * delta / (2 * a.stddev * a.stddev)) /
+                           (r * r + a.epsilon) / r);
+              }
+            }
+          } else if constexpr (std::is_same_v<A, RandomAccel>) {
+            Random rng = actionRandom(c, L, i);
+            acc = a.acceleration.sample(rng) * falloffWeight(a.falloff, p);
+          } else if constexpr (std::is_same_v<A, Turbulence>) {
+            acc = curlNoise((p - a.drift * float(t)) * a.frequency, a.octaves) * a.amplitude *
+                  falloffWeight(a.falloff, p);
+          } else if constexpr (std::is_same_v<A, ElectricField>) {
+            acc = a.field * chargePerMass(L, i) * falloffWeight(a.falloff, p);
+          } else if constexpr (std::is_same_v<A, MagneticField>) {
+            acc = glm::cross(v, a.field) * chargePerMass(L, i);
+          } else if constexpr (std::is_same_v<A, SampledField>) {
+            const Vec3 u = a.field->sample(p) * a.strength;
+            acc = a.mode == SampledField::Mode::Acceleration ? u : (u - v) * a.responsiveness;
+          } else if constexpr (std::is_same_v<A, TargetVelocity>) {
+            acc = (a.velocity - v) * a.rate;
+          }
+          add(s.a, i, acc);
+        }
+      },
+      action);
+}
+
+/// Scratch for one block's integration (per thread).
+struct IntegratorScratch {
+  std::vector<float> data;
+  float* take(std::size_t n) {  // call reset() first
+    float* p = data.data() + used;
+    used += n;
+    return p;
+  }
+  void reset(std::size_t n, std::size_t arrays) {
+    if (data.size() < n * arrays) data.resize(n * arrays);
+    used = 0;
+  }
+  std::size_t used = 0;
+};
+
+/// Move with an integrator other than semi-implicit Euler: `forces` are the indices of the
+/// force actions gathered for this Move.
+inline void integrate(Integrator integrator, const std::vector<Action>& acts,
+                      const std::vector<std::uint32_t>& forces, const Lanes& L, std::size_t n,
+                      const BlockContext& c, IntegratorScratch& scratch) {
+  const float dt = c.dt;
+  const double t = c.time;
+  scratch.reset(n, 24);
+  auto arrays3 = [&](float** out) {
+    for (int d = 0; d < 3; ++d) out[d] = scratch.take(n);
+  };
+  auto evaluate = [&](const float* const* p, const float* const* v, float* const* a, double at) {
+    for (int d = 0; d < 3; ++d) std::fill_n(a[d], n, 0.0f);
+    const Stage s{{p[0], p[1], p[2]}, {v[0], v[1], v[2]}, {a[0], a[1], a[2]}};
+    for (std::uint32_t k : forces) {
+      BlockContext ck = c;
+      ck.action = k;
+      accumulate(acts[k], s, L, n, ck, at);
+    }
+  };
+  if (L.prev[0]) copyLoop(L.prev[0], L.prev[1], L.prev[2], L.p[0], L.p[1], L.p[2], n);
+
+  float *a0[3], *a1[3];
+  arrays3(a0);
+  switch (integrator) {
+    case Integrator::ExplicitEuler: {
+      evaluate(L.p, L.v, a0, t);
+      for (int d = 0; d < 3; ++d)
+        for (std::size_t i = 0; i < n; ++i) {
+          L.p[d][i] += L.v[d][i] * dt;  // with the velocity at the start of the step
+          L.v[d][i] += a0[d][i] * dt;
+        }
+      break;
+    }
+    case Integrator::VelocityVerlet: {
+      arrays3(a1);
+      float *p1[3], *v1[3];
+      arrays3(p1);
+      arrays3(v1);
+      evaluate(L.p, L.v, a0, t);
+      for (int d = 0; d < 3; ++d)
+        for (std::size_t i = 0; i < n; ++i) {
+          p1[d][i] = L.p[d][i] + L.v[d][i] * dt + 0.5f * a0[d][i] * dt * dt;
+          v1[d][i] = L.v[d][i] + a0[d][i] * dt;  // predicted, for velocity-dependent forces
+        }
+      evaluate(p1, v1, a1, t + dt);
+      for (int d = 0; d < 3; ++d)
+        for (std::size_t i = 0; i < n; ++i) {
+          L.p[d][i] = p1[d][i];
+          L.v[d][i] += 0.5f * (a0[d][i] + a1[d][i]) * dt;
+        }
+      break;
+    }
+    case Integrator::RK4: {
+      // Classic RK4 on (p, v): k_p = v, k_v = a(p, v, t).
+      float *ps[3], *vs[3], *sp[3], *sv[3];
+      arrays3(a1);  // stage acceleration
+      arrays3(ps);
+      arrays3(vs);
+      arrays3(sp);  // weighted sums
+      arrays3(sv);
+      for (int d = 0; d < 3; ++d) {
+        std::fill_n(sp[d], n, 0.0f);
+        std::fill_n(sv[d], n, 0.0f);
+        std::copy_n(L.p[d], n, ps[d]);
+        std::copy_n(L.v[d], n, vs[d]);
+      }
+      const float h[4] = {0.0f, 0.5f, 0.5f, 1.0f}, w[4] = {1.0f, 2.0f, 2.0f, 1.0f};
+      for (int k = 0; k < 4; ++k) {
+        evaluate(ps, vs, a1, t + h[k] * dt);
+        const float next = k < 3 ? h[k + 1] * dt : 0.0f;
+        for (int d = 0; d < 3; ++d)
+          for (std::size_t i = 0; i < n; ++i) {
+            const float kp = vs[d][i], kv = a1[d][i];
+            sp[d][i] += w[k] * kp;
+            sv[d][i] += w[k] * kv;
+            ps[d][i] = L.p[d][i] + kp * next;  // the next stage's state
+            vs[d][i] = L.v[d][i] + kv * next;
+          }
+      }
+      for (int d = 0; d < 3; ++d)
+        for (std::size_t i = 0; i < n; ++i) {
+          L.p[d][i] += sp[d][i] * (dt / 6.0f);
+          L.v[d][i] += sv[d][i] * (dt / 6.0f);
+        }
+      break;
+    }
+    case Integrator::Exact: {
+      // Constant acceleration g (Gravity + (q/m)E) with per-axis linear drag k: exact.
+      arrays3(a1);  // drag rates
+      const Stage none{{L.p[0], L.p[1], L.p[2]}, {L.v[0], L.v[1], L.v[2]}, {a0[0], a0[1], a0[2]}};
+      for (int d = 0; d < 3; ++d) {
+        std::fill_n(a0[d], n, 0.0f);
+        std::fill_n(a1[d], n, 0.0f);
+      }
+      for (std::uint32_t k : forces) {
+        if (const auto* dmp = std::get_if<Damping>(&acts[k])) {
+          for (int d = 0; d < 3; ++d)
+            for (std::size_t i = 0; i < n; ++i) a1[d][i] += dmp->rate[d];
+        } else {
+          BlockContext ck = c;
+          ck.action = k;
+          accumulate(acts[k], none, L, n, ck, t);
+        }
+      }
+      for (int d = 0; d < 3; ++d)
+        for (std::size_t i = 0; i < n; ++i) {
+          const float g = a0[d][i], k = a1[d][i], v0 = L.v[d][i];
+          if (k > 0.0f) {
+            const float e = std::exp(-k * dt), term = g / k;
+            L.p[d][i] += term * dt + (v0 - term) * (1.0f - e) / k;
+            L.v[d][i] = term + (v0 - term) * e;
+          } else {
+            L.p[d][i] += v0 * dt + 0.5f * g * dt * dt;
+            L.v[d][i] = v0 + g * dt;
+          }
+        }
+      break;
+    }
+    case Integrator::SemiImplicitEuler:
+      break;  // not used: the forces ran as their own updates
+  }
+  if (L.age) ageLoop(L.age, n, dt);
+}
+
+}  // namespace flurry::detail::cpu

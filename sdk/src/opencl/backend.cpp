@@ -1,0 +1,662 @@
+// The OpenCL backend: each group's particles live on the device between steps, and a step
+// is a handful of kernel launches that the host never waits for (PoCL: 5-6 us per launch
+// queued back to back, 44-87 us if the host waits every step).
+//
+//   fl_act       the action list as one generated, fused kernel; leaves a kill code each
+//   fl_count     dead per tile                \  only when the list can kill;
+//   fl_scan      prefix over tiles, counts     > one launch (fl_scan_list) for groups of
+//   fl_list      hole and tail lists           /  one tile
+//   fl_tail      closes holes from the tail, writes the newborns
+//
+// The host does not know the live count while steps are in flight: every kernel reads it
+// from the device's state buffer, and the host sizes launches by an upper bound (the last
+// count it read back asynchronously plus the births queued since).
+#include "backend.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <deque>
+#include <limits>
+#include <map>
+
+#include "codegen.hpp"
+
+namespace flurry::detail::ocl {
+
+static_assert(sizeof(cl::FlDomain) == 72 && alignof(cl::FlDomain) == 4);
+static_assert(sizeof(cl::FlFuzzy) == 16);
+static_assert(sizeof(cl::FlParticleType) == 4 * 72 + 5 * 16 + 8);
+static_assert(sizeof(cl::FlEmitter) == 72 + 16 + 32 + 24 && offsetof(cl::FlEmitter, start) == 72);
+static_assert(sizeof(cl::FlKeyframe) == 24 && offsetof(cl::FlKeyframe, position) == 8);
+static_assert(sizeof(cl::FlBirthRun) == 32 && offsetof(cl::FlBirthRun, emitter) == 24);
+static_assert(sizeof(cl::FlActionParams) == 96 && offsetof(cl::FlActionParams, u) == 80);
+static_assert(FL_TILE % 16 == 0);
+
+namespace {
+
+constexpr std::size_t kActLocal = 256;   // fixed: PoCL compiles once per (kernel, local size)
+constexpr std::size_t kSmallLocal = 64;  // count, list and tail
+constexpr std::size_t kMaxInFlight = 4;  // steps queued before the host waits for the oldest
+constexpr std::size_t kMaxFillItems = 1 << 16;
+constexpr std::size_t kSmallTiles = 4;  // up to 4096 particles: count-scan-list in one item
+
+std::size_t roundUp(std::size_t x, std::size_t m) {
+  return (x + m - 1) / m * m;
+}
+
+std::uint64_t doubleBits(double d) {
+  std::uint64_t b;
+  std::memcpy(&b, &d, sizeof b);
+  return b;
+}
+
+// emission.cpp producedBy: births a rate has produced by time t.
+std::uint64_t producedBy(const Emitter& e, double t) {
+  const double elapsed = std::min(t, e.stop) - e.start;
+  if (elapsed <= 0) return 0;
+  const double x = e.rate * elapsed;
+  return std::uint64_t(std::floor(x + 1e-9 * std::max(1.0, x)));
+}
+
+cl::FlFuzzy packFuzzy(const Fuzzy& f) {
+  return {f.center, f.spread, f.distribution == Fuzzy::Distribution::Normal ? 1u : 0u, 0u};
+}
+
+// What the device does not run yet is refused, naming it, rather than silently ignored. The
+// checks compile whether or not the core has the feature yet (`requires`).
+template <class G>
+void checkSupported(const G& g) {
+  auto refuse = [&](const std::string& what) {
+    throw Error("OpenCL backend: group '" + g.name + "' uses " + what +
+                ", which does not run on the device yet; use Backend::Cpu");
+  };
+  if constexpr (requires { g.primes.empty(); })
+    if (!g.primes.empty()) refuse("prime emitters");
+  if constexpr (requires { g.live.empty(); })
+    if (!g.live.empty()) refuse("prime emitters");
+  if constexpr (requires { g.hair.enabled; })
+    if (g.hair.enabled) refuse("hair mode");
+  for (std::size_t i = 0; i < g.emitters.size(); ++i) {
+    const auto& e = g.emitters[i];
+    const std::string name = "emitters[" + std::to_string(i) + "]";
+    if constexpr (requires { e.spacing; })
+      if (e.spacing > 0) refuse(name + ".spacing (emission by distance)");
+    if constexpr (requires { e.normalSpeed.center; })
+      if (e.normalSpeed.center != 0.0f || e.normalSpeed.spread != 0.0f)
+        refuse(name + ".normalSpeed");
+  }
+}
+
+template <class T>
+void setArg(cl_kernel k, cl_uint i, const T& v) {
+  check(clSetKernelArg(k, i, sizeof(T), &v), "clSetKernelArg");
+}
+
+}  // namespace
+
+/// What every group of one Context shares: the device's runtime and one in-order queue.
+struct Shared {
+  std::shared_ptr<Runtime> runtime;
+  Queue queue;
+  bool profile = false;  // FLURRY_OPENCL_PROFILE=1: per-kernel device times on stderr
+  cl_device_id device() const { return runtime->device().id; }
+  bool cpu() const { return runtime->device().cpu; }
+  bool fp64() const { return runtime->device().info.fp64; }
+};
+
+namespace {
+
+struct StepTables {
+  std::vector<cl::FlBirthRun> runs;
+  std::vector<cl::FlEmitter> emitters;
+  std::vector<cl::FlParticleType> types;
+  std::vector<cl::FlKeyframe> keys;
+};
+
+// A step queued on the device: its state is read back into `state` when `done` fires.
+struct InFlight {
+  Event done;
+  std::vector<std::uint32_t> state;
+  std::uint64_t births = 0;
+  StepTables tables;  // the step's non-blocking writes read these
+};
+
+struct DeviceLane {
+  LaneRef ref;
+  LaneBuffer host;  // CPU devices: the buffer's memory (aligned, huge pages), used in place
+  Mem mem;
+};
+
+// A device buffer that only grows.
+struct GrowBuffer {
+  Mem mem;
+  std::size_t bytes = 0;
+  bool reserve(cl_context ctx, std::size_t want, cl_mem_flags flags = CL_MEM_READ_WRITE) {
+    if (want <= bytes && mem) return false;
+    const std::size_t n = std::max<std::size_t>(want, 2 * bytes);
+    cl_int err = CL_SUCCESS;
+    Mem m(clCreateBuffer(ctx, flags, std::max<std::size_t>(n, 64), nullptr, &err));
+    check(err, "clCreateBuffer");
+    mem = std::move(m);
+    bytes = n;
+    return true;
+  }
+};
+
+class ClGroup final : public DeviceMirror {
+ public:
+  explicit ClGroup(std::shared_ptr<Shared> shared) : shared_(std::move(shared)) {}
+  ~ClGroup() override {
+    if (!shared_) return;
+    clFinish(shared_->queue.get());  // buffers must outlive queued work
+    if (shared_->profile) {
+      collectProfile();
+      for (const auto& [name, t] : profile_)
+        std::fprintf(stderr,
+                     "flurry opencl profile: %-14s %8llu launches %10.3f ms total %9.1f us each\n",
+                     name.c_str(), static_cast<unsigned long long>(t.second), t.first * 1e3,
+                     t.first * 1e6 / double(std::max<std::uint64_t>(t.second, 1)));
+    }
+  }
+
+  void collectProfile() {
+    for (auto& [name, e] : profiled_) {
+      cl_ulong a = 0, b = 0;
+      clGetEventProfilingInfo(e.get(), CL_PROFILING_COMMAND_START, sizeof a, &a, nullptr);
+      clGetEventProfilingInfo(e.get(), CL_PROFILING_COMMAND_END, sizeof b, &b, nullptr);
+      auto& t = profile_[name];
+      t.first += double(b - a) * 1e-9;
+      ++t.second;
+    }
+    profiled_.clear();
+  }
+
+  void pullToHost(GroupImpl& g) override {
+    if (!deviceNewer_) return;
+    drain(g);
+    for (auto& lane : lanes_) {
+      if (size_ == 0) break;
+      void* dst = g.lanes[std::size_t(lane.ref.attribute)][lane.ref.component].data();
+      check(clEnqueueReadBuffer(queue(), lane.mem.get(), CL_FALSE, 0, size_ * 4, dst, 0, nullptr,
+                                nullptr),
+            "clEnqueueReadBuffer (particles)");
+    }
+    check(clFinish(queue()), "clFinish");
+    g.size = size_;
+    g.nextId = nextId_;
+    deviceNewer_ = false;
+  }
+
+  void hostChanged(GroupImpl&) override { hostDirty_ = true; }
+  // Steps in flight report their counts when they finish: wait for them, read no particles.
+  void syncStats(GroupImpl& g) override { finish(g); }
+
+  void finish(GroupImpl& g) {
+    check(clFinish(queue()), "clFinish");
+    drain(g);
+    if (shared_->profile) collectProfile();
+  }
+
+  void step(GroupImpl& g, const StepParams& sp);
+
+ private:
+  cl_command_queue queue() const { return shared_->queue.get(); }
+  cl_context context() const { return shared_->runtime->context(); }
+
+  void allocate(GroupImpl& g);
+  void buildProgram(GroupImpl& g);
+  void upload(GroupImpl& g);
+  void retire(GroupImpl& g, bool wait);
+  void drain(GroupImpl& g) {
+    while (!inFlight_.empty()) retire(g, true);
+  }
+  void apply(GroupImpl& g, const std::vector<std::uint32_t>& state);
+  std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, StepTables& t);
+
+  std::shared_ptr<Shared> shared_;
+  std::vector<DeviceLane> lanes_;
+  AttributeSet laneSet_;
+  bool allocated_ = false;
+  Mem codes_, tileDead_, tileOff_, holes_, tailList_;
+  GrowBuffer state_, params_, runs_, emitters_, types_, keys_;
+  std::size_t tiles_ = 0;
+
+  Program program_;
+  ActionList programActions_;
+  bool programValid_ = false;
+  std::string emitterSignature_;
+  std::vector<LaneRef> actLanes_;
+  Kernel act_, count_, scan_, list_, scanList_, tailKernel_;
+  std::vector<cl::FlActionParams> params_host_, params_uploaded_;
+
+  std::vector<std::pair<std::string, Event>> profiled_;
+  std::map<std::string, std::pair<double, std::uint64_t>> profile_;
+  std::deque<InFlight> inFlight_;
+  std::size_t size_ = 0;  // the device's live count at the last completed step
+  std::uint32_t nextId_ = 0;
+  std::uint32_t lastDropped_ = 0;
+  std::vector<std::uint32_t> lastKills_;
+  bool hostDirty_ = true;
+  bool deviceNewer_ = false;
+};
+
+void ClGroup::allocate(GroupImpl& g) {
+  const auto& dev = shared_->runtime->device();
+  const std::size_t laneBytes = g.capacity * 4;
+  if (laneBytes > dev.info.maxAllocation)
+    throw OpenCLError(CL_INVALID_BUFFER_SIZE,
+                      "OpenCL: group '" + g.name + "' of capacity " + std::to_string(g.capacity) +
+                          " needs " + std::to_string(laneBytes) + " bytes per attribute lane; " +
+                          dev.info.name + " allows " + std::to_string(dev.info.maxAllocation) +
+                          " bytes per buffer (use a smaller capacity or the CPU backend)");
+  // Build the new set aside, so a failure (out of device memory) leaves the group as it was.
+  std::vector<DeviceLane> lanes;
+  cl_int err = CL_SUCCESS;
+  for (const LaneRef& ref : lanesOf(g.stored)) {
+    DeviceLane l{ref, LaneBuffer(), Mem()};
+    if (shared_->cpu()) {
+      // PoCL on the CPU: buffers over memory we allocate (aligned, huge pages) run ~30 %
+      // faster than ALLOC_HOST_PTR ones (PERF-NOTES); the device uses it in place.
+      l.host = LaneBuffer(g.capacity);
+      l.mem = Mem(clCreateBuffer(context(), CL_MEM_READ_WRITE | CL_MEM_USE_HOST_PTR, laneBytes,
+                                 l.host.data(), &err));
+    } else {
+      l.mem = Mem(clCreateBuffer(context(), CL_MEM_READ_WRITE, laneBytes, nullptr, &err));
+    }
+    check(err, "clCreateBuffer (particles)");
+    lanes.push_back(std::move(l));
+  }
+  if (!allocated_) {
+    tiles_ = roundUp((g.capacity + FL_TILE - 1) / FL_TILE, kSmallLocal);
+    auto make = [&](std::size_t bytes) {
+      Mem m(clCreateBuffer(context(), CL_MEM_READ_WRITE, bytes, nullptr, &err));
+      check(err, "clCreateBuffer (scratch)");
+      return m;
+    };
+    codes_ = make(std::max(roundUp(g.capacity, FL_TILE), roundUp(g.capacity, kActLocal)));
+    tileDead_ = make(tiles_ * 4);
+    tileOff_ = make(tiles_ * 4);
+    holes_ = make(g.capacity * 4);
+    tailList_ = make(g.capacity * 4);
+  }
+  lanes_ = std::move(lanes);
+  laneSet_ = g.stored;
+  allocated_ = true;
+  programValid_ = false;
+}
+
+void ClGroup::buildProgram(GroupImpl& g) {
+  const GeneratedProgram gen = generateProgram(g.actions, g.stored, shared_->fp64(), g.emitters);
+  emitterSignature_ = emitterSignature(g.emitters);
+  Program p(shared_->runtime->program(gen.source, gen.options));
+  cl_int err = CL_SUCCESS;
+  auto kernel = [&](const char* name) {
+    Kernel k(clCreateKernel(p.get(), name, &err));
+    check(err, "clCreateKernel");
+    return k;
+  };
+  Kernel act = kernel("fl_act"), count = kernel("fl_count"), scan = kernel("fl_scan"),
+         list = kernel("fl_list"), scanList = kernel("fl_scan_list"), tail = kernel("fl_tail");
+  program_ = std::move(p);
+  act_ = std::move(act);
+  count_ = std::move(count);
+  scan_ = std::move(scan);
+  list_ = std::move(list);
+  scanList_ = std::move(scanList);
+  tailKernel_ = std::move(tail);
+  actLanes_ = gen.actLanes;
+  programActions_ = g.actions;
+  programValid_ = true;
+
+  // The buffer arguments; scalars are set per step.
+  auto laneMem = [&](const LaneRef& r) {
+    for (auto& l : lanes_)
+      if (l.ref.attribute == r.attribute && l.ref.component == r.component) return l.mem.get();
+    return cl_mem(nullptr);
+  };
+  cl_uint i = 0;
+  for (const auto& r : actLanes_) setArg(act_.get(), i++, laneMem(r));
+  setArg(act_.get(), i++, codes_.get());
+  i = 0;
+  for (const auto& l : lanes_) setArg(tailKernel_.get(), i++, l.mem.get());
+  setArg(tailKernel_.get(), i++, holes_.get());
+  setArg(tailKernel_.get(), i++, tailList_.get());
+  setArg(count_.get(), 0, codes_.get());
+  setArg(count_.get(), 1, tileDead_.get());
+  setArg(scan_.get(), 0, codes_.get());
+  setArg(scan_.get(), 1, tileDead_.get());
+  setArg(scan_.get(), 2, tileOff_.get());
+  setArg(list_.get(), 0, codes_.get());
+  setArg(list_.get(), 1, tileOff_.get());
+  setArg(list_.get(), 2, tileDead_.get());
+  setArg(list_.get(), 3, holes_.get());
+  setArg(list_.get(), 4, tailList_.get());
+  setArg(scanList_.get(), 0, codes_.get());
+  setArg(scanList_.get(), 1, tileDead_.get());
+  setArg(scanList_.get(), 2, tileOff_.get());
+  setArg(scanList_.get(), 3, holes_.get());
+  setArg(scanList_.get(), 4, tailList_.get());
+  params_uploaded_.clear();
+}
+
+void ClGroup::upload(GroupImpl& g) {
+  drain(g);
+  const std::size_t nActions = std::max<std::size_t>(g.actions.size(), 1);
+  if (state_.reserve(context(), (FL_STATE_HEADER + nActions) * 4)) programValid_ = false;
+  for (auto& lane : lanes_) {
+    if (g.size == 0) break;
+    const void* src = g.lanes[std::size_t(lane.ref.attribute)][lane.ref.component].data();
+    check(clEnqueueWriteBuffer(queue(), lane.mem.get(), CL_FALSE, 0, g.size * 4, src, 0, nullptr,
+                               nullptr),
+          "clEnqueueWriteBuffer (particles)");
+  }
+  std::vector<std::uint32_t> state(FL_STATE_HEADER + nActions, 0u);
+  state[FL_STATE_SIZE] = std::uint32_t(g.size);
+  state[FL_STATE_NEXT_ID] = g.nextId;
+  check(clEnqueueWriteBuffer(queue(), state_.mem.get(), CL_TRUE, 0, state.size() * 4, state.data(),
+                             0, nullptr, nullptr),
+        "clEnqueueWriteBuffer (state)");
+  check(clFinish(queue()), "clFinish");
+  size_ = g.size;
+  nextId_ = g.nextId;
+  lastDropped_ = 0;
+  lastKills_.assign(nActions, 0u);
+  hostDirty_ = false;
+  deviceNewer_ = false;
+}
+
+void ClGroup::apply(GroupImpl& g, const std::vector<std::uint32_t>& s) {
+  size_ = s[FL_STATE_SIZE];
+  nextId_ = s[FL_STATE_NEXT_ID];
+  // The device's counters are 32-bit and wrap; the host sums their deltas in 64 bits.
+  g.stats.droppedAtCapacity += std::uint32_t(s[FL_STATE_DROPPED] - lastDropped_);
+  lastDropped_ = s[FL_STATE_DROPPED];
+  const auto& acts = programActions_.actions();
+  for (std::size_t k = 0; k < acts.size() && k < lastKills_.size(); ++k) {
+    const std::uint32_t now = s[FL_STATE_KILLS + k];
+    const std::uint32_t d = now - lastKills_[k];
+    lastKills_[k] = now;
+    if (d == 0) continue;
+    if (k < g.stats.killedByAction.size()) g.stats.killedByAction[k] += d;
+    if (std::holds_alternative<KillOld>(acts[k]))
+      g.stats.killedByAge += d;
+    else
+      g.stats.absorbed += d;
+  }
+}
+
+void ClGroup::retire(GroupImpl& g, bool wait) {
+  if (inFlight_.empty()) return;
+  InFlight& f = inFlight_.front();
+  cl_int status = CL_COMPLETE;
+  if (wait) {
+    const cl_event e = f.done.get();
+    const cl_int err = clWaitForEvents(1, &e);
+    if (err != CL_SUCCESS && err != CL_EXEC_STATUS_ERROR_FOR_EVENTS_IN_WAIT_LIST)
+      check(err, "clWaitForEvents");
+  }
+  check(clGetEventInfo(f.done.get(), CL_EVENT_COMMAND_EXECUTION_STATUS, sizeof status, &status,
+                       nullptr),
+        "clGetEventInfo");
+  if (status < 0) {
+    inFlight_.clear();
+    hostDirty_ = true;  // the device's copy is lost; the group keeps its last host copy
+    deviceNewer_ = false;
+    check(status, "a queued step");
+  }
+  if (status != CL_COMPLETE) return;
+  apply(g, f.state);
+  inFlight_.pop_front();
+}
+
+std::uint64_t ClGroup::planBirths(GroupImpl& g, const StepParams& sp, StepTables& t) {
+  // emission.cpp step 1, verbatim in effect: which emitter gives birth, how many, when.
+  const double t0 = sp.time, t1 = sp.time + sp.dt;
+  std::uint64_t total = 0;
+  for (std::uint32_t e = 0; e < g.emitters.size(); ++e) {
+    const Emitter& em = g.emitters[e];
+    auto& state = g.emitterState[e];
+    if (em.rate > 0) {
+      const std::uint64_t target = producedBy(em, t1);
+      if (target > state.emittedByRate) {
+        t.runs.push_back({state.emittedByRate, 0, total, e, 0u});
+        total += target - state.emittedByRate;
+        state.emittedByRate = target;
+      }
+    }
+    for (const Burst& b : em.bursts)
+      for (std::uint32_t r = 0; r < b.repeat; ++r) {
+        const double tb = b.time + r * b.interval;
+        if (tb >= t0 && tb < t1 && b.count > 0) {
+          t.runs.push_back({0, doubleBits(tb), total, e, 1u});
+          total += b.count;
+        }
+      }
+  }
+  g.stats.emitted += total;
+  if (total == 0) return 0;
+  for (const Emitter& em : g.emitters) {
+    cl::FlEmitter o{};
+    o.shape = packDomain(em.shape);
+    o.start = doubleBits(em.start);
+    o.rate = doubleBits(em.rate);
+    for (int c = 0; c < 3; ++c) {
+      o.position[c] = em.position[c];
+      o.velocity[c] = em.velocity[c];
+    }
+    o.pathFirst = cl::fl_u32(t.keys.size());
+    o.pathCount = cl::fl_u32(em.path.size());
+    for (const Keyframe& k : em.path)
+      t.keys.push_back({doubleBits(k.time), {k.position.x, k.position.y, k.position.z, 0.0f}});
+    o.typeFirst = cl::fl_u32(t.types.size());
+    o.typeCount = cl::fl_u32(em.types.size());
+    float totalWeight = 0;
+    for (const ParticleType& p : em.types) {
+      totalWeight += p.weight;
+      cl::FlParticleType q{};
+      q.velocity = packDomain(p.velocity);
+      q.color = packDomain(p.color);
+      q.up = packDomain(p.up);
+      q.rotVelocity = packDomain(p.rotVelocity);
+      q.alpha = packFuzzy(p.alpha);
+      q.size = packFuzzy(p.size);
+      q.mass = packFuzzy(p.mass);
+      q.lifetime = packFuzzy(p.lifetime);
+      q.charge = packFuzzy(p.charge);
+      q.weight = p.weight;
+      t.types.push_back(q);
+    }
+    o.totalWeight = totalWeight;
+    t.emitters.push_back(o);
+  }
+  if (t.keys.empty()) t.keys.push_back({});
+  return total;
+}
+
+void ClGroup::step(GroupImpl& g, const StepParams& sp) {
+  checkSupported(g);
+  if (!allocated_ || laneSet_ != g.stored) {
+    drain(g);
+    allocate(g);
+    hostDirty_ = true;
+  }
+  if (hostDirty_) {
+    upload(g);
+    programValid_ = false;
+  }
+  // Emitters may be edited at any time (Group::emitters()); the program follows their kinds.
+  if (programValid_ && emitterSignature(g.emitters) != emitterSignature_) programValid_ = false;
+  if (!programValid_) buildProgram(g);
+
+  packActions(g.actions, float(sp.dt), params_host_);
+  const std::size_t paramBytes = params_host_.size() * sizeof(cl::FlActionParams);
+  if (params_uploaded_.size() != params_host_.size() ||
+      std::memcmp(params_uploaded_.data(), params_host_.data(), paramBytes) != 0) {
+    params_.reserve(context(), paramBytes, CL_MEM_READ_ONLY);
+    check(clEnqueueWriteBuffer(queue(), params_.mem.get(), CL_TRUE, 0, paramBytes,
+                               params_host_.data(), 0, nullptr, nullptr),
+          "clEnqueueWriteBuffer (action parameters)");
+    params_uploaded_ = params_host_;
+  }
+
+  InFlight f;
+  const std::uint64_t total = planBirths(g, sp, f.tables);
+  const std::uint32_t births = std::uint32_t(std::min<std::uint64_t>(total, g.capacity));
+  g.stats.droppedAtCapacity += total - births;  // the device sees at most `capacity`
+  f.births = births;
+
+  std::size_t bound = size_;
+  for (const auto& q : inFlight_) bound += q.births;
+  const std::size_t nBound = std::min(bound, g.capacity);
+  const bool acts = !g.actions.empty() && nBound > 0;
+  const bool kills = acts && g.actions.kills();
+  if (!acts && births == 0) return;  // nothing on the device changes
+
+  cl_command_queue q = queue();
+  cl_mem state = state_.mem.get();
+  const cl_uint seedLo = cl_uint(sp.seed), seedHi = cl_uint(sp.seed >> 32);
+  const cl_uint cap = cl_uint(g.capacity);
+  auto launch = [&](cl_kernel k, std::size_t global, std::size_t local, const char* what) {
+    cl_event e = nullptr;
+    check(clEnqueueNDRangeKernel(q, k, 1, nullptr, &global, &local, 0, nullptr,
+                                 shared_->profile ? &e : nullptr),
+          what);
+    if (e) profiled_.emplace_back(what, Event(e));
+  };
+
+  if (acts) {
+    cl_kernel k = act_.get();
+    cl_uint i = cl_uint(actLanes_.size()) + 1;
+    setArg(k, i++, params_.mem.get());
+    setArg(k, i++, state);
+    setArg(k, i++, float(sp.dt));
+    setArg(k, i++, seedLo);
+    setArg(k, i++, seedHi);
+    setArg(k, i++, cl_uint(sp.step));
+    setArg(k, i++, cl_uint(g.index << 16));
+    launch(k, roundUp(nBound, kActLocal), kActLocal, "fl_act");
+  }
+  if (kills) {
+    const std::size_t tiles = (nBound + FL_TILE - 1) / FL_TILE;
+    if (tiles <= kSmallTiles) {
+      setArg(scanList_.get(), 5, state);
+      setArg(scanList_.get(), 6, cl_uint(births));
+      setArg(scanList_.get(), 7, cap);
+      setArg(scanList_.get(), 8, cl_uint(tiles));
+      launch(scanList_.get(), 1, 1, "fl_scan_list");
+    } else {
+      const std::size_t global = roundUp(tiles, kSmallLocal);
+      setArg(count_.get(), 2, state);
+      launch(count_.get(), global, kSmallLocal, "fl_count");
+      setArg(scan_.get(), 3, state);
+      setArg(scan_.get(), 4, cl_uint(tiles));
+      setArg(scan_.get(), 5, cl_uint(births));
+      setArg(scan_.get(), 6, cap);
+      launch(scan_.get(), 1, 1, "fl_scan");
+      setArg(list_.get(), 5, state);
+      launch(list_.get(), global, kSmallLocal, "fl_list");
+    }
+  } else if (births > 0) {
+    setArg(scan_.get(), 3, state);
+    setArg(scan_.get(), 4, cl_uint(0));
+    setArg(scan_.get(), 5, cl_uint(births));
+    setArg(scan_.get(), 6, cap);
+    launch(scan_.get(), 1, 1, "fl_scan");
+  }
+  if (births > 0 || kills) {
+    auto& t = f.tables;
+    auto write = [&](GrowBuffer& b, const void* data, std::size_t bytes) {
+      b.reserve(context(), std::max<std::size_t>(bytes, 64), CL_MEM_READ_ONLY);
+      if (bytes)
+        check(clEnqueueWriteBuffer(q, b.mem.get(), CL_FALSE, 0, bytes, data, 0, nullptr, nullptr),
+              "clEnqueueWriteBuffer (emitters)");
+    };
+    write(runs_, t.runs.data(), t.runs.size() * sizeof(cl::FlBirthRun));
+    write(emitters_, t.emitters.data(), t.emitters.size() * sizeof(cl::FlEmitter));
+    write(types_, t.types.data(), t.types.size() * sizeof(cl::FlParticleType));
+    write(keys_, t.keys.data(), t.keys.size() * sizeof(cl::FlKeyframe));
+    cl_kernel k = tailKernel_.get();
+    cl_uint i = cl_uint(lanes_.size()) + 2;
+    setArg(k, i++, state);
+    setArg(k, i++, runs_.mem.get());
+    setArg(k, i++, emitters_.mem.get());
+    setArg(k, i++, types_.mem.get());
+    setArg(k, i++, keys_.mem.get());
+    setArg(k, i++, cl_uint(t.runs.size()));
+    setArg(k, i++, cl_ulong(doubleBits(sp.time + sp.dt)));
+    setArg(k, i++, seedLo);
+    setArg(k, i++, seedHi);
+    setArg(k, i++, cl_uint(g.index));
+    const std::size_t fill = kills ? std::min(roundUp(nBound, kSmallLocal), kMaxFillItems) : 0;
+    launch(k, roundUp(std::max<std::size_t>(births, fill), kSmallLocal), kSmallLocal, "fl_tail");
+
+    // The step's counts come back without the host waiting; later steps size their launches
+    // from them.
+    f.state.resize(FL_STATE_HEADER + std::max<std::size_t>(g.actions.size(), 1));
+    cl_event e = nullptr;
+    check(clEnqueueReadBuffer(q, state, CL_FALSE, 0, f.state.size() * 4, f.state.data(), 0, nullptr,
+                              &e),
+          "clEnqueueReadBuffer (state)");
+    f.done = Event(e);
+    inFlight_.push_back(std::move(f));
+  }
+  check(clFlush(q), "clFlush");
+  deviceNewer_ = true;
+  while (inFlight_.size() > kMaxInFlight) retire(g, true);
+  while (!inFlight_.empty()) {  // take what is done without waiting
+    const std::size_t before = inFlight_.size();
+    retire(g, false);
+    if (inFlight_.size() == before) break;
+  }
+}
+
+class OpenCLBackend final : public BackendImpl {
+ public:
+  explicit OpenCLBackend(std::shared_ptr<Shared> shared) : shared_(std::move(shared)) {}
+  const char* name() const override { return "opencl"; }
+  void step(GroupImpl& g, const StepParams& sp) override {
+    auto* mine = dynamic_cast<ClGroup*>(g.mirror.get());
+    if (!mine) {
+      g.syncHost();
+      auto m = std::make_unique<ClGroup>(shared_);
+      mine = m.get();
+      g.mirror = std::move(m);
+    }
+    mine->step(g, sp);
+  }
+
+ private:
+  std::shared_ptr<Shared> shared_;
+};
+
+}  // namespace
+
+void finishGroup(GroupImpl& group) {
+  if (auto* m = dynamic_cast<ClGroup*>(group.mirror.get())) m->finish(group);
+}
+
+std::string programSource(const ActionList& actions, AttributeSet stored, bool fp64) {
+  return generateProgram(actions, stored, fp64, {}).source;
+}
+
+}  // namespace flurry::detail::ocl
+
+namespace flurry::detail {
+
+std::unique_ptr<BackendImpl> makeOpenCLBackend(const ContextOptions& options) {
+  auto shared = std::make_shared<ocl::Shared>();
+  shared->runtime = ocl::Runtime::get(ocl::selectDevice(options.device));
+  cl_int err = CL_SUCCESS;
+  const char* profile = std::getenv("FLURRY_OPENCL_PROFILE");
+  shared->profile = profile && *profile && std::string(profile) != "0";
+  shared->queue =
+      ocl::Queue(clCreateCommandQueue(shared->runtime->context(), shared->device(),
+                                      shared->profile ? CL_QUEUE_PROFILING_ENABLE : 0, &err));
+  ocl::check(err, "clCreateCommandQueue");
+  return std::make_unique<ocl::OpenCLBackend>(std::move(shared));
+}
+
+}  // namespace flurry::detail

@@ -1,0 +1,373 @@
+// Capturing particles, writing files atomically, and the background sequence writer. No
+// OpenVDB headers here (see grids.hpp).
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <cstring>
+#include <deque>
+#include <exception>
+#include <mutex>
+#include <numbers>
+#include <thread>
+
+#include "detail.hpp"
+
+namespace fs = std::filesystem;
+
+namespace flurry::vdb {
+
+namespace detail {
+
+std::atomic<BeforeRenameHook> beforeRename{nullptr};
+
+double particleMass(float radius, float density) {
+  const double r = radius;
+  return double(density) * (4.0 / 3.0) * std::numbers::pi * r * r * r;
+}
+
+void validate(const ExportOptions& o) {
+  auto nonNegative = [](float v, const char* name) {
+    if (!std::isfinite(v) || v < 0.0f) throw InvalidArgument(name, "must be finite and >= 0");
+  };
+  nonNegative(o.fogVoxelSize, "fogVoxelSize");
+  nonNegative(o.pointsVoxelSize, "pointsVoxelSize");
+  nonNegative(o.density, "density");
+  nonNegative(o.defaultRadius, "defaultRadius");
+  if (!std::isfinite(o.fogMinKernelVoxels) || o.fogMinKernelVoxels <= 0.0f)
+    throw InvalidArgument("fogMinKernelVoxels", "must be finite and > 0");
+  if (o.pointsPerVoxel < 1) throw InvalidArgument("pointsPerVoxel", "must be >= 1");
+  if (!o.fog && !o.points) throw InvalidArgument("fog", "neither fog nor points is exported");
+}
+
+namespace {
+
+/// write() until done, retrying short writes; returns 0 or errno.
+int writeAll(int fd, std::string_view bytes) {
+  const char* p = bytes.data();
+  std::size_t left = bytes.size();
+  while (left > 0) {
+    const ssize_t n = ::write(fd, p, std::min<std::size_t>(left, std::size_t(1) << 30));
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return errno;
+    }
+    if (n == 0) return EIO;
+    p += n;
+    left -= std::size_t(n);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void writeAtomic(const fs::path& path, std::string_view bytes) {
+  const fs::path tmp = path.string() + ".tmp." + std::to_string(::getpid());
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd < 0) throw IoError(path.string(), std::string("cannot create: ") + std::strerror(errno));
+  int err = writeAll(fd, bytes);
+  // fsync before the rename: after a power cut the name must not point at missing blocks.
+  if (!err && ::fsync(fd) != 0 && errno != EINVAL && errno != EROFS) err = errno;
+  if (::close(fd) != 0 && !err && errno != EINTR) err = errno;
+  if (err) {
+    ::unlink(tmp.c_str());
+    throw IoError(path.string(), std::string("write failed: ") + std::strerror(err));
+  }
+  if (BeforeRenameHook hook = beforeRename.load()) hook(tmp, path);
+  if (::rename(tmp.c_str(), path.c_str()) != 0) {
+    err = errno;
+    ::unlink(tmp.c_str());
+    throw IoError(path.string(), std::string("rename failed: ") + std::strerror(err));
+  }
+  // Make the rename itself durable; a folder that cannot be synced is not an error.
+  const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {
+    ::fsync(dfd);
+    ::close(dfd);
+  }
+}
+
+}  // namespace detail
+
+Particles Particles::capture(const Group& group, const ExportOptions& o) {
+  Particles out;
+  out.group = group.name();
+  const std::size_t n = group.size();
+  const AttributeSet stored = group.attributes();
+  // Which particles: all, or those no blocker hides. Visible not stored: none is hidden.
+  std::vector<std::uint32_t> keep;
+  const bool filter = !o.keepHidden && stored.has(Attribute::Visible);
+  if (filter) {
+    const auto vis = group.visible();
+    keep.reserve(n);
+    for (std::size_t i = 0; i < n; ++i)
+      if (vis[i]) keep.push_back(std::uint32_t(i));
+    out.hidden = n - keep.size();
+  }
+  const std::size_t m = filter ? keep.size() : n;
+  auto pick = [&](std::size_t k) { return filter ? std::size_t(keep[k]) : k; };
+  auto vec3 = [&](Attribute a, std::vector<Vec3>& dst) {
+    const auto x = group.lane(a, 0), y = group.lane(a, 1), z = group.lane(a, 2);
+    dst.resize(m);
+    for (std::size_t k = 0; k < m; ++k) {
+      const std::size_t i = pick(k);
+      dst[k] = Vec3(x[i], y[i], z[i]);
+    }
+  };
+  auto scalar = [&](Attribute a, std::vector<float>& dst) {
+    const auto x = group.lane(a, 0);
+    dst.resize(m);
+    for (std::size_t k = 0; k < m; ++k) dst[k] = x[pick(k)];
+  };
+  vec3(Attribute::Position, out.position);
+  const auto ids = group.ids();
+  out.id.resize(m);
+  for (std::size_t k = 0; k < m; ++k) out.id[k] = ids[pick(k)];
+  if (stored.has(Attribute::Velocity)) vec3(Attribute::Velocity, out.velocity);
+  if (stored.has(Attribute::Color)) vec3(Attribute::Color, out.color);
+  if (stored.has(Attribute::Size)) scalar(Attribute::Size, out.radius);
+  if (o.points && stored.has(Attribute::Age)) scalar(Attribute::Age, out.age);
+  return out;
+}
+
+float fogVoxelSize(const Frame& frame, const ExportOptions& o) {
+  if (o.fogVoxelSize > 0.0f) return o.fogVoxelSize;
+  // Half the median radius; a strided sample of at most ~64k radii is plenty for a median.
+  std::vector<float> radii;
+  std::size_t total = 0;
+  for (const Particles& g : frame.groups) total += g.size();
+  for (const Strands& s : frame.strands) total += s.vertexCount();
+  const std::size_t stride = std::max<std::size_t>(1, total / 65536);
+  std::size_t k = 0;
+  for (const Particles& g : frame.groups)
+    for (std::size_t i = 0; i < g.size(); ++i, ++k)
+      if (k % stride == 0) radii.push_back(g.radius.empty() ? o.defaultRadius : g.radius[i]);
+  for (const Strands& s : frame.strands)
+    for (std::size_t i = 0; i < s.vertexCount(); ++i, ++k)
+      if (k % stride == 0) radii.push_back(s.radius.empty() ? o.defaultRadius : s.radius[i]);
+  std::erase_if(radii, [](float r) { return !(r > 0.0f) || !std::isfinite(r); });
+  if (radii.empty()) return o.defaultRadius > 0.0f ? 0.5f * o.defaultRadius : 0.025f;
+  auto mid = radii.begin() + std::ptrdiff_t(radii.size() / 2);
+  std::nth_element(radii.begin(), mid, radii.end());
+  return 0.5f * *mid;
+}
+
+namespace {
+
+void checkFinite(const Frame& frame) {
+  for (std::size_t g = 0; g < frame.groups.size(); ++g) {
+    const Particles& p = frame.groups[g];
+    auto where = [&](const char* what, std::size_t i) {
+      return "groups[" + std::to_string(g) + "]." + what + "[" + std::to_string(i) + "]";
+    };
+    if (p.id.size() != p.size()) throw InvalidArgument(where("id", 0), "needs one id per particle");
+    auto sized = [&](std::size_t n, const char* what) {
+      if (n != 0 && n != p.size())
+        throw InvalidArgument(where(what, 0), "needs one value per particle, or none");
+    };
+    sized(p.velocity.size(), "velocity");
+    sized(p.color.size(), "color");
+    sized(p.radius.size(), "radius");
+    sized(p.age.size(), "age");
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const Vec3 x = p.position[i];
+      if (!std::isfinite(x.x) || !std::isfinite(x.y) || !std::isfinite(x.z))
+        throw InvalidArgument(where("position", i), "is not finite");
+    }
+    for (std::size_t i = 0; i < p.radius.size(); ++i)
+      if (!std::isfinite(p.radius[i]) || p.radius[i] < 0.0f)
+        throw InvalidArgument(where("radius", i), "must be finite and >= 0");
+  }
+}
+
+}  // namespace
+
+FileStats writeFile(const fs::path& path, const Frame& frame, const ExportOptions& options) {
+  detail::validate(options);
+  checkFinite(frame);
+  FileStats st;
+  st.path = path;
+  const std::string bytes = detail::encode(frame, options, st);
+  const auto start = std::chrono::steady_clock::now();
+  detail::writeAtomic(path, bytes);
+  st.writeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  st.bytes = bytes.size();
+  return st;
+}
+
+FileStats writeFile(const fs::path& path, const Group& group, const ExportOptions& options) {
+  Frame f;
+  f.groups.push_back(Particles::capture(group, options));
+  return writeFile(path, f, options);
+}
+
+FileStats writeFog(const fs::path& path, const Strands& strands, const ExportOptions& options) {
+  Frame f;
+  f.strands.push_back(strands);
+  ExportOptions o = options;
+  o.fog = true;
+  o.points = false;
+  return writeFile(path, f, o);
+}
+
+// ---------------------------------------------------------------------------------------
+
+struct SequenceWriter::Impl {
+  SequenceOptions options;
+  mutable std::mutex mutex;
+  std::condition_variable changed;
+  std::deque<Frame> queue;
+  bool busy = false;  ///< the worker holds a frame
+  bool stop = false;
+  std::exception_ptr error;
+  ExportCost cost;
+  FileStats last;
+  std::thread worker;
+
+  void run() {
+    std::unique_lock lock(mutex);
+    for (;;) {
+      changed.wait(lock, [&] { return stop || !queue.empty(); });
+      if (queue.empty()) return;  // stop, and nothing left
+      Frame frame = std::move(queue.front());
+      queue.pop_front();
+      busy = true;
+      const bool failed = error != nullptr;
+      lock.unlock();
+      FileStats st;
+      std::exception_ptr e;
+      if (!failed) {  // after an error the sequence is broken: drop the rest
+        const fs::path path = pathFor(frame.number);
+        try {
+          st = writeFile(path, frame, options.content);
+        } catch (const Error&) {
+          e = std::current_exception();
+        } catch (const std::exception& x) {  // bad_alloc, OpenVDB's own: name the file
+          e = std::make_exception_ptr(IoError(path.string(), x.what()));
+        }
+      }
+      lock.lock();
+      busy = false;
+      if (e && !error) error = e;
+      if (!failed && !e) {
+        ++cost.files;
+        cost.bytes += st.bytes;
+        cost.buildSeconds += st.buildSeconds;
+        cost.writeSeconds += st.writeSeconds;
+        last = st;
+      }
+      changed.notify_all();
+    }
+  }
+
+  fs::path pathFor(int frame) const {
+    char digits[32];
+    std::snprintf(digits, sizeof digits, ".%0*d.vdb", options.padding, frame);
+    return options.folder / (options.name + digits);
+  }
+
+  void rethrow() const {
+    if (error) std::rethrow_exception(error);
+  }
+};
+
+SequenceWriter::SequenceWriter(SequenceOptions options) : impl_(std::make_unique<Impl>()) {
+  detail::validate(options.content);
+  if (options.name.empty()) throw InvalidArgument("name", "must not be empty");
+  if (options.padding < 1 || options.padding > 12) throw InvalidArgument("padding", "1 to 12");
+  if (options.maxPending < 1) throw InvalidArgument("maxPending", "must be >= 1");
+  std::error_code ec;
+  fs::create_directories(options.folder, ec);
+  if (ec || !fs::is_directory(options.folder))
+    throw IoError(
+        options.folder.string(),
+        "cannot create the output folder: " + (ec ? ec.message() : std::string("not a directory")));
+  impl_->options = std::move(options);
+  impl_->worker = std::thread([impl = impl_.get()] { impl->run(); });
+}
+
+SequenceWriter::~SequenceWriter() {
+  {
+    std::lock_guard lock(impl_->mutex);
+    impl_->stop = true;
+  }
+  impl_->changed.notify_all();
+  if (impl_->worker.joinable()) impl_->worker.join();
+}
+
+void SequenceWriter::write(std::span<Group* const> groups, int frame, double time) {
+  {
+    std::lock_guard lock(impl_->mutex);
+    impl_->rethrow();  // don't copy particles for a sequence that has already failed
+  }
+  const auto start = std::chrono::steady_clock::now();
+  Frame f;
+  f.number = frame;
+  f.time = time;
+  for (const Group* g : groups) f.groups.push_back(Particles::capture(*g, impl_->options.content));
+  const double secs =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  {
+    std::lock_guard lock(impl_->mutex);
+    impl_->cost.captureSeconds += secs;
+  }
+  write(std::move(f));
+}
+
+void SequenceWriter::write(const Group& group, int frame, double time) {
+  Group* g = const_cast<Group*>(&group);  // the span is of non-const pointers; only read
+  write(std::span<Group* const>(&g, 1), frame, time);
+}
+
+void SequenceWriter::write(Frame frame) {
+  std::unique_lock lock(impl_->mutex);
+  impl_->rethrow();
+  const auto start = std::chrono::steady_clock::now();
+  impl_->changed.wait(lock, [&] {
+    return impl_->error || impl_->queue.size() + (impl_->busy ? 1 : 0) < impl_->options.maxPending;
+  });
+  impl_->cost.waitSeconds +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  impl_->rethrow();
+  impl_->queue.push_back(std::move(frame));
+  impl_->changed.notify_all();
+}
+
+fs::path SequenceWriter::pathFor(int frame) const {
+  return impl_->pathFor(frame);
+}
+
+std::size_t SequenceWriter::written() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->cost.files;
+}
+
+std::size_t SequenceWriter::pending() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->queue.size() + (impl_->busy ? 1 : 0);
+}
+
+ExportCost SequenceWriter::cost() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->cost;
+}
+
+FileStats SequenceWriter::last() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->last;
+}
+
+ExportCost SequenceWriter::finish() {
+  std::unique_lock lock(impl_->mutex);
+  impl_->changed.wait(lock, [&] { return impl_->queue.empty() && !impl_->busy; });
+  impl_->rethrow();
+  return impl_->cost;
+}
+
+}  // namespace flurry::vdb

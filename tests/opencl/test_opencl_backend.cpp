@@ -1,0 +1,207 @@
+// The OpenCL backend's behaviour apart from parity: device choice, errors, the program
+// cache, host reads and writes between steps, capacity.
+#include <cstdlib>
+#include <filesystem>
+
+#include "builtin.hpp"
+#include "opencl/backend.hpp"
+#include "opencl/runtime.hpp"
+#include "opencl_test.hpp"
+
+using namespace flurry;
+
+namespace {
+
+ContextOptions openclOptions(std::uint64_t seed = 3) {
+  ContextOptions o;
+  o.seed = seed;
+  o.threads = 2;
+  o.backend = Backend::OpenCL;
+  return o;
+}
+
+}  // namespace
+
+TEST(OpenCLBackend, ListsDevices) {
+  FLURRY_REQUIRE_OPENCL();
+  const auto devices = openclDevices();
+  ASSERT_FALSE(devices.empty());
+  for (const auto& d : devices) {
+    EXPECT_FALSE(d.name.empty());
+    EXPECT_GT(d.maxAllocation, 0u);
+  }
+}
+
+TEST(OpenCLBackend, AutoPicksOpenCLWhenThereIsADevice) {
+  FLURRY_REQUIRE_OPENCL();
+  ContextOptions o;
+  o.backend = Backend::Auto;
+  Context ctx(o);
+  EXPECT_EQ(ctx.backend(), Backend::OpenCL);
+}
+
+TEST(OpenCLBackend, AnUnknownDeviceNameThrowsNamingTheDevicesFound) {
+  FLURRY_REQUIRE_OPENCL();
+  ContextOptions o = openclOptions();
+  o.device = "no-such-device-xyz";
+  try {
+    Context ctx(o);
+    FAIL() << "expected OpenCLError";
+  } catch (const OpenCLError& e) {
+    EXPECT_EQ(e.code(), CL_DEVICE_NOT_FOUND);
+    EXPECT_NE(std::string(e.what()).find("no-such-device-xyz"), std::string::npos);
+  }
+  // Auto falls back to the CPU instead, with a message.
+  o.backend = Backend::Auto;
+  Context fallback(o);
+  EXPECT_EQ(fallback.backend(), Backend::Cpu);
+}
+
+TEST(OpenCLBackend, ABuildFailureCarriesTheLogAndTheSource) {
+  FLURRY_REQUIRE_OPENCL();
+  auto rt = detail::ocl::Runtime::get(detail::ocl::selectDevice(""));
+  const std::string bad = "__kernel void broken(__global float* x) { x[0] = undefined_thing; }";
+  try {
+    rt->program(bad, "");
+    FAIL() << "expected OpenCLError";
+  } catch (const OpenCLError& e) {
+    EXPECT_EQ(e.code(), CL_BUILD_PROGRAM_FAILURE);
+    EXPECT_NE(e.buildLog().find("undefined_thing"), std::string::npos) << e.buildLog();
+    EXPECT_EQ(e.source(), bad);
+  }
+}
+
+TEST(OpenCLBackend, TheSecondContextPaysNoCompile) {
+  FLURRY_REQUIRE_OPENCL();
+  auto run = [] {
+    Context ctx(openclOptions());
+    samples::buildFountain(ctx, 10000, 2000, 2.0f);
+    ctx.run(3);
+  };
+  run();
+  const auto before = detail::ocl::Runtime::cacheStats();
+  run();
+  const auto after = detail::ocl::Runtime::cacheStats();
+  EXPECT_EQ(after.builds, before.builds);
+  EXPECT_EQ(after.diskHits, before.diskHits);
+  EXPECT_GT(after.memoryHits, before.memoryHits);
+}
+
+TEST(OpenCLBackend, ProgramsAreCachedOnDisk) {
+  FLURRY_REQUIRE_OPENCL();
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("flurry-cl-cache-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  ::setenv("FLURRY_OPENCL_CACHE", dir.c_str(), 1);
+  auto run = [] {
+    Context ctx(openclOptions());
+    Group& g = samples::buildFountain(ctx, 1000, 500, 1.0f);
+    // A list no other test uses, so the program is not in memory yet.
+    g.setActions({Gravity{Vec3(0.0f, -1.0f, 0.0f)}, Damping{Vec3(0.01f)}, Move{}, KillOld{}});
+    ctx.run(2);
+  };
+  detail::ocl::Runtime::clearMemoryCache();
+  run();  // compiles (or loads a binary PoCL cached) and writes the binary
+  EXPECT_FALSE(std::filesystem::is_empty(dir));
+  detail::ocl::Runtime::clearMemoryCache();
+  const auto before = detail::ocl::Runtime::cacheStats();
+  run();
+  const auto after = detail::ocl::Runtime::cacheStats();
+  ::unsetenv("FLURRY_OPENCL_CACHE");
+  std::filesystem::remove_all(dir);
+  EXPECT_EQ(after.builds, before.builds);
+  EXPECT_EQ(after.diskHits, before.diskHits + 1);
+}
+
+// Particles added and edited by the host between steps reach the device, and the device's
+// particles come back when the host reads them.
+TEST(OpenCLBackend, HostReadsAndWritesBetweenSteps) {
+  FLURRY_REQUIRE_OPENCL();
+  auto run = [](Backend b) {
+    ContextOptions o = openclOptions();
+    o.backend = b;
+    Context ctx(o);
+    Group& g = ctx.createGroup("g", 1000);
+    g.setActions({Gravity{Vec3(0.0f, -1.0f, 0.0f)}, Move{}, KillOld{}});
+    for (int i = 0; i < 100; ++i) {
+      Particle p;
+      p.position = Vec3(float(i), 0.0f, 0.0f);
+      p.velocity = Vec3(0.0f, 1.0f, 0.0f);
+      p.lifetime = 0.05f * float(i);
+      g.add(p);
+    }
+    ctx.run(10);
+    EXPECT_LT(g.size(), 100u);                // some died of age
+    auto y = g.lane(Attribute::Position, 1);  // writable: the device must take it
+    for (float& v : y) v += 100.0f;
+    ctx.run(10);
+    Particle extra;
+    extra.lifetime = 100.0f;
+    g.add(extra);
+    ctx.run(5);
+    std::map<std::uint32_t, Vec3> out;
+    for (std::size_t i = 0; i < g.size(); ++i) out[g.particle(i).id] = g.particle(i).position;
+    return std::make_pair(out, g.stats().killedByAge);
+  };
+  const auto cpu = run(Backend::Cpu);
+  const auto cl = run(Backend::OpenCL);
+  EXPECT_EQ(cpu.second, cl.second);
+  ASSERT_EQ(cpu.first.size(), cl.first.size());
+  for (const auto& [id, p] : cpu.first) {
+    ASSERT_TRUE(cl.first.count(id)) << id;
+    // Not bitwise: GCC contracts the CPU's AVX2/AVX-512 fused pass into FMAs.
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(p[c], cl.first.at(id)[c], 1e-4f) << id;
+  }
+}
+
+TEST(OpenCLBackend, ClearAndRequireBetweenSteps) {
+  FLURRY_REQUIRE_OPENCL();
+  Context ctx(openclOptions());
+  Group& g = samples::buildFountain(ctx, 20000, 3000, 1.0f);
+  ctx.run(20);
+  EXPECT_GT(g.size(), 0u);
+  g.clear();
+  EXPECT_EQ(g.size(), 0u);
+  ctx.run(5);
+  const std::size_t n = g.size();
+  EXPECT_GT(n, 0u);
+  g.require({Attribute::Color, Attribute::Size});  // new lanes: the device reallocates
+  ctx.run(5);
+  EXPECT_GT(g.size(), n);
+  EXPECT_GT(g.particle(0).size, 0.0f);
+}
+
+// A group larger than one device buffer may be: a clear error, and the group stays usable.
+TEST(OpenCLBackend, TooLargeForTheDeviceIsAClearError) {
+  FLURRY_REQUIRE_OPENCL();
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "maps gigabytes of host lanes, which AddressSanitizer makes take ~10 s";
+#endif
+  Context ctx(openclOptions());
+  const auto dev = detail::ocl::selectDevice("");
+  const std::size_t capacity = std::size_t(dev.info.maxAllocation / 4 + 1);
+  if (capacity > 0xFFFFFFF0u) GTEST_SKIP() << "the device allows buffers larger than any group";
+  Group& g = ctx.createGroup("huge", capacity);  // host lanes: untouched virtual memory
+  g.setActions({Move{}});
+  try {
+    ctx.step();
+    FAIL() << "expected OpenCLError";
+  } catch (const OpenCLError& e) {
+    EXPECT_NE(std::string(e.what()).find("capacity"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(g.size(), 0u);
+}
+
+TEST(OpenCLBackend, TheGeneratedKernelTouchesOnlyTheListsAttributes) {
+  const ActionList list{Gravity{Vec3(0.0f, -1.0f, 0.0f)}, Move{}};
+  AttributeSet stored{Attribute::Position, Attribute::Id, Attribute::Velocity, Attribute::Color,
+                      Attribute::Age};
+  const std::string src = detail::ocl::programSource(list, stored, true);
+  const auto act = src.substr(src.find("__kernel void fl_act("));
+  EXPECT_NE(act.find("l_vx"), std::string::npos);
+  EXPECT_NE(act.find("l_age"), std::string::npos);     // Move ages the stored age
+  EXPECT_EQ(act.find("l_r["), std::string::npos);      // color: stored, but no action uses it
+  EXPECT_EQ(act.find("codes[i]"), std::string::npos);  // nothing kills: no kill codes
+  EXPECT_NE(act.find("fl_gravity(&ap[0]"), std::string::npos);
+  EXPECT_NE(act.find("fl_move("), std::string::npos);
+}
