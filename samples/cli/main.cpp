@@ -1,27 +1,37 @@
-// `flurry`: runs sample effects from the command line.
+// `flurry`: runs effect files (built-in or on disk) from the command line.
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include "builtin.hpp"
+#include "flurry/effect.hpp"
 #include "flurry/flurry.hpp"
 #include "outputs.hpp"
+#ifdef FLURRY_CLI_VDB
+#include "flurry/vdb.hpp"
+#endif
 
 namespace fs = std::filesystem;
 
 namespace {
 
+using Clock = std::chrono::steady_clock;
+
 struct RunOptions {
   std::string effect;
-  int frames = 300;
+  std::optional<int> frames;
   std::string out;
   int every = 10;
-  std::uint64_t seed = 1;
-  double dt = 1.0 / 30.0;
+  std::optional<std::uint64_t> seed;
+  std::optional<double> dt;
   unsigned threads = 0;
-  std::size_t capacity = 1'000'000;
+  std::size_t capacity = 0;
   bool quiet = false;
   std::string backend = "cpu";
   std::string device;
@@ -41,18 +51,95 @@ std::vector<std::unique_ptr<flurry::cli::Plugin>> makePlugins() {
   return plugins;
 }
 
+flurry::EffectLoadOptions loadOptions() {
+  flurry::EffectLoadOptions o;
+#ifdef FLURRY_CLI_VDB
+  // The core does not link OpenVDB; the tool lends the loader its reader.
+  o.fieldResolver = [](const fs::path& file, const std::string& grid) {
+    return flurry::vdb::readVectorField(file, grid);
+  };
+#endif
+  return o;
+}
+
 std::string frameName(const std::string& base, int frame, const char* ext) {
   char buf[32];
   std::snprintf(buf, sizeof buf, ".%04d.%s", frame, ext);
   return base + buf;
 }
 
-int run(const RunOptions& o, std::vector<std::unique_ptr<flurry::cli::Plugin>>& plugins) {
-  const flurry::samples::Sample* sample = flurry::samples::findSample(o.effect);
-  if (!sample) {
-    std::cerr << "flurry: no built-in effect named '" << o.effect << "' (see `flurry list`)\n";
-    return 2;
+std::string hms(double secs) {
+  const long s = long(secs + 0.5);
+  char buf[32];
+  if (s >= 3600)
+    std::snprintf(buf, sizeof buf, "%ld:%02ld:%02ld", s / 3600, s / 60 % 60, s % 60);
+  else
+    std::snprintf(buf, sizeof buf, "%ld:%02ld", s / 60, s % 60);
+  return buf;
+}
+
+/// A one-line progress bar with ETA on stderr. It appears only once a run has taken a second
+/// (short runs stay silent), on a terminal or when FLURRY_PROGRESS=1.
+class Progress {
+ public:
+  Progress(int total, bool quiet) : total_(total), start_(Clock::now()) {
+    tty_ = ::isatty(STDERR_FILENO) == 1;
+    const char* env = std::getenv("FLURRY_PROGRESS");
+    active_ = !quiet && (env ? std::string(env) == "1" : tty_);
   }
+  ~Progress() { clear(); }
+  bool active() const { return active_; }
+  /// Starts the clock (after the outputs' set-up, so that the ETA measures steps alone).
+  void start() { start_ = Clock::now(); }
+
+  void update(int done) {
+    if (!active_) return;
+    const auto now = Clock::now();
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    // A terminal redraws in place; a log (FLURRY_PROGRESS=1) gets a line a second.
+    const auto every = std::chrono::milliseconds(tty_ ? 100 : 1000);
+    if (elapsed < 1.0 || (shown_ && now - last_ < every && done < total_)) return;
+    last_ = now;
+    shown_ = true;
+    const double frac = total_ > 0 ? double(done) / total_ : 1.0;
+    const int width = 30, fill = int(frac * width);
+    std::string bar(std::size_t(fill), '#');
+    bar.append(std::size_t(width - fill), '.');
+    const double eta = done > 0 ? elapsed * (total_ - done) / done : 0.0;
+    std::fprintf(stderr, "%s[%s] %3d%%  frame %d/%d  %s elapsed  ETA %s%s", tty_ ? "\r" : "",
+                 bar.c_str(), int(frac * 100), done, total_, hms(elapsed).c_str(), hms(eta).c_str(),
+                 tty_ ? "\033[K" : "\n");
+    std::fflush(stderr);
+  }
+
+  /// Removes the bar (before anything else is printed, and at the end).
+  void clear() {
+    if (!shown_) return;
+    std::fprintf(stderr, tty_ ? "\r\033[K" : "");
+    std::fflush(stderr);
+    shown_ = false;
+  }
+
+ private:
+  int total_;
+  Clock::time_point start_, last_;
+  bool tty_ = false, active_ = false, shown_ = false;
+};
+
+void printStats(const flurry::Group& g, int frame, double time) {
+  const flurry::Bounds b = g.bounds();
+  std::printf("frame %4d  t=%7.3fs  %-10s live %8zu", frame, time, g.name().c_str(), g.size());
+  if (!b.empty)
+    std::printf("  bounds (%.2f %.2f %.2f)..(%.2f %.2f %.2f)", b.min.x, b.min.y, b.min.z, b.max.x,
+                b.max.y, b.max.z);
+  if (!g.strands().position.empty())
+    std::printf("  strands %zu (%zu vertices)", g.strands().size(), g.strands().vertexCount());
+  std::printf("\n");
+}
+
+int run(const RunOptions& o, std::vector<std::unique_ptr<flurry::cli::Plugin>>& plugins) {
+  const flurry::Effect fx = flurry::samples::loadEffectOrSample(o.effect, loadOptions());
+  const int frames = o.frames.value_or(fx.frames);
   if (!o.out.empty()) {
     std::error_code ec;
     fs::create_directories(o.out, ec);
@@ -61,57 +148,101 @@ int run(const RunOptions& o, std::vector<std::unique_ptr<flurry::cli::Plugin>>& 
       return 1;
     }
   }
-  flurry::ContextOptions opts;
-  opts.seed = o.seed;
-  opts.dt = o.dt;
+  flurry::ContextOptions opts = fx.contextOptions();
+  if (o.seed) opts.seed = *o.seed;
+  if (o.dt) opts.dt = *o.dt;
   opts.threads = o.threads;
   opts.backend = o.backend == "opencl" ? flurry::Backend::OpenCL
                  : o.backend == "auto" ? flurry::Backend::Auto
                                        : flurry::Backend::Cpu;
   opts.device = o.device;
   flurry::Context ctx(opts);
-  sample->build(ctx, o.capacity);
-  const flurry::cli::RunInfo info{o.effect, o.frames, o.quiet};
+  fx.build(ctx, o.capacity);
+
+  flurry::cli::RunInfo info{fx.name, frames, o.quiet};
+  info.effectFile = &fx;
+  info.render = fx.render;
+  Progress progress(frames, o.quiet);
+  info.progress = progress.active();
   for (auto& p : plugins)
     if (p->enabled()) p->begin(ctx, info);
+  progress.start();
 
-  const auto start = std::chrono::steady_clock::now();
+  // Per-frame lines only where no bar is drawn (a log, a pipe): the bar replaces them.
+  const bool perFrame = !o.quiet && !progress.active();
+  const auto start = Clock::now();
   int written = 0;
-  for (int frame = 1; frame <= o.frames; ++frame) {
-    ctx.step();
-    const bool save = !o.out.empty() && (frame % o.every == 0 || frame == o.frames);
-    for (flurry::Group* g : ctx.groups()) {
-      if (!o.quiet) {
-        const flurry::Bounds b = g->bounds();
-        std::printf("frame %4d  t=%7.3fs  %-10s live %8zu", frame, ctx.time(), g->name().c_str(),
-                    g->size());
-        if (!b.empty)
-          std::printf("  bounds (%.2f %.2f %.2f)..(%.2f %.2f %.2f)", b.min.x, b.min.y, b.min.z,
-                      b.max.x, b.max.y, b.max.z);
-        std::printf("\n");
+  try {
+    for (int frame = 1; frame <= frames; ++frame) {
+      ctx.step();
+      const bool save = !o.out.empty() && (frame % o.every == 0 || frame == frames);
+      for (flurry::Group* g : ctx.groups()) {
+        if (perFrame) printStats(*g, frame, ctx.time());
+        if (save) {
+          flurry::writePly(*g, fs::path(o.out) / frameName(g->name(), frame, "ply"));
+          ++written;
+        }
       }
-      if (save) {
-        flurry::writePly(*g, fs::path(o.out) / frameName(g->name(), frame, "ply"));
-        ++written;
-      }
+      for (auto& p : plugins)
+        if (p->enabled()) p->frame(ctx, frame);
+      progress.update(frame);
     }
+    progress.clear();
     for (auto& p : plugins)
-      if (p->enabled()) p->frame(ctx, frame);
+      if (p->enabled()) p->end(ctx);
+  } catch (...) {
+    progress.clear();
+    throw;
   }
-  for (auto& p : plugins)
-    if (p->enabled()) p->end(ctx);
-  const double secs =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double secs = std::chrono::duration<double>(Clock::now() - start).count();
+  if (o.quiet) {
+    // One line for scripts.
+    unsigned long long emitted = 0, alive = 0, killed = 0, absorbed = 0, dropped = 0;
+    for (flurry::Group* g : ctx.groups()) {
+      const auto& s = g->stats();
+      emitted += s.emitted, alive += g->size(), killed += s.killedByAge, absorbed += s.absorbed,
+          dropped += s.droppedAtCapacity;
+    }
+    std::printf(
+        "%s: %d steps in %.3f s; emitted %llu, alive %llu, killed by age %llu, absorbed "
+        "%llu, dropped at capacity %llu\n",
+        fx.name.c_str(), frames, secs, emitted, alive, killed, absorbed, dropped);
+    return 0;
+  }
   for (flurry::Group* g : ctx.groups()) {
+    if (!perFrame) printStats(*g, frames, ctx.time());
     const auto& s = g->stats();
-    std::printf("%s: %d steps in %.3f s; emitted %llu, alive %zu, killed by age %llu, absorbed %llu, "
-                "dropped at capacity %llu\n",
-                g->name().c_str(), o.frames, secs, (unsigned long long)s.emitted, g->size(),
-                (unsigned long long)s.killedByAge, (unsigned long long)s.absorbed,
-                (unsigned long long)s.droppedAtCapacity);
+    std::printf(
+        "%s: %d steps in %.3f s; emitted %llu, alive %zu, killed by age %llu, absorbed "
+        "%llu, dropped at capacity %llu",
+        g->name().c_str(), frames, secs, (unsigned long long)s.emitted, g->size(),
+        (unsigned long long)s.killedByAge, (unsigned long long)s.absorbed,
+        (unsigned long long)s.droppedAtCapacity);
+    if (s.emittersSpawned > 0)
+      std::printf(", emitters spawned %llu", (unsigned long long)s.emittersSpawned);
+    std::printf("\n");
   }
   if (!o.out.empty()) std::printf("wrote %d PLY files to %s\n", written, o.out.c_str());
   return 0;
+}
+
+/// Loads each effect and builds it into a scratch context (so the core's own checks run too).
+int validate(const std::vector<std::string>& files) {
+  int bad = 0;
+  for (const std::string& f : files) {
+    try {
+      const flurry::Effect fx = flurry::samples::loadEffectOrSample(f, loadOptions());
+      flurry::ContextOptions co = fx.contextOptions();
+      co.threads = 1;
+      flurry::Context ctx(co);
+      fx.build(ctx, 64);  // a small capacity: the checks do not depend on it
+      std::printf("%s: ok\n", f.c_str());
+    } catch (const flurry::Error& e) {
+      std::cerr << "flurry: " << e.what() << "\n";
+      ++bad;
+    }
+  }
+  return bad ? 1 : 0;
 }
 
 }  // namespace
@@ -121,20 +252,29 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   RunOptions o;
   CLI::App* runCmd = app.add_subcommand("run", "run an effect and write its frames");
-  runCmd->add_option("effect", o.effect, "a built-in effect name (see `flurry list`)")->required();
-  runCmd->add_option("--frames", o.frames, "steps to run")->check(CLI::Range(1, 100000000));
+  runCmd
+      ->add_option("effect", o.effect,
+                   "a built-in effect name (see `flurry list`) or an effect file (.json)")
+      ->required();
+  runCmd->add_option("--frames", o.frames, "steps to run (default: the effect's)")
+      ->check(CLI::Range(1, 100000000));
   runCmd->add_option("--out", o.out, "folder for the frames (PLY point clouds)");
   runCmd->add_option("--every", o.every, "write every N frames")->check(CLI::Range(1, 1000000));
-  runCmd->add_option("--seed", o.seed, "random seed");
-  runCmd->add_option("--dt", o.dt, "seconds per step")->check(CLI::Range(1e-6, 10.0));
+  runCmd->add_option("--seed", o.seed, "random seed (default: the effect's)");
+  runCmd->add_option("--dt", o.dt, "seconds per step (default: the effect's)")
+      ->check(CLI::Range(1e-6, 10.0));
   runCmd->add_option("--threads", o.threads, "worker threads (0: all cores)");
-  runCmd->add_option("--capacity", o.capacity, "particles per group at most")
-      ->check(CLI::Range(std::size_t(1), std::size_t(1) << 31));
-  runCmd->add_flag("--quiet", o.quiet, "print only the summary");
+  runCmd->add_option("--capacity", o.capacity, "cap every group's capacity (0: the effect's)")
+      ->check(CLI::Range(std::size_t(0), std::size_t(1) << 31));
+  runCmd->add_flag("--quiet", o.quiet, "print only errors and a one-line summary");
   runCmd->add_option("--backend", o.backend, "cpu, opencl or auto")
       ->check(CLI::IsMember({"cpu", "opencl", "auto"}));
   runCmd->add_option("--device", o.device, "OpenCL platform or device name (a substring)");
   app.add_subcommand("list", "list the built-in effects");
+  std::vector<std::string> toValidate;
+  CLI::App* validateCmd =
+      app.add_subcommand("validate", "check effect files: print \"ok\" or the first error");
+  validateCmd->add_option("effect", toValidate, "effect files (or built-in names)")->required();
   auto plugins = makePlugins();
   for (auto& p : plugins) p->addOptions(app, *runCmd);
 
@@ -153,6 +293,7 @@ int main(int argc, char** argv) {
         std::printf("%-12s %s\n", s.name.c_str(), s.description.c_str());
       return 0;
     }
+    if (validateCmd->parsed()) return validate(toValidate);
     return run(o, plugins);
   } catch (const flurry::Error& e) {
     std::cerr << "flurry: " << e.what() << "\n";

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "flurry/effect.hpp"
 #include "flurry/flurry.hpp"
 
 namespace flurry::cli {
@@ -16,6 +17,13 @@ struct RunInfo {
   std::string effect;  ///< the effect's name, used to name output files
   int frames = 0;
   bool quiet = false;
+  /// The loaded effect file (valid during the run).
+  const Effect* effectFile = nullptr;
+  /// Its `render` object as JSON text ("{}" when it has none); see docs/rendering.md.
+  std::string render = "{}";
+  /// The tool draws a progress bar with ETA on stderr during this run: a plugin should draw
+  /// none of its own (it may report in end()).
+  bool progress = false;
 };
 
 class Plugin {

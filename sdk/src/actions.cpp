@@ -290,8 +290,7 @@ bool isForce(const Action& a) {
          std::holds_alternative<Jet>(a) || std::holds_alternative<Explosion>(a) ||
          std::holds_alternative<RandomAccel>(a) || std::holds_alternative<Turbulence>(a) ||
          std::holds_alternative<ElectricField>(a) || std::holds_alternative<MagneticField>(a) ||
-         std::holds_alternative<SampledField>(a) || std::holds_alternative<Follow>(a) ||
-         std::holds_alternative<TargetVelocity>(a);
+         std::holds_alternative<SampledField>(a) || std::holds_alternative<Follow>(a);
 }
 
 bool hasClosedForm(const Action& a) {

@@ -342,8 +342,9 @@ std::string actionName(const Action& a);
 /// velocity, in list order, then moves with the new velocity: symplectic, first order, and the
 /// behaviour of the classic API's Gravity/Move lists. The others gather the force actions that
 /// come before a Move (Gravity, Damping, OrbitPoint, OrbitLine, Gravitate, Vortex, Jet,
-/// Explosion, RandomAccel, Turbulence, ElectricField, MagneticField, SampledField, Follow,
-/// TargetVelocity) into one acceleration a(p, v, t) and integrate it inside Move:
+/// Explosion, RandomAccel, Turbulence, ElectricField, MagneticField, SampledField, Follow;
+/// Vortex as k·(u - v)) into one acceleration a(p, v, t) and integrate it inside Move
+/// (TargetVelocity keeps its own exact update, so it never overshoots):
 /// ExplicitEuler (p += v·dt, v += a·dt: the textbook first-order method), VelocityVerlet
 /// (second order, symplectic for position-only forces), RK4 (fourth order), or Exact (closed
 /// form for constant acceleration with linear drag: Gravity, Damping, ElectricField only).

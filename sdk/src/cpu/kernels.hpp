@@ -173,7 +173,6 @@ inline void bouncePlanarLoop(float* __restrict px, float* __restrict py, float* 
                              std::size_t n, float dt, Vec3 P, Vec3 N, OnPiece onPiece,
                              const Bounce& b) {
   const Reflect reflect{b.restitution, 1.0f - b.friction, b.cutoff * b.cutoff};
-  const float scaleP = std::abs(P.x) + std::abs(P.y) + std::abs(P.z);
   for (std::size_t i = 0; i < n; ++i) {
     const float x = px[i], y = py[i], z = pz[i];
     const float vx = vxs[i], vy = vys[i], vz = vzs[i];
@@ -191,8 +190,15 @@ inline void bouncePlanarLoop(float* __restrict px, float* __restrict py, float* 
     // Where Move will put it; push it out if rounding left it on or behind the plane.
     const float qx = nx + nvx * dt, qy = ny + nvy * dt, qz = nz + nvz * dt;
     const float qd = side * ((qx - P.x) * N.x + (qy - P.y) * N.y + (qz - P.z) * N.z);
-    const float margin = 4e-7f * (std::abs(qx) + std::abs(qy) + std::abs(qz) + scaleP) + 1e-30f;
-    const float push = std::max(2.0f * margin - qd, 0.0f) * side;
+    // A few ulps of what decides the side: the coordinates along the normal, and the step
+    // Move adds to them (p + v·dt loses bits to cancellation when |v·dt| is large). Far from
+    // the origin along the plane this stays small, so bounces do not gain height.
+    const float margin =
+        1.2e-7f * (std::abs(N.x) * (std::abs(qx) + std::abs(P.x) + std::abs(nvx * dt)) +
+                   std::abs(N.y) * (std::abs(qy) + std::abs(P.y) + std::abs(nvy * dt)) +
+                   std::abs(N.z) * (std::abs(qz) + std::abs(P.z) + std::abs(nvz * dt))) +
+        1e-30f;
+    const float push = std::max(margin - qd, 0.0f) * side;
     float ox = x, oy = y, oz = z, ovx = vx, ovy = vy, ovz = vz;
     if (hit) {
       ox = nx + push * N.x;
@@ -242,7 +248,9 @@ inline void bounceSphereLoop(float* __restrict px, float* __restrict py, float* 
     // Signed clearance on the allowed side: outside it is |q| - R, inside R - |q|.
     const float qd = Inside ? R - std::sqrt(qx * qx + qy * qy + qz * qz)
                             : std::sqrt(qx * qx + qy * qy + qz * qz) - R;
-    const float margin = 4e-7f * (std::abs(qx) + std::abs(qy) + std::abs(qz) + scaleC) + 1e-30f;
+    const float margin = 4e-7f * (std::abs(qx) + std::abs(qy) + std::abs(qz) + scaleC +
+                                  std::abs(nvx * dt) + std::abs(nvy * dt) + std::abs(nvz * dt)) +
+                         1e-30f;
     const float push = std::max(2.0f * margin - qd, 0.0f) * (Inside ? -1.0f : 1.0f);
     float ox = x, oy = y, oz = z, ovx = vx, ovy = vy, ovz = vz;
     if (hit) {
@@ -265,7 +273,8 @@ inline void bounceSphereLoop(float* __restrict px, float* __restrict py, float* 
     // bounces again for what is left of the step; if it still would leave, it ends inside.
     for (std::size_t i = 0; i < n; ++i) {
       Vec3 p(px[i], py[i], pz[i]), v(vxs[i], vys[i], vzs[i]);
-      auto out = [&](Vec3 q) { return glm::length(q - C) > R * (1.0f - 1e-6f); };
+      const float slack = 4e-7f * (R + glm::length(v) * dt);
+      auto out = [&](Vec3 q) { return glm::length(q - C) > R - slack; };
       if (!out(p + v * dt)) continue;
       Vec3 pos = p + v * dt;  // recover where the reflected path starts: at the last hit
       float left = dt;
@@ -283,7 +292,10 @@ inline void bounceSphereLoop(float* __restrict px, float* __restrict py, float* 
         v = Vec3(nvx, nvy, nvz);
       }
       pos = cur + v * left;
-      if (out(pos)) pos = C + (pos - C) * (R * (1.0f - 4e-6f) / glm::length(pos - C));
+      // Inside by more than Move's rounding of p + v·dt, which grows with |v|·dt.
+      const float margin = 4e-6f * R + 1e-6f * glm::length(v) * dt;
+      if (glm::length(pos - C) > R - margin)
+        pos = C + (pos - C) * (std::max(R - margin, 0.5f * R) / glm::length(pos - C));
       p = pos - v * dt;
       px[i] = p.x;
       py[i] = p.y;

@@ -1,0 +1,101 @@
+// Effect files: a whole scene (groups, emitters, prime emitters, action lists, render
+// settings) described in JSON, loaded, validated and built into a Context.
+// The format is documented in docs/effect-format.md.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "flurry/actions.hpp"
+#include "flurry/context.hpp"
+#include "flurry/emitter.hpp"
+#include "flurry/error.hpp"
+#include "flurry/field.hpp"
+#include "flurry/group.hpp"
+
+namespace flurry {
+
+/// A malformed or invalid effect file. what() is "FILE: JSON.PATH: why", e.g.
+/// `fountain.json: groups[0].emitters[2].rate: must be finite and >= 0`;
+/// parameter() is the JSON path alone (empty for a syntax error, whose why() gives the line
+/// and column).
+class EffectError : public InvalidArgument {
+ public:
+  EffectError(std::string file, std::string path, std::string why);
+  const char* what() const noexcept override { return message_.c_str(); }
+  const std::string& file() const noexcept { return file_; }
+  const std::string& path() const noexcept { return parameter(); }
+  const std::string& why() const noexcept { return why_; }
+
+ private:
+  std::string file_, why_, message_;
+};
+
+/// One group of an effect, as loaded (validated, not yet built).
+struct EffectGroup {
+  std::string name;
+  std::size_t capacity = 0;
+  std::vector<Emitter> emitters;
+  std::vector<PrimeEmitter> primeEmitters;
+  /// The action list, with the 2-D constraint already inserted for a `mode2d` group.
+  ActionList actions;
+  HairOptions hair;
+  /// Attributes stored although no action reads them (a renderer or exporter will).
+  AttributeSet require;
+};
+
+/// A loaded effect file.
+struct Effect {
+  std::string name;
+  std::string description;  ///< one line, shown by `flurry list`
+  double dt = 1.0 / 30.0;   ///< seconds per step
+  std::uint64_t seed = 1;
+  int frames = 300;  ///< steps `flurry run` takes by default
+  std::vector<EffectGroup> groups;
+  /// The `render` object as JSON text ("{}" when absent); the core does not read it, a
+  /// renderer parses it (docs/rendering.md).
+  std::string render = "{}";
+  /// The file it came from (empty for an embedded or in-memory effect).
+  std::filesystem::path file;
+
+  /// ContextOptions with this effect's seed and dt (the rest default).
+  ContextOptions contextOptions() const;
+  /// Creates the groups in `ctx` with their emitters, actions, hair options and required
+  /// attributes. maxCapacity > 0 caps every group's capacity. Returns the groups created.
+  /// Errors raised by the core are rethrown as EffectError naming the group.
+  std::vector<Group*> build(Context& ctx, std::size_t maxCapacity = 0) const;
+};
+
+/// Reads a sampled vector field kept outside the effect file (`{"vdb": "file.vdb", "grid":
+/// "vel"}`). The path is already resolved against the effect file's folder. Throw an Error on
+/// failure; the loader reports it with the field's JSON path.
+using FieldResolver =
+    std::function<VectorField(const std::filesystem::path& file, const std::string& grid)>;
+
+struct EffectLoadOptions {
+  /// For `{"vdb": ...}` fields; without one such a field is an error (the core does not
+  /// link OpenVDB: `flurry` passes flurry::vdb::readVectorField when built with it).
+  FieldResolver fieldResolver;
+  /// Relative paths in the effect resolve against this folder (loadEffect: the file's).
+  std::filesystem::path baseDir;
+};
+
+/// Parses and validates an effect from JSON text. `fileName` names it in errors.
+/// Throws EffectError; never anything else for bad input (std::bad_alloc aside).
+Effect parseEffect(std::string_view json, const std::string& fileName = "<effect>",
+                   const EffectLoadOptions& options = {});
+
+/// Reads, parses and validates an effect file. Throws EffectError (IoError-like failures are
+/// reported as EffectError with an empty JSON path).
+Effect loadEffect(const std::filesystem::path& file, EffectLoadOptions options = {});
+
+/// The names effect files use for attributes ("color", "size", ...): attributeName(a).
+/// Returns false if `name` is not one.
+bool attributeFromName(std::string_view name, Attribute& out);
+
+}  // namespace flurry

@@ -1,0 +1,1260 @@
+// The effect-file loader: JSON (nlohmann) to an Effect, validating every field as it goes so
+// that an error names the file, the JSON path of the bad field and why. Unknown fields are
+// errors with a suggestion: a typo must not silently become a default.
+#include "flurry/effect.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+
+namespace flurry {
+
+EffectError::EffectError(std::string file, std::string path, std::string why)
+    : InvalidArgument(std::move(path), why), file_(std::move(file)), why_(std::move(why)) {
+  message_ = file_;
+  if (!parameter().empty()) message_ += (message_.empty() ? "" : ": ") + parameter();
+  message_ += (message_.empty() ? "" : ": ") + why_;
+}
+
+bool attributeFromName(std::string_view name, Attribute& out) {
+  for (int i = 0; i < int(Attribute::Count); ++i)
+    if (attributeName(Attribute(i)) == name) {
+      out = Attribute(i);
+      return true;
+    }
+  return false;
+}
+
+namespace {
+
+using json = nlohmann::json;
+
+constexpr int kMaxDepth = 24;  // nested next levels and unions
+constexpr std::size_t kMaxCapacity = std::size_t(1) << 30;
+constexpr std::size_t kMaxInlineSamples = std::size_t(1) << 24;  // dense fields, mesh vertices
+
+// ---- small helpers --------------------------------------------------------------------------
+
+std::size_t editDistance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diag = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      const bool same =
+          std::tolower((unsigned char)a[i - 1]) == std::tolower((unsigned char)b[j - 1]);
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (same ? 0 : 1)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
+}
+
+/// "; did you mean "x"?" for the nearest candidate, if it is near enough to be a typo.
+std::string suggestion(std::string_view got, const std::vector<std::string>& candidates) {
+  const std::string* best = nullptr;
+  std::size_t bestD = std::numeric_limits<std::size_t>::max();
+  for (const std::string& c : candidates) {
+    const std::size_t d = editDistance(got, c);
+    if (d < bestD) bestD = d, best = &c;
+  }
+  if (!best) return {};
+  const std::size_t limit = std::max<std::size_t>(2, std::min(got.size(), best->size()) / 3);
+  return bestD <= limit ? "; did you mean \"" + *best + "\"?" : std::string();
+}
+
+std::string kindOf(const json& j) {
+  switch (j.type()) {
+    case json::value_t::null:
+      return "null";
+    case json::value_t::object:
+      return "an object";
+    case json::value_t::array:
+      return "an array";
+    case json::value_t::string:
+      return "a string";
+    case json::value_t::boolean:
+      return "a boolean";
+    case json::value_t::number_integer:
+    case json::value_t::number_unsigned:
+    case json::value_t::number_float:
+      return "a number";
+    default:
+      return "an unsupported value";
+  }
+}
+
+std::string join(const std::string& path, const std::string& key) {
+  return path.empty() ? key : path + "." + key;
+}
+std::string index(const std::string& path, std::size_t i) {
+  return path + "[" + std::to_string(i) + "]";
+}
+
+/// Effect and group names become parts of output file names (fountain.0010.ply): keep them
+/// to characters that are safe in any file system and cannot climb out of a folder.
+bool safeName(std::string_view s) {
+  if (s.empty() || s.size() > 128 || s[0] == '.' || s[0] == '-') return false;
+  return std::all_of(s.begin(), s.end(), [](char c) {
+    return std::isalnum((unsigned char)c) || c == '_' || c == '-' || c == '.';
+  });
+}
+constexpr const char* kNameRule =
+    "must be 1 to 128 letters, digits, '_', '-' or '.', not starting with '.' or '-'";
+
+/// Nesting depth of a JSON value, without recursion (the render object is kept as text, and
+/// nlohmann's serializer recurses).
+std::size_t depthOf(const json& root) {
+  std::size_t deepest = 0;
+  std::vector<std::pair<const json*, std::size_t>> stack{{&root, 1}};
+  while (!stack.empty()) {
+    const auto [j, d] = stack.back();
+    stack.pop_back();
+    deepest = std::max(deepest, d);
+    if (j->is_structured())
+      for (const json& c : *j) stack.emplace_back(&c, d + 1);
+  }
+  return deepest;
+}
+
+/// The loader's state: which file, how to reach external data, how deep we are.
+struct Loader {
+  std::string file;
+  const EffectLoadOptions* options;
+  mutable int depth = 0;  // nesting of next levels and unions, bounded against deep input
+
+  [[noreturn]] void fail(const std::string& path, const std::string& why) const {
+    throw EffectError(file, path, why);
+  }
+
+  /// Rethrows a core InvalidArgument as an EffectError. `path` is the JSON path of the object
+  /// that was validated; the core's parameter is rewritten to a path under it where it can be.
+  [[noreturn]] void rethrow(const std::string& path, const InvalidArgument& e,
+                            std::string_view corePrefix = {}) const {
+    const std::string& p = e.parameter();
+    std::string why = e.what();
+    if (why.size() > p.size() + 2 && why.compare(0, p.size(), p) == 0)
+      why = why.substr(p.size() + 2);
+    if (!corePrefix.empty() && p.compare(0, corePrefix.size(), corePrefix) == 0) {
+      // The core named the field relative to the object: "sphere.outerRadius" ->
+      // "shape.outerRadius".
+      std::string rest = p.substr(corePrefix.size());
+      if (!rest.empty() && rest[0] == '.') rest = rest.substr(1);
+      fail(rest.empty() ? path : join(path, rest), why);
+    }
+    if (corePrefix.empty() && p.compare(0, path.size(), path) == 0) fail(p, why);
+    fail(path, p.empty() ? why : p + ": " + why);
+  }
+};
+
+/// An object being read: records the keys asked for, so that finish() can report any other
+/// key as unknown, with the nearest known name.
+class Obj {
+ public:
+  Obj(const json& j, std::string path, const Loader& L) : j_(j), path_(std::move(path)), L_(L) {
+    if (!j.is_object()) L.fail(path_, "expected an object, got " + kindOf(j));
+  }
+  const std::string& path() const { return path_; }
+  std::string at(const char* key) const { return join(path_, key); }
+  const Loader& loader() const { return L_; }
+
+  /// The value of `key`, or null if absent (absent and null are the same: the default).
+  const json* get(const char* key) {
+    known_.emplace_back(key);
+    const auto it = j_.find(key);
+    if (it == j_.end() || it->is_null()) return nullptr;
+    return &*it;
+  }
+  bool has(const char* key) const {
+    const auto it = j_.find(key);
+    return it != j_.end() && !it->is_null();
+  }
+  const json& require(const char* key, const char* what = nullptr) {
+    const json* v = get(key);
+    if (!v) L_.fail(at(key), what ? std::string("missing (") + what + ")" : "missing (required)");
+    return *v;
+  }
+  template <class T>
+  void opt(const char* key, T& out);
+  template <class T>
+  void req(const char* key, T& out, const char* what = nullptr);
+
+  void finish() const {
+    for (auto it = j_.begin(); it != j_.end(); ++it) {
+      const std::string& k = it.key();
+      if (k == "$comment") continue;  // documentation inside the file
+      if (std::find(known_.begin(), known_.end(), k) != known_.end()) continue;
+      L_.fail(join(path_, k), "unknown field" + suggestion(k, known_));
+    }
+  }
+
+ private:
+  const json& j_;
+  std::string path_;
+  const Loader& L_;
+  std::vector<std::string> known_;
+};
+
+// ---- values ---------------------------------------------------------------------------------
+
+double readNumber(const json& j, const std::string& path, const Loader& L, bool allowInf) {
+  if (j.is_string() && allowInf) {
+    const auto& s = j.get_ref<const std::string&>();
+    if (s == "inf" || s == "infinity") return std::numeric_limits<double>::infinity();
+    if (s == "-inf" || s == "-infinity") return -std::numeric_limits<double>::infinity();
+    L.fail(path, "expected a number or \"inf\", got the string \"" + s + "\"");
+  }
+  if (!j.is_number()) L.fail(path, "expected a number, got " + kindOf(j));
+  const double v = j.get<double>();
+  if (!std::isfinite(v)) L.fail(path, "not finite");
+  return v;
+}
+
+void read(const json& j, const std::string& path, const Loader& L, double& out) {
+  out = readNumber(j, path, L, true);
+}
+void read(const json& j, const std::string& path, const Loader& L, float& out) {
+  const double v = readNumber(j, path, L, true);
+  if (std::isfinite(v) && std::abs(v) > double(std::numeric_limits<float>::max()))
+    L.fail(path, "out of range for a float");
+  out = float(v);
+}
+void read(const json& j, const std::string& path, const Loader& L, bool& out) {
+  if (!j.is_boolean()) L.fail(path, "expected true or false, got " + kindOf(j));
+  out = j.get<bool>();
+}
+void read(const json& j, const std::string& path, const Loader& L, std::string& out) {
+  if (!j.is_string()) L.fail(path, "expected a string, got " + kindOf(j));
+  out = j.get<std::string>();
+}
+
+/// An integer in [lo, hi]; a float is accepted when it is integral (1e3).
+std::uint64_t readInteger(const json& j, const std::string& path, const Loader& L, std::uint64_t lo,
+                          std::uint64_t hi) {
+  const std::string range =
+      "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  if (!j.is_number()) L.fail(path, "expected " + range + ", got " + kindOf(j));
+  std::uint64_t v = 0;
+  if (j.is_number_unsigned()) {
+    v = j.get<std::uint64_t>();
+  } else if (j.is_number_integer()) {
+    const std::int64_t s = j.get<std::int64_t>();
+    if (s < 0) L.fail(path, "must be " + range);
+    v = std::uint64_t(s);
+  } else {
+    const double d = j.get<double>();
+    if (!std::isfinite(d) || d != std::floor(d) || d < 0 || d >= 18446744073709551616.0)
+      L.fail(path, "must be " + range);
+    v = std::uint64_t(d);
+  }
+  if (v < lo || v > hi) L.fail(path, "must be " + range);
+  return v;
+}
+
+void read(const json& j, const std::string& path, const Loader& L, std::uint32_t& out) {
+  out = std::uint32_t(readInteger(j, path, L, 0, 0xFFFFFFFFu));
+}
+void read(const json& j, const std::string& path, const Loader& L, int& out) {
+  out = int(readInteger(j, path, L, 0, std::numeric_limits<int>::max()));
+}
+void read(const json& j, const std::string& path, const Loader& L, std::uint64_t& out) {
+  out = readInteger(j, path, L, 0, std::numeric_limits<std::uint64_t>::max());
+}
+
+const json& arrayOf(const json& j, const std::string& path, const Loader& L, std::size_t n,
+                    const char* what) {
+  if (!j.is_array() || (n && j.size() != n))
+    L.fail(path, std::string("expected ") + what + ", got " +
+                     (j.is_array() ? "an array of " + std::to_string(j.size()) : kindOf(j)));
+  return j;
+}
+
+void read(const json& j, const std::string& path, const Loader& L, Vec3& out) {
+  arrayOf(j, path, L, 3, "[x, y, z]");
+  for (int i = 0; i < 3; ++i) read(j[std::size_t(i)], index(path, i), L, out[i]);
+}
+
+void read(const json& j, const std::string& path, const Loader& L, Vec4& out) {
+  if (!j.is_array() || (j.size() != 3 && j.size() != 4))
+    L.fail(path, "expected [r, g, b] or [r, g, b, a], got " +
+                     (j.is_array() ? "an array of " + std::to_string(j.size()) : kindOf(j)));
+  out.w = 1.0f;
+  for (std::size_t i = 0; i < j.size(); ++i) read(j[i], index(path, i), L, out[int(i)]);
+}
+
+template <class T>
+void Obj::opt(const char* key, T& out) {
+  if (const json* v = get(key)) read(*v, at(key), L_, out);
+}
+template <class T>
+void Obj::req(const char* key, T& out, const char* what) {
+  read(require(key, what), at(key), L_, out);
+}
+
+/// 3, [3, 0.5], {"center": 3, "spread": 0.5 | "percent": 10, "distribution": "normal"}.
+void read(const json& j, const std::string& path, const Loader& L, Fuzzy& out) {
+  if (j.is_number()) {
+    read(j, path, L, out.center);
+    out.spread = 0;
+  } else if (j.is_array()) {
+    arrayOf(j, path, L, 2, "a number, [center, spread] or an object");
+    read(j[0], index(path, 0), L, out.center);
+    read(j[1], index(path, 1), L, out.spread);
+  } else if (j.is_object()) {
+    Obj o(j, path, L);
+    o.req("center", out.center);
+    out.spread = 0;
+    o.opt("spread", out.spread);
+    if (const json* p = o.get("percent")) {
+      if (o.has("spread")) L.fail(o.at("percent"), "give spread or percent, not both");
+      float pct = 0;
+      read(*p, o.at("percent"), L, pct);
+      if (!(pct >= 0)) L.fail(o.at("percent"), "must be >= 0");
+      out = Fuzzy::percent(out.center, pct);
+    }
+    std::string d = "uniform";
+    o.opt("distribution", d);
+    if (d == "uniform")
+      out.distribution = Fuzzy::Distribution::Uniform;
+    else if (d == "normal")
+      out.distribution = Fuzzy::Distribution::Normal;
+    else
+      L.fail(o.at("distribution"),
+             "expected \"uniform\" or \"normal\"" + suggestion(d, {"uniform", "normal"}));
+    o.finish();
+  } else {
+    L.fail(path, "expected a number, [center, spread] or an object, got " + kindOf(j));
+  }
+  try {
+    out.validate(path.c_str());
+  } catch (const InvalidArgument& e) {
+    L.rethrow(path, e);
+  }
+}
+
+struct DepthGuard {
+  const Loader& L;
+  DepthGuard(const Loader& l, const std::string& path) : L(l) {
+    if (++L.depth > kMaxDepth) {
+      --L.depth;
+      L.fail(path, "nested more than " + std::to_string(kMaxDepth) + " levels deep");
+    }
+  }
+  ~DepthGuard() { --L.depth; }
+};
+
+const std::vector<std::string> kDomainTypes = {"point", "line", "triangle", "plane",    "rectangle",
+                                               "disc",  "box",  "sphere",   "cylinder", "cone",
+                                               "blob",  "mesh", "union"};
+
+Domain readDomain(const json& j, const std::string& path, const Loader& L);
+
+Domain readDomainObject(Obj& o, const std::string& type) {
+  const Loader& L = o.loader();
+  Vec3 a(0.0f), b(0.0f), c(0.0f);
+  float outer = 0, inner = 0;
+  auto radii = [&] {
+    o.req("outerRadius", outer, "the radius");
+    o.opt("innerRadius", inner);
+  };
+  if (type == "point") {
+    o.opt("point", a);
+    return Domain::point(a);
+  }
+  if (type == "line") {
+    o.req("p0", a);
+    o.req("p1", b);
+    return Domain::line(a, b);
+  }
+  if (type == "triangle") {
+    o.req("p0", a);
+    o.req("p1", b);
+    o.req("p2", c);
+    return Domain::triangle(a, b, c);
+  }
+  if (type == "plane") {
+    o.opt("point", a);
+    o.req("normal", b);
+    return Domain::plane(a, b);
+  }
+  if (type == "rectangle") {
+    o.opt("origin", a);
+    o.req("u", b);
+    o.req("v", c);
+    return Domain::rectangle(a, b, c);
+  }
+  if (type == "disc") {
+    o.opt("center", a);
+    o.req("normal", b);
+    radii();
+    return Domain::disc(a, b, outer, inner);
+  }
+  if (type == "box") {
+    o.req("min", a);
+    o.req("max", b);
+    return Domain::box(a, b);
+  }
+  if (type == "sphere") {
+    o.opt("center", a);
+    radii();
+    return Domain::sphere(a, outer, inner);
+  }
+  if (type == "cylinder") {
+    o.req("p0", a);
+    o.req("p1", b);
+    radii();
+    return Domain::cylinder(a, b, outer, inner);
+  }
+  if (type == "cone") {
+    o.opt("apex", a);
+    o.req("base", b);
+    radii();
+    return Domain::cone(a, b, outer, inner);
+  }
+  if (type == "blob") {
+    o.opt("center", a);
+    float stddev = 0;
+    o.req("stddev", stddev);
+    return Domain::blob(a, stddev);
+  }
+  if (type == "mesh") {
+    const json& vs = o.require("vertices");
+    const std::string vp = o.at("vertices");
+    arrayOf(vs, vp, L, 0, "an array of [x, y, z]");
+    if (vs.size() > kMaxInlineSamples) L.fail(vp, "too many vertices");
+    std::vector<Vec3> vertices(vs.size());
+    for (std::size_t i = 0; i < vs.size(); ++i) read(vs[i], index(vp, i), L, vertices[i]);
+    const json& ts = o.require("triangles");
+    const std::string tp = o.at("triangles");
+    arrayOf(ts, tp, L, 0, "an array of [i, j, k]");
+    if (ts.size() > kMaxInlineSamples) L.fail(tp, "too many triangles");
+    std::vector<glm::uvec3> tris(ts.size());
+    for (std::size_t i = 0; i < ts.size(); ++i) {
+      arrayOf(ts[i], index(tp, i), L, 3, "[i, j, k]");
+      for (int k = 0; k < 3; ++k) {
+        const std::string ip = index(index(tp, i), std::size_t(k));
+        if (vertices.empty()) L.fail(ip, "the mesh has no vertices");
+        tris[i][k] =
+            std::uint32_t(readInteger(ts[i][std::size_t(k)], ip, L, 0, vertices.size() - 1));
+      }
+    }
+    return Domain::mesh(std::move(vertices), std::move(tris));
+  }
+  // union
+  const json& ps = o.require("parts");
+  const std::string pp = o.at("parts");
+  arrayOf(ps, pp, L, 0, "an array of domains");
+  if (ps.empty()) L.fail(pp, "a union needs at least one part");
+  std::vector<Domain> parts;
+  for (std::size_t i = 0; i < ps.size(); ++i) parts.push_back(readDomain(ps[i], index(pp, i), L));
+  return Domain::unite(std::move(parts));
+}
+
+void read(const json& j, const std::string& path, const Loader& L, Domain& out) {
+  out = readDomain(j, path, L);
+}
+
+/// [x, y, z] is a point; otherwise {"type": "sphere", ...}.
+Domain readDomain(const json& j, const std::string& path, const Loader& L) {
+  if (j.is_array()) {
+    Vec3 p;
+    read(j, path, L, p);
+    return Domain::point(p);
+  }
+  DepthGuard guard(L, path);
+  Obj o(j, path, L);
+  std::string type;
+  o.req("type", type,
+        "one of point, line, triangle, plane, rectangle, disc, box, sphere, "
+        "cylinder, cone, blob, mesh, union");
+  if (std::find(kDomainTypes.begin(), kDomainTypes.end(), type) == kDomainTypes.end())
+    L.fail(o.at("type"), "unknown domain \"" + type + "\"" + suggestion(type, kDomainTypes));
+  Domain d;
+  try {
+    d = readDomainObject(o, type);
+  } catch (const EffectError&) {
+    throw;
+  } catch (const InvalidArgument& e) {
+    L.rethrow(path, e, type);
+  }
+  o.finish();
+  return d;
+}
+
+void read(const json& j, const std::string& path, const Loader& L, Falloff& out) {
+  Obj o(j, path, L);
+  o.opt("center", out.center);
+  o.opt("radius", out.radius);
+  o.opt("power", out.power);
+  o.finish();
+}
+
+template <class T, class F>
+void readArray(const json& j, const std::string& path, const Loader& L, std::vector<T>& out,
+               F&& each) {
+  arrayOf(j, path, L, 0, "an array");
+  out.clear();
+  for (std::size_t i = 0; i < j.size(); ++i) {
+    T t{};
+    each(j[i], index(path, i), t);
+    out.push_back(std::move(t));
+  }
+}
+
+void read(const json& j, const std::string& path, const Loader& L, std::vector<Burst>& out) {
+  readArray(j, path, L, out, [&](const json& e, const std::string& p, Burst& b) {
+    Obj o(e, p, L);
+    o.opt("time", b.time);
+    o.req("count", b.count);
+    o.opt("interval", b.interval);
+    o.opt("repeat", b.repeat);
+    o.finish();
+  });
+}
+
+void read(const json& j, const std::string& path, const Loader& L, std::vector<Keyframe>& out) {
+  readArray(j, path, L, out, [&](const json& e, const std::string& p, Keyframe& k) {
+    Obj o(e, p, L);
+    o.req("time", k.time);
+    o.req("position", k.position);
+    o.finish();
+  });
+}
+
+void read(const json& j, const std::string& path, const Loader& L, ParticleType& t) {
+  Obj o(j, path, L);
+  o.opt("weight", t.weight);
+  o.opt("velocity", t.velocity);
+  o.opt("color", t.color);
+  o.opt("alpha", t.alpha);
+  o.opt("size", t.size);
+  o.opt("mass", t.mass);
+  o.opt("lifetime", t.lifetime);
+  o.opt("charge", t.charge);
+  o.opt("up", t.up);
+  o.opt("rotVelocity", t.rotVelocity);
+  o.finish();
+}
+
+void read(const json& j, const std::string& path, const Loader& L, std::vector<ParticleType>& out) {
+  readArray(j, path, L, out,
+            [&](const json& e, const std::string& p, ParticleType& t) { read(e, p, L, t); });
+  if (out.empty()) L.fail(path, "an emitter needs at least one particle type");
+}
+
+/// The fields an emitter and a prime emitter share: where, when and how many.
+template <class E>
+void readCounting(Obj& o, E& e) {
+  o.opt("name", e.name);
+  o.opt("shape", e.shape);
+  o.opt("rate", e.rate);
+  o.opt("bursts", e.bursts);
+  o.opt("position", e.position);
+  o.opt("velocity", e.velocity);
+  o.opt("path", e.path);
+  o.opt("start", e.start);
+  o.opt("stop", e.stop);
+}
+
+Emitter readEmitterFields(const json& j, const std::string& path, const Loader& L) {
+  Obj o(j, path, L);
+  Emitter e;
+  readCounting(o, e);
+  o.opt("types", e.types);
+  o.opt("spacing", e.spacing);
+  o.opt("normalSpeed", e.normalSpeed);
+  o.finish();
+  return e;
+}
+
+Emitter readEmitter(const json& j, const std::string& path, const Loader& L) {
+  Emitter e = readEmitterFields(j, path, L);
+  try {
+    e.validate(path);
+  } catch (const InvalidArgument& x) {
+    L.rethrow(path, x);
+  }
+  return e;
+}
+
+std::shared_ptr<EmitterSpec> readSpec(const json& j, const std::string& path, const Loader& L) {
+  DepthGuard guard(L, path);
+  Obj o(j, path, L);
+  auto s = std::make_shared<EmitterSpec>();
+  if (const json* e = o.get("emitter")) s->emitter = readEmitterFields(*e, o.at("emitter"), L);
+  o.opt("velocity", s->velocity);
+  o.opt("inheritVelocity", s->inheritVelocity);
+  o.opt("lifetime", s->lifetime);
+  o.opt("acceleration", s->acceleration);
+  o.opt("drag", s->drag);
+  o.opt("deathBurst", s->deathBurst);
+  o.opt("deathChildren", s->deathChildren);
+  if (const json* n = o.get("next")) s->next = readSpec(*n, o.at("next"), L);
+  o.finish();
+  return s;
+}
+
+PrimeEmitter readPrime(const json& j, const std::string& path, const Loader& L) {
+  Obj o(j, path, L);
+  PrimeEmitter p;
+  readCounting(o, p);
+  p.child = *readSpec(o.require("child", "the emitters it emits"), o.at("child"), L);
+  o.finish();
+  try {
+    p.validate(path);
+  } catch (const InvalidArgument& x) {
+    L.rethrow(path, x);
+  }
+  return p;
+}
+
+// ---- actions --------------------------------------------------------------------------------
+
+const std::vector<std::string> kActionTypes = {"Gravity",
+                                               "Damping",
+                                               "RotDamping",
+                                               "OrbitPoint",
+                                               "OrbitLine",
+                                               "Gravitate",
+                                               "Vortex",
+                                               "Jet",
+                                               "Explosion",
+                                               "RandomAccel",
+                                               "RandomDisplace",
+                                               "RandomVelocity",
+                                               "RandomRotVelocity",
+                                               "Turbulence",
+                                               "ElectricField",
+                                               "MagneticField",
+                                               "SampledField",
+                                               "Avoid",
+                                               "Follow",
+                                               "MatchVelocity",
+                                               "MatchRotVelocity",
+                                               "TargetVelocity",
+                                               "TargetRotVelocity",
+                                               "TargetColor",
+                                               "TargetSize",
+                                               "SpeedClamp",
+                                               "ColorOverLife",
+                                               "SizeOverLife",
+                                               "Bounce",
+                                               "Sink",
+                                               "SinkVelocity",
+                                               "Block",
+                                               "KillOld",
+                                               "Move",
+                                               "Constrain2D",
+                                               "CopyVertexB",
+                                               "Restore"};
+
+std::shared_ptr<const VectorField> readField(const json& j, const std::string& path,
+                                             const Loader& L) {
+  Obj o(j, path, L);
+  if (o.has("vdb")) {
+    std::string file, grid;
+    o.req("vdb", file);
+    o.opt("grid", grid);
+    o.finish();
+    if (!L.options->fieldResolver)
+      L.fail(o.at("vdb"), "an OpenVDB field needs flurry::vdb; this program was built without it");
+    std::filesystem::path p(file);
+    if (p.is_relative() && !L.options->baseDir.empty()) p = L.options->baseDir / p;
+    VectorField f;
+    try {
+      f = L.options->fieldResolver(p, grid);
+    } catch (const std::exception& e) {
+      L.fail(o.at("vdb"), e.what());
+    }
+    try {
+      f.validate(path.c_str());
+    } catch (const InvalidArgument& e) {
+      L.rethrow(path, e);
+    }
+    return std::make_shared<const VectorField>(std::move(f));
+  }
+  auto f = std::make_shared<VectorField>();
+  o.opt("origin", f->origin);
+  o.opt("voxelSize", f->voxelSize);
+  const json& dims = o.require("dims", "[nx, ny, nz], or \"vdb\": a file");
+  arrayOf(dims, o.at("dims"), L, 3, "[nx, ny, nz]");
+  std::uint64_t total = 1;
+  for (int k = 0; k < 3; ++k) {
+    f->dims[k] = int(readInteger(dims[std::size_t(k)], index(o.at("dims"), std::size_t(k)), L, 1,
+                                 kMaxInlineSamples));
+    total *= std::uint64_t(f->dims[k]);
+    if (total > kMaxInlineSamples)
+      L.fail(o.at("dims"), "more than " + std::to_string(kMaxInlineSamples) +
+                               " samples: keep large fields in a VDB file");
+  }
+  const json& data = o.require("data", "[[x, y, z], ...], x fastest");
+  const std::string dp = o.at("data");
+  arrayOf(data, dp, L, 0, "an array of [x, y, z]");
+  if (data.size() != total)
+    L.fail(dp,
+           "has " + std::to_string(data.size()) + " samples; dims need " + std::to_string(total));
+  f->data.resize(data.size());
+  for (std::size_t i = 0; i < data.size(); ++i) read(data[i], index(dp, i), L, f->data[i]);
+  o.finish();
+  try {
+    f->validate(path.c_str());
+  } catch (const InvalidArgument& e) {
+    L.rethrow(path, e);
+  }
+  return f;
+}
+
+template <class T>
+void readEnum(Obj& o, const char* key, T& out,
+              const std::vector<std::pair<std::string, T>>& names) {
+  std::string s;
+  if (const json* v = o.get(key))
+    read(*v, o.at(key), o.loader(), s);
+  else
+    return;
+  for (const auto& [n, val] : names)
+    if (n == s) {
+      out = val;
+      return;
+    }
+  std::vector<std::string> all;
+  std::string list;
+  for (const auto& [n, val] : names) {
+    all.push_back(n);
+    list += (list.empty() ? "" : ", ") + n;
+  }
+  o.loader().fail(o.at(key), "\"" + s + "\" is not one of " + list + suggestion(s, all));
+}
+
+Action readActionBody(Obj& o, const std::string& type) {
+  const Loader& L = o.loader();
+  auto falloff = [&](Falloff& f) { o.opt("falloff", f); };
+  if (type == "Gravity") {
+    Gravity a;
+    o.opt("acceleration", a.acceleration);
+    falloff(a.falloff);
+    return a;
+  }
+  if (type == "Damping") {
+    Damping a;
+    o.opt("rate", a.rate);
+    falloff(a.falloff);
+    return a;
+  }
+  if (type == "RotDamping") {
+    RotDamping a;
+    o.opt("rate", a.rate);
+    return a;
+  }
+  if (type == "OrbitPoint") {
+    OrbitPoint a;
+    o.opt("center", a.center);
+    o.opt("magnitude", a.magnitude);
+    o.opt("epsilon", a.epsilon);
+    o.opt("maxRadius", a.maxRadius);
+    return a;
+  }
+  if (type == "OrbitLine") {
+    OrbitLine a;
+    o.opt("point", a.point);
+    o.opt("axis", a.axis);
+    o.opt("magnitude", a.magnitude);
+    o.opt("epsilon", a.epsilon);
+    o.opt("maxRadius", a.maxRadius);
+    return a;
+  }
+  if (type == "Gravitate" || type == "Follow") {
+    float magnitude = 1.0f, epsilon = 1e-3f, maxRadius = kInfinity;
+    o.opt("magnitude", magnitude);
+    o.opt("epsilon", epsilon);
+    o.opt("maxRadius", maxRadius);
+    if (type == "Follow") return Follow{magnitude, epsilon, maxRadius};
+    return Gravitate{magnitude, epsilon, maxRadius};
+  }
+  if (type == "Vortex") {
+    Vortex a;
+    o.opt("center", a.center);
+    o.opt("axis", a.axis);
+    o.opt("aroundSpeed", a.aroundSpeed);
+    o.opt("coreRadius", a.coreRadius);
+    o.opt("tightness", a.tightness);
+    o.opt("inSpeed", a.inSpeed);
+    o.opt("upSpeed", a.upSpeed);
+    o.opt("responsiveness", a.responsiveness);
+    o.opt("maxRadius", a.maxRadius);
+    return a;
+  }
+  if (type == "Jet") {
+    Jet a;
+    o.opt("center", a.center);
+    o.opt("radius", a.radius);
+    o.opt("acceleration", a.acceleration);
+    return a;
+  }
+  if (type == "Explosion") {
+    Explosion a;
+    o.opt("center", a.center);
+    o.opt("speed", a.speed);
+    o.opt("magnitude", a.magnitude);
+    o.opt("stddev", a.stddev);
+    o.opt("epsilon", a.epsilon);
+    o.opt("time", a.time);
+    return a;
+  }
+  if (type == "RandomAccel") {
+    RandomAccel a;
+    o.opt("acceleration", a.acceleration);
+    falloff(a.falloff);
+    return a;
+  }
+  if (type == "RandomDisplace") {
+    RandomDisplace a;
+    o.opt("displacement", a.displacement);
+    return a;
+  }
+  if (type == "RandomVelocity") {
+    RandomVelocity a;
+    o.opt("velocity", a.velocity);
+    return a;
+  }
+  if (type == "RandomRotVelocity") {
+    RandomRotVelocity a;
+    o.opt("rotVelocity", a.rotVelocity);
+    return a;
+  }
+  if (type == "Turbulence") {
+    Turbulence a;
+    o.opt("amplitude", a.amplitude);
+    o.opt("frequency", a.frequency);
+    o.opt("octaves", a.octaves);
+    o.opt("drift", a.drift);
+    falloff(a.falloff);
+    return a;
+  }
+  if (type == "ElectricField") {
+    ElectricField a;
+    o.opt("field", a.field);
+    falloff(a.falloff);
+    return a;
+  }
+  if (type == "MagneticField") {
+    MagneticField a;
+    o.opt("field", a.field);
+    return a;
+  }
+  if (type == "SampledField") {
+    SampledField a;
+    a.field = readField(o.require("field", "a dense grid or {\"vdb\": file}"), o.at("field"), L);
+    readEnum(o, "mode", a.mode,
+             {{"acceleration", SampledField::Mode::Acceleration},
+              {"velocity", SampledField::Mode::Velocity}});
+    o.opt("strength", a.strength);
+    o.opt("responsiveness", a.responsiveness);
+    return a;
+  }
+  if (type == "Avoid") {
+    Avoid a;
+    o.opt("obstacle", a.obstacle);
+    o.opt("magnitude", a.magnitude);
+    o.opt("epsilon", a.epsilon);
+    o.opt("lookAhead", a.lookAhead);
+    return a;
+  }
+  if (type == "MatchVelocity" || type == "MatchRotVelocity") {
+    float magnitude = 1.0f, epsilon = 1e-3f, maxRadius = 1.0f;
+    o.opt("magnitude", magnitude);
+    o.opt("epsilon", epsilon);
+    o.opt("maxRadius", maxRadius);
+    if (type == "MatchVelocity") return MatchVelocity{magnitude, epsilon, maxRadius};
+    return MatchRotVelocity{magnitude, epsilon, maxRadius};
+  }
+  if (type == "TargetVelocity") {
+    TargetVelocity a;
+    o.opt("velocity", a.velocity);
+    o.opt("rate", a.rate);
+    return a;
+  }
+  if (type == "TargetRotVelocity") {
+    TargetRotVelocity a;
+    o.opt("rotVelocity", a.rotVelocity);
+    o.opt("rate", a.rate);
+    return a;
+  }
+  if (type == "TargetColor") {
+    TargetColor a;
+    o.opt("color", a.color);
+    o.opt("alpha", a.alpha);
+    o.opt("rate", a.rate);
+    return a;
+  }
+  if (type == "TargetSize") {
+    TargetSize a;
+    o.opt("size", a.size);
+    o.opt("rate", a.rate);
+    return a;
+  }
+  if (type == "SpeedClamp") {
+    SpeedClamp a;
+    o.opt("minSpeed", a.minSpeed);
+    o.opt("maxSpeed", a.maxSpeed);
+    return a;
+  }
+  if (type == "ColorOverLife") {
+    ColorOverLife a;
+    if (const json* k = o.get("keys"))
+      readArray(*k, o.at("keys"), L, a.keys,
+                [&](const json& e, const std::string& p, ColorOverLife::Key& key) {
+                  Obj ko(e, p, L);
+                  ko.req("t", key.t);
+                  ko.req("color", key.color);
+                  ko.finish();
+                });
+    return a;
+  }
+  if (type == "SizeOverLife") {
+    SizeOverLife a;
+    if (const json* k = o.get("keys"))
+      readArray(*k, o.at("keys"), L, a.keys,
+                [&](const json& e, const std::string& p, SizeOverLife::Key& key) {
+                  Obj ko(e, p, L);
+                  ko.req("t", key.t);
+                  ko.req("size", key.size);
+                  ko.finish();
+                });
+    return a;
+  }
+  if (type == "Bounce") {
+    Bounce a;
+    o.req("surface", a.surface, "the deflecting surface, a domain");
+    o.opt("restitution", a.restitution);
+    o.opt("friction", a.friction);
+    o.opt("cutoff", a.cutoff);
+    o.opt("inside", a.inside);
+    o.opt("planeNormal", a.planeNormal);
+    return a;
+  }
+  if (type == "Sink") {
+    Sink a;
+    o.req("region", a.region, "the absorbing region or surface, a domain");
+    o.opt("killInside", a.killInside);
+    o.opt("passThrough", a.passThrough);
+    readEnum(o, "mode", a.mode,
+             {{"inside", Sink::Mode::Inside},
+              {"outside", Sink::Mode::Outside},
+              {"enter", Sink::Mode::Enter},
+              {"leave", Sink::Mode::Leave},
+              {"hit", Sink::Mode::Hit}});
+    return a;
+  }
+  if (type == "SinkVelocity") {
+    SinkVelocity a;
+    o.opt("velocity", a.velocity);
+    o.opt("killInside", a.killInside);
+    return a;
+  }
+  if (type == "Block") {
+    Block a;
+    o.req("region", a.region, "the region that hides particles, a domain");
+    return a;
+  }
+  if (type == "KillOld") return KillOld{};
+  if (type == "Move") return Move{};
+  if (type == "Constrain2D") {
+    Constrain2D a;
+    o.opt("point", a.point);
+    o.opt("normal", a.normal);
+    return a;
+  }
+  if (type == "CopyVertexB") {
+    CopyVertexB a;
+    o.opt("copyPosition", a.copyPosition);
+    o.opt("copyVelocity", a.copyVelocity);
+    return a;
+  }
+  // Restore
+  Restore a;
+  o.opt("start", a.start);
+  o.opt("duration", a.duration);
+  return a;
+}
+
+Action readAction(const json& j, const std::string& path, const Loader& L) {
+  Obj o(j, path, L);
+  std::string type;
+  o.req("type", type, "the action's name, e.g. \"Gravity\"");
+  if (type == "Callback")
+    L.fail(o.at("type"), "a Callback runs C++ code and cannot be described in an effect file");
+  if (std::find(kActionTypes.begin(), kActionTypes.end(), type) == kActionTypes.end())
+    L.fail(o.at("type"), "unknown action \"" + type + "\"" + suggestion(type, kActionTypes));
+  Action a = readActionBody(o, type);
+  o.finish();
+  return a;
+}
+
+/// Appends `a` (the JSON actions[i]) to `list`, rewriting the core's "actions[i].Name.field"
+/// to the JSON path "groups[g].actions[i].field".
+void addAction(ActionList& list, const Action& a, const std::string& path, const Loader& L) {
+  try {
+    list.add(a);
+  } catch (const InvalidArgument& e) {
+    const std::string prefix = "actions[" + std::to_string(list.size()) + "]." + actionName(a);
+    L.rethrow(path, e, prefix);
+  }
+}
+
+// ---- groups and the effect ------------------------------------------------------------------
+
+EffectGroup readGroup(const json& j, const std::string& path, const Loader& L,
+                      const std::vector<EffectGroup>& before) {
+  Obj o(j, path, L);
+  EffectGroup g;
+  g.name = "group" + std::to_string(before.size());
+  o.opt("name", g.name);
+  if (!safeName(g.name)) L.fail(o.at("name"), kNameRule);
+  for (const EffectGroup& b : before)
+    if (b.name == g.name) L.fail(o.at("name"), "a group named \"" + g.name + "\" already exists");
+  g.capacity = std::size_t(readInteger(o.require("capacity", "the most particles the group holds"),
+                                       o.at("capacity"), L, 1, kMaxCapacity));
+  if (const json* es = o.get("emitters")) {
+    arrayOf(*es, o.at("emitters"), L, 0, "an array of emitters");
+    for (std::size_t i = 0; i < es->size(); ++i)
+      g.emitters.push_back(readEmitter((*es)[i], index(o.at("emitters"), i), L));
+  }
+  if (const json* ps = o.get("primeEmitters")) {
+    arrayOf(*ps, o.at("primeEmitters"), L, 0, "an array of prime emitters");
+    for (std::size_t i = 0; i < ps->size(); ++i)
+      g.primeEmitters.push_back(readPrime((*ps)[i], index(o.at("primeEmitters"), i), L));
+  }
+
+  // 2-D mode: `true` is the z = 0 plane.
+  std::optional<Constrain2D> plane;
+  if (const json* m = o.get("mode2d")) {
+    const std::string mp = o.at("mode2d");
+    if (m->is_boolean()) {
+      if (m->get<bool>()) plane = Constrain2D{};
+    } else {
+      Obj mo(*m, mp, L);
+      Constrain2D c;
+      mo.opt("point", c.point);
+      mo.opt("normal", c.normal);
+      mo.finish();
+      const float n = glm::length(c.normal);
+      if (!(n > 1e-12f) || !std::isfinite(n)) L.fail(mo.at("normal"), "must be a non-zero vector");
+      c.normal /= n;
+      plane = c;
+    }
+  }
+
+  ActionList actions;
+  std::vector<Action> parsed;
+  if (const json* as = o.get("actions")) {
+    const std::string ap = o.at("actions");
+    arrayOf(*as, ap, L, 0, "an array of actions");
+    for (std::size_t i = 0; i < as->size(); ++i) {
+      Action a = readAction((*as)[i], index(ap, i), L);
+      // In a 2-D group a segment deflects within the group's plane unless told otherwise.
+      if (plane && std::holds_alternative<Bounce>(a) && !(*as)[i].contains("planeNormal"))
+        std::get<Bounce>(a).planeNormal = plane->normal;
+      addAction(actions, a, index(ap, i), L);
+      parsed.push_back(std::move(a));
+    }
+  }
+  const bool hasConstrain = std::any_of(parsed.begin(), parsed.end(), [](const Action& a) {
+    return std::holds_alternative<Constrain2D>(a);
+  });
+  if (plane && !hasConstrain) {
+    // Project after the forces, before deflectors, absorbers and Move read the motion.
+    auto it = std::find_if(parsed.begin(), parsed.end(), [](const Action& a) {
+      return std::holds_alternative<Bounce>(a) || std::holds_alternative<Sink>(a) ||
+             std::holds_alternative<Move>(a);
+    });
+    parsed.insert(it, *plane);
+    actions = ActionList();
+    for (const Action& a : parsed) addAction(actions, a, o.at("mode2d"), L);
+  }
+  // How Move integrates the forces, and sub-stepping (properties of the action list).
+  if (const json* v = o.get("integrator")) {
+    std::string name;
+    read(*v, o.at("integrator"), L, name);
+    const Integrator all[] = {Integrator::SemiImplicitEuler, Integrator::ExplicitEuler,
+                              Integrator::VelocityVerlet, Integrator::RK4, Integrator::Exact};
+    std::vector<std::string> names;
+    bool found = false;
+    for (Integrator i : all) {
+      names.emplace_back(integratorName(i));
+      if (name == names.back()) {
+        found = true;
+        try {
+          actions.setIntegrator(i);
+        } catch (const InvalidArgument& e) {
+          L.rethrow(o.at("integrator"), e, "integrator");
+        }
+      }
+    }
+    if (!found)
+      L.fail(o.at("integrator"), "unknown integrator \"" + name + "\"" + suggestion(name, names));
+  }
+  if (const json* v = o.get("substeps")) {
+    Obj so(*v, o.at("substeps"), L);
+    Substeps sub;
+    so.opt("maxStep", sub.maxStep);
+    so.opt("maxDistance", sub.maxDistance);
+    if (const json* m = so.get("maxSubsteps"))
+      sub.maxSubsteps = std::uint32_t(readInteger(*m, so.at("maxSubsteps"), L, 1, 1u << 16));
+    so.finish();
+    try {
+      actions.setSubsteps(sub);
+    } catch (const InvalidArgument& e) {
+      L.rethrow(so.path(), e, "substeps");
+    }
+  }
+  g.actions = std::move(actions);
+
+  if (const json* h = o.get("hair")) {
+    const std::string hp = o.at("hair");
+    if (h->is_boolean()) {
+      g.hair.enabled = h->get<bool>();
+    } else {
+      Obj ho(*h, hp, L);
+      g.hair.enabled = true;
+      ho.opt("enabled", g.hair.enabled);
+      if (const json* v = ho.get("every"))
+        g.hair.every = std::uint32_t(readInteger(*v, ho.at("every"), L, 1, 1u << 20));
+      if (const json* v = ho.get("maxVertices"))
+        g.hair.maxVertices = std::uint32_t(readInteger(*v, ho.at("maxVertices"), L, 2, 1u << 20));
+      ho.finish();
+    }
+  }
+  if (const json* r = o.get("require")) {
+    const std::string rp = o.at("require");
+    arrayOf(*r, rp, L, 0, "an array of attribute names");
+    std::vector<std::string> names;
+    for (int i = 0; i < int(Attribute::Count); ++i) names.emplace_back(attributeName(Attribute(i)));
+    for (std::size_t i = 0; i < r->size(); ++i) {
+      std::string s;
+      read((*r)[i], index(rp, i), L, s);
+      Attribute a;
+      if (!attributeFromName(s, a))
+        L.fail(index(rp, i), "unknown attribute \"" + s + "\"" + suggestion(s, names));
+      g.require.insert(a);
+    }
+  }
+  o.finish();
+  return g;
+}
+
+Effect readEffect(const json& j, const Loader& L, const std::string& defaultName) {
+  Obj o(j, "", L);
+  Effect fx;
+  fx.name = defaultName;
+  if (const json* v = o.get("version")) {
+    if (readInteger(*v, o.at("version"), L, 0, 1000) != 1)
+      L.fail(o.at("version"), "this Flurry reads effect format version 1");
+  }
+  o.opt("name", fx.name);
+  if (!safeName(fx.name)) L.fail(o.at("name"), kNameRule);
+  o.opt("description", fx.description);
+  if (fx.description.find('\n') != std::string::npos)
+    L.fail(o.at("description"), "must be one line");
+  o.opt("dt", fx.dt);
+  if (!(fx.dt > 0 && fx.dt <= 10)) L.fail(o.at("dt"), "must be in (0, 10] seconds");
+  o.opt("seed", fx.seed);
+  if (const json* v = o.get("frames"))
+    fx.frames = int(readInteger(*v, o.at("frames"), L, 1, 100'000'000));
+  const json& gs = o.require("groups", "an array of groups");
+  arrayOf(gs, "groups", L, 0, "an array of groups");
+  if (gs.empty()) L.fail("groups", "an effect needs at least one group");
+  for (std::size_t i = 0; i < gs.size(); ++i)
+    fx.groups.push_back(readGroup(gs[i], index("groups", i), L, fx.groups));
+  if (const json* r = o.get("render")) {
+    if (!r->is_object()) L.fail(o.at("render"), "expected an object, got " + kindOf(*r));
+    if (depthOf(*r) > 64) L.fail(o.at("render"), "nested more than 64 levels deep");
+    fx.render = r->dump();
+  }
+  o.finish();
+  return fx;
+}
+
+}  // namespace
+
+ContextOptions Effect::contextOptions() const {
+  ContextOptions o;
+  o.seed = seed;
+  o.dt = dt;
+  return o;
+}
+
+std::vector<Group*> Effect::build(Context& ctx, std::size_t maxCapacity) const {
+  const std::string where = file.empty() ? name : file.string();
+  std::vector<Group*> made;
+  for (std::size_t i = 0; i < groups.size(); ++i) {
+    const EffectGroup& eg = groups[i];
+    const std::string path = index("groups", i);
+    try {
+      const std::size_t cap = maxCapacity > 0 ? std::min(eg.capacity, maxCapacity) : eg.capacity;
+      Group& g = ctx.createGroup(eg.name, cap);
+      g.setActions(eg.actions);
+      if (eg.hair.enabled) g.setHair(eg.hair);
+      g.require(eg.require);
+      for (std::size_t k = 0; k < eg.emitters.size(); ++k) g.addEmitter(eg.emitters[k]);
+      for (std::size_t k = 0; k < eg.primeEmitters.size(); ++k)
+        g.addPrimeEmitter(eg.primeEmitters[k]);
+      made.push_back(&g);
+    } catch (const InvalidArgument& e) {
+      throw EffectError(where, path, e.what());
+    } catch (const Error& e) {
+      throw EffectError(where, path, e.what());
+    }
+  }
+  return made;
+}
+
+Effect parseEffect(std::string_view text, const std::string& fileName,
+                   const EffectLoadOptions& options) {
+  json j;
+  try {
+    // Comments (// and /* */) are allowed: effect files are written by hand.
+    j = json::parse(text.begin(), text.end(), nullptr, true, true);
+  } catch (const json::exception& e) {
+    // parse_error (with line and column), or out_of_range for a number like 1e400.
+    std::string why = e.what();
+    // "[json.exception.parse_error.101] parse error at line 3, column 5: ..." -> from "parse".
+    if (const auto p = why.find("] "); p != std::string::npos) why = why.substr(p + 2);
+    throw EffectError(fileName, "", why);
+  }
+  Loader L{fileName, &options, 0};
+  // The default name is the file's stem, made safe for output file names.
+  std::string stem = std::filesystem::path(fileName).stem().string();
+  for (char& c : stem)
+    if (!std::isalnum((unsigned char)c) && c != '-' && c != '.') c = '_';
+  if (!safeName(stem)) stem = "effect";
+  try {
+    return readEffect(j, L, stem);
+  } catch (const EffectError&) {
+    throw;
+  } catch (const json::exception& e) {
+    // A JSON access the loader did not guard: report, do not crash.
+    throw EffectError(fileName, "", std::string("malformed: ") + e.what());
+  }
+}
+
+Effect loadEffect(const std::filesystem::path& file, EffectLoadOptions options) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw EffectError(file.string(), "", "cannot open the file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw EffectError(file.string(), "", "cannot read the file");
+  if (options.baseDir.empty()) options.baseDir = file.parent_path();
+  Effect fx = parseEffect(ss.str(), file.string(), options);
+  fx.file = file;
+  return fx;
+}
+
+}  // namespace flurry

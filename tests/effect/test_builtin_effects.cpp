@@ -1,0 +1,132 @@
+// Every built-in sample is an effect file: it loads, builds, runs 100 steps and stays finite;
+// the embedded copy is the file in samples/effects/; the fountain helper matches the file.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "builtin.hpp"
+#include "flurry/effect.hpp"
+#include "flurry/flurry.hpp"
+
+using namespace flurry;
+
+namespace {
+
+bool allFinite(const Group& g) {
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const Particle p = g.particle(i);
+    for (int k = 0; k < 3; ++k)
+      if (!std::isfinite(p.position[k]) || !std::isfinite(p.velocity[k])) return false;
+    for (int k = 0; k < 4; ++k)
+      if (!std::isfinite(p.color[k])) return false;
+    if (!std::isfinite(p.size) || !std::isfinite(p.age)) return false;
+  }
+  const Strands& s = g.strands();
+  for (std::size_t i = 0; i < s.vertexCount(); ++i)
+    for (int k = 0; k < 3; ++k)
+      if (!std::isfinite(s.position[i][k])) return false;
+  return true;
+}
+
+}  // namespace
+
+TEST(BuiltinEffects, ListIsComplete) {
+  const auto& all = samples::builtinSamples();
+  for (const char* name : {"fountain", "fireworks", "snow", "hair", "tornado", "pinball2d",
+                           "magnetic", "galaxy", "smoke", "shockwave"})
+    EXPECT_NE(samples::findSample(name), nullptr) << name;
+  for (const auto& s : all) {
+    EXPECT_TRUE(s.effect) << s.name << ": " << s.description;
+    EXPECT_FALSE(s.description.empty()) << s.name;
+    EXPECT_EQ(s.description.find('\n'), std::string::npos) << s.name;
+    EXPECT_LE(s.description.size(), 120u) << s.name << ": keep it one line for `flurry list`";
+  }
+}
+
+class EachBuiltin : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(EachBuiltin, LoadsRuns100StepsAndStaysFinite) {
+  const samples::Sample* s = samples::findSample(GetParam());
+  ASSERT_NE(s, nullptr);
+  ASSERT_TRUE(s->effect) << s->description;
+  ContextOptions co = s->effect->contextOptions();
+  co.threads = 2;
+  Context ctx(co);
+  s->build(ctx, 0);
+  ASSERT_FALSE(ctx.groups().empty());
+  std::uint64_t emitted = 0;
+  for (int i = 0; i < 100; ++i) {
+    ctx.step();
+    if (i % 25 == 24)
+      for (Group* g : ctx.groups()) ASSERT_TRUE(allFinite(*g)) << g->name() << " step " << i;
+  }
+  for (Group* g : ctx.groups()) {
+    ASSERT_TRUE(allFinite(*g)) << g->name();
+    emitted += g->stats().emitted;
+    EXPECT_EQ(g->stats().droppedAtCapacity, 0u) << g->name() << ": capacity too small";
+  }
+  EXPECT_GT(emitted, 0u) << "an effect that shows nothing";
+}
+
+std::vector<std::string> builtinNames() {
+  std::vector<std::string> names;
+  for (const auto& s : samples::builtinSamples()) names.push_back(s.name);
+  return names;
+}
+
+INSTANTIATE_TEST_SUITE_P(All, EachBuiltin, ::testing::ValuesIn(builtinNames()),
+                         [](const auto& info) { return info.param; });
+
+TEST(BuiltinEffects, EmbeddedCopiesMatchTheFiles) {
+  const std::filesystem::path dir = FLURRY_EFFECTS_DIR;
+  std::size_t files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() != ".json") continue;
+    ++files;
+    std::ifstream in(entry.path(), std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    const Effect fx = loadEffect(entry.path());
+    const samples::Sample* s = samples::findSample(fx.name);
+    ASSERT_NE(s, nullptr) << entry.path();
+    EXPECT_EQ(s->file, entry.path().filename().string()) << "name and file name differ";
+    EXPECT_EQ(std::string(s->json), ss.str()) << entry.path() << ": rebuild to re-embed";
+  }
+  EXPECT_EQ(files, samples::builtinSamples().size());
+}
+
+TEST(BuiltinEffects, LoadEffectOrSample) {
+  EXPECT_EQ(samples::loadEffectOrSample("fountain").name, "fountain");
+  const std::filesystem::path file = std::filesystem::path(FLURRY_EFFECTS_DIR) / "snow.json";
+  const Effect fx = samples::loadEffectOrSample(file.string());
+  EXPECT_EQ(fx.file, file);
+  try {
+    samples::loadEffectOrSample("fountian");
+    FAIL();
+  } catch (const EffectError& e) {
+    EXPECT_NE(e.why().find("no built-in effect"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(samples::loadEffectOrSample("nowhere/none.json"), EffectError);
+}
+
+TEST(BuiltinEffects, BuildFountainMatchesTheEffectFile) {
+  // The helper the tests and benchmark use is the fountain file with its rate and lifetime set.
+  Context a({.seed = 3, .threads = 1});
+  Group& ga = samples::buildFountain(a, 20000, 2000.0, 3.0f);
+  Context b({.seed = 3, .threads = 1});
+  const samples::Sample* s = samples::findSample("fountain");
+  ASSERT_NE(s, nullptr);
+  s->build(b, 0);
+  Group& gb = b.group("fountain");
+  EXPECT_EQ(ga.name(), gb.name());
+  for (int i = 0; i < 60; ++i) {
+    a.step();
+    b.step();
+  }
+  ASSERT_EQ(ga.size(), gb.size());
+  const auto xa = ga.lane(Attribute::Position, 1), xb = gb.lane(Attribute::Position, 1);
+  for (std::size_t i = 0; i < ga.size(); ++i) ASSERT_EQ(xa[i], xb[i]) << i;
+}
