@@ -124,12 +124,16 @@ struct Validator {
     finiteVec(a.field, "field");
     falloff(a.falloff);
   }
-  void operator()(const MagneticField& a) const { finiteVec(a.field, "field"); }
+  void operator()(const MagneticField& a) const {
+    finiteVec(a.field, "field");
+    falloff(a.falloff);
+  }
   void operator()(const SampledField& a) const {
     require(a.field != nullptr, "field", "no field given");
     a.field->validate((where + ".field").c_str());
     finiteNum(a.strength, "strength");
     nonNegative(a.responsiveness, "responsiveness");
+    falloff(a.falloff);
   }
   void operator()(const Avoid& a) const {
     finiteNum(a.magnitude, "magnitude");
@@ -245,7 +249,9 @@ struct Uses {
   AttributeSet operator()(const ElectricField&) const {
     return {A::Position, A::Velocity, A::Charge, A::Mass};
   }
-  AttributeSet operator()(const MagneticField&) const { return {A::Velocity, A::Charge, A::Mass}; }
+  AttributeSet operator()(const MagneticField&) const {
+    return {A::Position, A::Velocity, A::Charge, A::Mass};
+  }
   AttributeSet operator()(const SampledField&) const { return {A::Position, A::Velocity}; }
   AttributeSet operator()(const Avoid&) const { return {A::Position, A::Velocity}; }
   AttributeSet operator()(const Follow&) const { return {A::Position, A::Velocity}; }

@@ -331,3 +331,28 @@ TEST(Constrain2D, KeepsTheGroupInItsPlane) {
   EXPECT_EQ(g.particle(0).position.z, 0.0f);
   EXPECT_EQ(g.particle(0).velocity.z, 0.0f);
 }
+
+// A falloff radius scales a field down to nothing at its edge, for every field kind.
+TEST(Falloff, FadesFieldsToZeroAtTheRadius) {
+  const Falloff f{Vec3(0), 2.0f, 1.0f};
+  Context ctx = makeContext(0.1);
+  Group& g = ctx.createGroup("g", 3);
+  MagneticField m{Vec3(0, 0, 5)};
+  m.falloff = f;
+  g.setActions({Gravity{Vec3(0, -10, 0), f}, m});
+  for (float x : {0.0f, 1.0f, 3.0f}) {
+    Particle p = at(Vec3(x, 0, 0), Vec3(1, 0, 0));
+    p.charge = 1.0f;
+    g.add(p);
+  }
+  ctx.step();
+  // Gravity scaled by w, then v turned about z by -(q/m)|B|dt·w = -0.5·w radians.
+  auto expect = [](float w) {
+    const Vec3 v(1.0f, -1.0f * w, 0.0f);
+    const float a = -0.5f * w;
+    return Vec3(v.x * std::cos(a) - v.y * std::sin(a), v.x * std::sin(a) + v.y * std::cos(a), 0.0f);
+  };
+  EXPECT_LT(glm::length(g.particle(0).velocity - expect(1.0f)), 1e-5f);  // full strength
+  EXPECT_LT(glm::length(g.particle(1).velocity - expect(0.5f)), 1e-5f);  // halfway out
+  EXPECT_EQ(g.particle(2).velocity, Vec3(1, 0, 0));                      // outside: untouched
+}

@@ -154,6 +154,7 @@ struct ElectricField {
 /// rotation of v about B by (charge / mass)·|B|·dt, so it does no work: speed is unchanged.
 struct MagneticField {
   Vec3 field{0.0f, 0.0f, 1.0f};
+  Falloff falloff;  ///< scales the field (the rotation angle), so still no work is done
 };
 
 /// A vector field sampled trilinearly from a grid (dense, or an OpenVDB grid read by
@@ -165,6 +166,7 @@ struct SampledField {
   Mode mode = Mode::Acceleration;
   float strength = 1.0f;
   float responsiveness = 5.0f;
+  Falloff falloff;
 };
 
 /// Steers particles away from an obstacle they would enter within `lookAhead` seconds, with

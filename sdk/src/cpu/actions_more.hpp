@@ -272,7 +272,8 @@ inline void apply(const MagneticField& a, const Lanes& L, std::size_t n, const B
   for (std::size_t i = 0; i < n; ++i) {
     // dv/dt = (q/m) v × B is a rotation about B at -(q/m)|B|: done exactly (Rodrigues), in
     // double so that the speed does not drift by float rounding over many steps.
-    const double theta = -double(chargePerMass(L, i)) * B * c.dt;
+    const double theta =
+        -double(chargePerMass(L, i)) * B * c.dt * falloffWeight(a.falloff, at(L.p, i));
     const double ct = std::cos(theta), st = std::sin(theta);
     const glm::dvec3 v(at(L.v, i)), kd(k);
     const glm::dvec3 r = v * ct + glm::cross(kd, v) * st + kd * (glm::dot(kd, v) * (1.0 - ct));
@@ -284,9 +285,11 @@ inline void apply(const SampledField& a, const Lanes& L, std::size_t n, const Bl
   const VectorField& f = *a.field;
   const float k = approach(a.responsiveness, c.dt);
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 u = f.sample(at(L.p, i)) * a.strength;
+    const Vec3 p = at(L.p, i);
+    const float w = falloffWeight(a.falloff, p);
+    const Vec3 u = f.sample(p) * a.strength;
     const Vec3 v = at(L.v, i);
-    put(L.v, i, a.mode == SampledField::Mode::Acceleration ? v + u * c.dt : v + (u - v) * k);
+    put(L.v, i, a.mode == SampledField::Mode::Acceleration ? v + u * (c.dt * w) : v + (u - v) * (k * w));
   }
 }
 

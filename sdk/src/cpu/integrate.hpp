@@ -94,10 +94,11 @@ inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std
           } else if constexpr (std::is_same_v<A, ElectricField>) {
             acc = a.field * chargePerMass(L, i) * falloffWeight(a.falloff, p);
           } else if constexpr (std::is_same_v<A, MagneticField>) {
-            acc = glm::cross(v, a.field) * chargePerMass(L, i);
+            acc = glm::cross(v, a.field) * chargePerMass(L, i) * falloffWeight(a.falloff, p);
           } else if constexpr (std::is_same_v<A, SampledField>) {
             const Vec3 u = a.field->sample(p) * a.strength;
-            acc = a.mode == SampledField::Mode::Acceleration ? u : (u - v) * a.responsiveness;
+            acc = (a.mode == SampledField::Mode::Acceleration ? u : (u - v) * a.responsiveness) *
+                  falloffWeight(a.falloff, p);
           } else if constexpr (std::is_same_v<A, TargetVelocity>) {
             acc = (a.velocity - v) * a.rate;
           }

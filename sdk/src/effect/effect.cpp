@@ -847,6 +847,7 @@ Action readActionBody(Obj& o, const std::string& type) {
   if (type == "MagneticField") {
     MagneticField a;
     o.opt("field", a.field);
+    falloff(a.falloff);
     return a;
   }
   if (type == "SampledField") {
@@ -857,6 +858,7 @@ Action readActionBody(Obj& o, const std::string& type) {
               {"velocity", SampledField::Mode::Velocity}});
     o.opt("strength", a.strength);
     o.opt("responsiveness", a.responsiveness);
+    falloff(a.falloff);
     return a;
   }
   if (type == "Avoid") {

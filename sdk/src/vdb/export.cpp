@@ -310,7 +310,11 @@ void SequenceWriter::write(std::span<Group* const> groups, int frame, double tim
   Frame f;
   f.number = frame;
   f.time = time;
-  for (const Group* g : groups) f.groups.push_back(Particles::capture(*g, impl_->options.content));
+  for (const Group* g : groups) {
+    f.groups.push_back(Particles::capture(*g, impl_->options.content));
+    // Hair groups hold strands, not live particles: their strands go into the fog volume.
+    if (g->hair().enabled && g->strands().size() > 0) f.strands.push_back(g->strands());
+  }
   const double secs =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   {
