@@ -5,7 +5,8 @@
 //
 // After the runs it prints a summary of ratios between the medians of this run.
 #include <benchmark/benchmark.h>
-#include <sys/mman.h>
+
+#include "common/read_modify_write.hpp"
 
 #include <cstdio>
 #include <cstdlib>
@@ -100,34 +101,9 @@ void Emission(benchmark::State& state) {
       born / threads() * 1e-9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
-// The ceiling: a[i] = a[i]*s + c over arrays of the same total size as the group's lanes,
-// allocated the same way (huge pages), on the same number of threads.
+// The ceiling, measured the same way in every benchmark (bench/common).
 void ReadModifyWrite(benchmark::State& state) {
-  const auto n = std::size_t(state.range(0));
-  std::vector<float*> arrays;
-  const std::size_t bytes = (n * 4 + (2u << 20) - 1) / (2u << 20) * (2u << 20);
-  for (int k = 0; k < kLanes; ++k) {
-    auto* a = static_cast<float*>(std::aligned_alloc(2u << 20, bytes));
-    madvise(a, bytes, MADV_HUGEPAGE);
-    for (std::size_t i = 0; i < n; ++i) a[i] = float(i & 1023);
-    arrays.push_back(a);
-  }
-  const unsigned t = threads();
-  for (auto _ : state) {
-    std::vector<std::thread> pool;
-    for (unsigned w = 0; w < t; ++w)
-      pool.emplace_back([&, w] {
-        const std::size_t lo = n * w / t, hi = n * (w + 1) / t;
-        for (float* a : arrays) {
-          float* __restrict p = a;
-          for (std::size_t i = lo; i < hi; ++i) p[i] = p[i] * 0.999f + 0.001f;
-        }
-      });
-    for (auto& th : pool) th.join();
-    benchmark::ClobberMemory();
-  }
-  state.SetBytesProcessed(std::int64_t(double(state.iterations()) * double(n) * kLanes * 8.0));
-  for (float* a : arrays) std::free(a);
+  flurry::bench::readModifyWrite(state, kLanes, threads());
 }
 
 // Prints ratios between the medians (or single runs) of this process's benchmarks.
