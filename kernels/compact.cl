@@ -129,3 +129,24 @@ __kernel void fl_scan_list(__global const uchar* codes, __global uint* tileDead,
   fl_scan_body(codes, tileDead, tileOff, state, tiles, births, capacity);
   for (uint t = 0; t < tiles; ++t) fl_list_body(t, codes, tileOff, holes, tail, state);
 }
+
+/* The fastest particle's |v|^2 into the state, for sub-steps by distance (fused_pass.cpp
+ * makePlan). Non-negative floats order as their bits; NaN is left out, as std::max does. */
+__kernel void fl_max_speed(__global const float* restrict vx, __global const float* restrict vy,
+                           __global const float* restrict vz, __global uint* state) {
+  __local uint best[64];
+  const uint i = get_global_id(0), l = get_local_id(0);
+  float m = 0.0f;
+  const uint n = state[FL_STATE_SIZE];
+  for (uint j = i; j < n; j += get_global_size(0)) {
+    const float v2 = vx[j] * vx[j] + vy[j] * vy[j] + vz[j] * vz[j];
+    m = v2 > m ? v2 : m;
+  }
+  best[l] = as_uint(m);
+  barrier(CLK_LOCAL_MEM_FENCE);
+  for (uint s = get_local_size(0) / 2; s > 0; s >>= 1) {
+    if (l < s) best[l] = max(best[l], best[l + s]);
+    barrier(CLK_LOCAL_MEM_FENCE);
+  }
+  if (l == 0) atomic_max(&state[FL_STATE_MAX_SPEED2], best[0]);
+}

@@ -161,7 +161,7 @@ FL_INLINE float fl_dot3(float ax, float ay, float az, float bx, float by, float 
 }
 
 /* shape_math.hpp inside(): whether (x, y, z) is in the domain. */
-FL_INLINE int fl_inside(__constant const float* v, uint kind, float x, float y, float z) {
+FL_INLINE int fl_inside(__global const float* v, uint kind, float x, float y, float z) {
   switch (kind) {
     case FL_DOMAIN_PLANE:
       return fl_dot3(x - v[0], y - v[1], z - v[2], v[3], v[4], v[5]) >= 0.0f;

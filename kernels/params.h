@@ -86,16 +86,15 @@ typedef struct FlBirthRun {
 } FlBirthRun;
 
 /* One action's constants, computed on the host as the CPU backend computes them (so the
- * products with dt round the same way). f[] by action:
- *  Gravity: a*dt | Damping: exp(-k*dt) | Move, KillOld: -
- *  Bounce: [0..2] plane point, [3..5] unit normal, [6] restitution, [7] 1 - friction,
- *    [8] cutoff^2, [9] scale (|P.x|+|P.y|+|P.z|, sphere |C|_1 + R), then by surface:
- *    rectangle/triangle [10..12] dual u, [13..15] dual v | disc [10] outer^2, [11] inner^2
- *    sphere [10] R, [11] R^2, [12] 1/R (center in [0..2])
- *  Sink: [0..15] the region as FlDomain.v, u[0] kind, [16] passThrough */
+ * products with dt round the same way), by the packer of the action's family
+ * (sdk/src/opencl/actions_*.cpp), which documents its f[] and u[] there. `domain` holds the
+ * action's region, surface or sampled domain (fl_sample and fl_inside read it directly);
+ * data longer than f[] (keys over life, triangles, grids) goes into the program's `extra`
+ * floats, at offsets the packer puts in u[]. */
 typedef struct FlActionParams {
-  float f[20];
-  fl_u32 u[4];
+  FlDomain domain;
+  float f[32];
+  fl_u32 u[8];
 } FlActionParams;
 
 /* The group's device-side state: one small buffer of uints, read back asynchronously after
@@ -108,12 +107,20 @@ typedef struct FlActionParams {
 #define FL_STATE_BORN 5     /* this step: born */
 #define FL_STATE_LOW_HOLES 6 /* this step: holes below the new size */
 #define FL_STATE_FIRST_ID 7 /* this step: the first newborn's id */
-#define FL_STATE_KILLS 8    /* then one cumulative (wrapping) kill counter per action */
-#define FL_STATE_HEADER 8
+#define FL_STATE_SUBSTEPS 8 /* this step: sub-steps (Substeps::maxDistance), from fl_max_speed */
+#define FL_STATE_MAX_SPEED2 9 /* this step: the largest |v|^2, as float bits (atomic_max) */
+#define FL_STATE_KILLS 10   /* then one cumulative (wrapping) kill counter per kill code */
+#define FL_STATE_HEADER 10
+#define FL_KILL_CODES 255   /* codes 1..255: 1 + the killing action, 255 non-finite */
+#define FL_NON_FINITE_CODE 255
 
 /* Particles per tile of the death count and the hole list (a multiple of 16: counted as
  * uint4 words). */
 #define FL_TILE 1024
+
+/* Neighbour actions read the particles as they were at the start of the step: component c
+ * (x y z) of attribute a (0 position, 1 velocity, 2 angular velocity) of particle j. */
+#define FL_SNAP(a, c, j) snap[((a) * 3u + (c)) * snapStride + (j)]
 
 #ifndef __OPENCL_VERSION__
 }  // namespace flurry::detail::cl

@@ -23,6 +23,7 @@
 #include <map>
 
 #include "codegen.hpp"
+#include "emission.hpp"
 
 namespace flurry::detail::ocl {
 
@@ -32,7 +33,8 @@ static_assert(sizeof(cl::FlParticleType) == 4 * 72 + 5 * 16 + 8);
 static_assert(sizeof(cl::FlEmitter) == 72 + 16 + 32 + 24 && offsetof(cl::FlEmitter, start) == 72);
 static_assert(sizeof(cl::FlKeyframe) == 24 && offsetof(cl::FlKeyframe, position) == 8);
 static_assert(sizeof(cl::FlBirthRun) == 32 && offsetof(cl::FlBirthRun, emitter) == 24);
-static_assert(sizeof(cl::FlActionParams) == 96 && offsetof(cl::FlActionParams, u) == 80);
+static_assert(sizeof(cl::FlActionParams) == 72 + 32 * 4 + 8 * 4 &&
+              offsetof(cl::FlActionParams, f) == 72 && offsetof(cl::FlActionParams, u) == 200);
 static_assert(FL_TILE % 16 == 0);
 
 namespace {
@@ -53,43 +55,6 @@ std::uint64_t doubleBits(double d) {
   return b;
 }
 
-// emission.cpp producedBy: births a rate has produced by time t.
-std::uint64_t producedBy(const Emitter& e, double t) {
-  const double elapsed = std::min(t, e.stop) - e.start;
-  if (elapsed <= 0) return 0;
-  const double x = e.rate * elapsed;
-  return std::uint64_t(std::floor(x + 1e-9 * std::max(1.0, x)));
-}
-
-cl::FlFuzzy packFuzzy(const Fuzzy& f) {
-  return {f.center, f.spread, f.distribution == Fuzzy::Distribution::Normal ? 1u : 0u, 0u};
-}
-
-// What the device does not run yet is refused, naming it, rather than silently ignored. The
-// checks compile whether or not the core has the feature yet (`requires`).
-template <class G>
-void checkSupported(const G& g) {
-  auto refuse = [&](const std::string& what) {
-    throw Error("OpenCL backend: group '" + g.name + "' uses " + what +
-                ", which does not run on the device yet; use Backend::Cpu");
-  };
-  if constexpr (requires { g.primes.empty(); })
-    if (!g.primes.empty()) refuse("prime emitters");
-  if constexpr (requires { g.live.empty(); })
-    if (!g.live.empty()) refuse("prime emitters");
-  if constexpr (requires { g.hair.enabled; })
-    if (g.hair.enabled) refuse("hair mode");
-  for (std::size_t i = 0; i < g.emitters.size(); ++i) {
-    const auto& e = g.emitters[i];
-    const std::string name = "emitters[" + std::to_string(i) + "]";
-    if constexpr (requires { e.spacing; })
-      if (e.spacing > 0) refuse(name + ".spacing (emission by distance)");
-    if constexpr (requires { e.normalSpeed.center; })
-      if (e.normalSpeed.center != 0.0f || e.normalSpeed.spread != 0.0f)
-        refuse(name + ".normalSpeed");
-  }
-}
-
 template <class T>
 void setArg(cl_kernel k, cl_uint i, const T& v) {
   check(clSetKernelArg(k, i, sizeof(T), &v), "clSetKernelArg");
@@ -108,13 +73,6 @@ struct Shared {
 };
 
 namespace {
-
-struct StepTables {
-  std::vector<cl::FlBirthRun> runs;
-  std::vector<cl::FlEmitter> emitters;
-  std::vector<cl::FlParticleType> types;
-  std::vector<cl::FlKeyframe> keys;
-};
 
 // A step queued on the device: its state is read back into `state` when `done` fires.
 struct InFlight {
@@ -214,14 +172,13 @@ class ClGroup final : public DeviceMirror {
     while (!inFlight_.empty()) retire(g, true);
   }
   void apply(GroupImpl& g, const std::vector<std::uint32_t>& state);
-  std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, StepTables& t);
 
   std::shared_ptr<Shared> shared_;
   std::vector<DeviceLane> lanes_;
   AttributeSet laneSet_;
   bool allocated_ = false;
   Mem codes_, tileDead_, tileOff_, holes_, tailList_;
-  GrowBuffer state_, params_, runs_, emitters_, types_, keys_;
+  GrowBuffer state_, params_, extra_, snap_, runs_, emitters_, types_, keys_;
   std::size_t tiles_ = 0;
 
   Program program_;
@@ -229,8 +186,10 @@ class ClGroup final : public DeviceMirror {
   bool programValid_ = false;
   std::string emitterSignature_;
   std::vector<LaneRef> actLanes_;
-  Kernel act_, count_, scan_, list_, scanList_, tailKernel_;
+  bool neighbours_ = false, substepsByDistance_ = false;
+  Kernel act_, count_, scan_, list_, scanList_, tailKernel_, maxSpeed_;
   std::vector<cl::FlActionParams> params_host_, params_uploaded_;
+  std::vector<float> extra_host_, extra_uploaded_;
 
   std::vector<std::pair<std::string, Event>> profiled_;
   std::map<std::string, std::pair<double, std::uint64_t>> profile_;
@@ -289,8 +248,9 @@ void ClGroup::allocate(GroupImpl& g) {
 }
 
 void ClGroup::buildProgram(GroupImpl& g) {
-  const GeneratedProgram gen = generateProgram(g.actions, g.stored, shared_->fp64(), g.emitters);
-  emitterSignature_ = emitterSignature(g.emitters);
+  const GeneratedProgram gen =
+      generateProgram(g.actions, g.stored, shared_->fp64(), emissionSource(g));
+  emitterSignature_ = emitterSignature(g);
   Program p(shared_->runtime->program(gen.source, gen.options));
   cl_int err = CL_SUCCESS;
   auto kernel = [&](const char* name) {
@@ -299,7 +259,8 @@ void ClGroup::buildProgram(GroupImpl& g) {
     return k;
   };
   Kernel act = kernel("fl_act"), count = kernel("fl_count"), scan = kernel("fl_scan"),
-         list = kernel("fl_list"), scanList = kernel("fl_scan_list"), tail = kernel("fl_tail");
+         list = kernel("fl_list"), scanList = kernel("fl_scan_list"), tail = kernel("fl_tail"),
+         maxSpeed = kernel("fl_max_speed");
   program_ = std::move(p);
   act_ = std::move(act);
   count_ = std::move(count);
@@ -307,7 +268,10 @@ void ClGroup::buildProgram(GroupImpl& g) {
   list_ = std::move(list);
   scanList_ = std::move(scanList);
   tailKernel_ = std::move(tail);
+  maxSpeed_ = std::move(maxSpeed);
   actLanes_ = gen.actLanes;
+  neighbours_ = gen.neighbours;
+  substepsByDistance_ = gen.substepsByDistance;
   programActions_ = g.actions;
   programValid_ = true;
 
@@ -339,13 +303,18 @@ void ClGroup::buildProgram(GroupImpl& g) {
   setArg(scanList_.get(), 2, tileOff_.get());
   setArg(scanList_.get(), 3, holes_.get());
   setArg(scanList_.get(), 4, tailList_.get());
+  if (substepsByDistance_) {
+    for (int c = 0; c < 3; ++c)
+      setArg(maxSpeed_.get(), cl_uint(c), laneMem({Attribute::Velocity, c, ""}));
+  }
   params_uploaded_.clear();
+  extra_uploaded_.clear();
 }
 
 void ClGroup::upload(GroupImpl& g) {
   drain(g);
   const std::size_t nActions = std::max<std::size_t>(g.actions.size(), 1);
-  if (state_.reserve(context(), (FL_STATE_HEADER + nActions) * 4)) programValid_ = false;
+  if (state_.reserve(context(), (FL_STATE_HEADER + FL_KILL_CODES) * 4)) programValid_ = false;
   for (auto& lane : lanes_) {
     if (g.size == 0) break;
     const void* src = g.lanes[std::size_t(lane.ref.attribute)][lane.ref.component].data();
@@ -353,7 +322,7 @@ void ClGroup::upload(GroupImpl& g) {
                                nullptr),
           "clEnqueueWriteBuffer (particles)");
   }
-  std::vector<std::uint32_t> state(FL_STATE_HEADER + nActions, 0u);
+  std::vector<std::uint32_t> state(FL_STATE_HEADER + FL_KILL_CODES, 0u);
   state[FL_STATE_SIZE] = std::uint32_t(g.size);
   state[FL_STATE_NEXT_ID] = g.nextId;
   check(clEnqueueWriteBuffer(queue(), state_.mem.get(), CL_TRUE, 0, state.size() * 4, state.data(),
@@ -363,7 +332,8 @@ void ClGroup::upload(GroupImpl& g) {
   size_ = g.size;
   nextId_ = g.nextId;
   lastDropped_ = 0;
-  lastKills_.assign(nActions, 0u);
+  lastKills_.assign(FL_KILL_CODES, 0u);
+  (void)nActions;
   hostDirty_ = false;
   deviceNewer_ = false;
 }
@@ -375,7 +345,13 @@ void ClGroup::apply(GroupImpl& g, const std::vector<std::uint32_t>& s) {
   g.stats.droppedAtCapacity += std::uint32_t(s[FL_STATE_DROPPED] - lastDropped_);
   lastDropped_ = s[FL_STATE_DROPPED];
   const auto& acts = programActions_.actions();
-  for (std::size_t k = 0; k < acts.size() && k < lastKills_.size(); ++k) {
+  {
+    const std::size_t k = FL_NON_FINITE_CODE - 1;
+    const std::uint32_t now = s[FL_STATE_KILLS + k];
+    g.stats.killedNonFinite += std::uint32_t(now - lastKills_[k]);
+    lastKills_[k] = now;
+  }
+  for (std::size_t k = 0; k < acts.size() && k + 1 < FL_NON_FINITE_CODE; ++k) {
     const std::uint32_t now = s[FL_STATE_KILLS + k];
     const std::uint32_t d = now - lastKills_[k];
     lastKills_[k] = now;
@@ -412,72 +388,8 @@ void ClGroup::retire(GroupImpl& g, bool wait) {
   inFlight_.pop_front();
 }
 
-std::uint64_t ClGroup::planBirths(GroupImpl& g, const StepParams& sp, StepTables& t) {
-  // emission.cpp step 1, verbatim in effect: which emitter gives birth, how many, when.
-  const double t0 = sp.time, t1 = sp.time + sp.dt;
-  std::uint64_t total = 0;
-  for (std::uint32_t e = 0; e < g.emitters.size(); ++e) {
-    const Emitter& em = g.emitters[e];
-    auto& state = g.emitterState[e];
-    if (em.rate > 0) {
-      const std::uint64_t target = producedBy(em, t1);
-      if (target > state.emittedByRate) {
-        t.runs.push_back({state.emittedByRate, 0, total, e, 0u});
-        total += target - state.emittedByRate;
-        state.emittedByRate = target;
-      }
-    }
-    for (const Burst& b : em.bursts)
-      for (std::uint32_t r = 0; r < b.repeat; ++r) {
-        const double tb = b.time + r * b.interval;
-        if (tb >= t0 && tb < t1 && b.count > 0) {
-          t.runs.push_back({0, doubleBits(tb), total, e, 1u});
-          total += b.count;
-        }
-      }
-  }
-  g.stats.emitted += total;
-  if (total == 0) return 0;
-  for (const Emitter& em : g.emitters) {
-    cl::FlEmitter o{};
-    o.shape = packDomain(em.shape);
-    o.start = doubleBits(em.start);
-    o.rate = doubleBits(em.rate);
-    for (int c = 0; c < 3; ++c) {
-      o.position[c] = em.position[c];
-      o.velocity[c] = em.velocity[c];
-    }
-    o.pathFirst = cl::fl_u32(t.keys.size());
-    o.pathCount = cl::fl_u32(em.path.size());
-    for (const Keyframe& k : em.path)
-      t.keys.push_back({doubleBits(k.time), {k.position.x, k.position.y, k.position.z, 0.0f}});
-    o.typeFirst = cl::fl_u32(t.types.size());
-    o.typeCount = cl::fl_u32(em.types.size());
-    float totalWeight = 0;
-    for (const ParticleType& p : em.types) {
-      totalWeight += p.weight;
-      cl::FlParticleType q{};
-      q.velocity = packDomain(p.velocity);
-      q.color = packDomain(p.color);
-      q.up = packDomain(p.up);
-      q.rotVelocity = packDomain(p.rotVelocity);
-      q.alpha = packFuzzy(p.alpha);
-      q.size = packFuzzy(p.size);
-      q.mass = packFuzzy(p.mass);
-      q.lifetime = packFuzzy(p.lifetime);
-      q.charge = packFuzzy(p.charge);
-      q.weight = p.weight;
-      t.types.push_back(q);
-    }
-    o.totalWeight = totalWeight;
-    t.emitters.push_back(o);
-  }
-  if (t.keys.empty()) t.keys.push_back({});
-  return total;
-}
-
 void ClGroup::step(GroupImpl& g, const StepParams& sp) {
-  checkSupported(g);
+  checkEmissionSupported(g);
   if (!allocated_ || laneSet_ != g.stored) {
     drain(g);
     allocate(g);
@@ -488,18 +400,28 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     programValid_ = false;
   }
   // Emitters may be edited at any time (Group::emitters()); the program follows their kinds.
-  if (programValid_ && emitterSignature(g.emitters) != emitterSignature_) programValid_ = false;
+  if (programValid_ && emitterSignature(g) != emitterSignature_) programValid_ = false;
   if (!programValid_) buildProgram(g);
 
-  packActions(g.actions, float(sp.dt), params_host_);
+  packActions(g.actions, float(sp.dt), params_host_, extra_host_);
   const std::size_t paramBytes = params_host_.size() * sizeof(cl::FlActionParams);
   if (params_uploaded_.size() != params_host_.size() ||
       std::memcmp(params_uploaded_.data(), params_host_.data(), paramBytes) != 0) {
+    drain(g);  // steps in flight read the buffer
     params_.reserve(context(), paramBytes, CL_MEM_READ_ONLY);
     check(clEnqueueWriteBuffer(queue(), params_.mem.get(), CL_TRUE, 0, paramBytes,
                                params_host_.data(), 0, nullptr, nullptr),
           "clEnqueueWriteBuffer (action parameters)");
     params_uploaded_ = params_host_;
+  }
+  if (extra_uploaded_ != extra_host_) {
+    drain(g);
+    const std::size_t bytes = extra_host_.size() * sizeof(float);
+    extra_.reserve(context(), bytes, CL_MEM_READ_ONLY);
+    check(clEnqueueWriteBuffer(queue(), extra_.mem.get(), CL_TRUE, 0, bytes, extra_host_.data(), 0,
+                               nullptr, nullptr),
+          "clEnqueueWriteBuffer (action data)");
+    extra_uploaded_ = extra_host_;
   }
 
   InFlight f;
@@ -512,7 +434,7 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   for (const auto& q : inFlight_) bound += q.births;
   const std::size_t nBound = std::min(bound, g.capacity);
   const bool acts = !g.actions.empty() && nBound > 0;
-  const bool kills = acts && g.actions.kills();
+  const bool kills = acts;           // the NaN guard can kill in any list
   if (!acts && births == 0) return;  // nothing on the device changes
 
   cl_command_queue q = queue();
@@ -529,14 +451,46 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
 
   if (acts) {
     cl_kernel k = act_.get();
+    if (substepsByDistance_) {
+      const cl_uint zero = 0;
+      check(
+          clEnqueueFillBuffer(q, state, &zero, 4, FL_STATE_MAX_SPEED2 * 4, 4, 0, nullptr, nullptr),
+          "clEnqueueFillBuffer (state)");
+      setArg(maxSpeed_.get(), 3, state);
+      launch(maxSpeed_.get(), std::min(roundUp(nBound, 64), std::size_t(1) << 14), 64,
+             "fl_max_speed");
+    }
+    cl_mem snap = extra_.mem.get();
+    if (neighbours_) {
+      // Neighbours are read as they were at the start of the step (fused_pass.cpp).
+      snap_.reserve(context(), 9 * g.capacity * 4);
+      snap = snap_.mem.get();
+      for (auto& l : lanes_) {
+        int slot = -1;
+        if (l.ref.attribute == Attribute::Position) slot = 0;
+        if (l.ref.attribute == Attribute::Velocity) slot = 1;
+        if (l.ref.attribute == Attribute::RotVelocity) slot = 2;
+        if (slot < 0) continue;
+        check(clEnqueueCopyBuffer(
+                  q, l.mem.get(), snap, 0,
+                  (std::size_t(slot) * 3 + std::size_t(l.ref.component)) * g.capacity * 4,
+                  nBound * 4, 0, nullptr, nullptr),
+              "clEnqueueCopyBuffer (neighbours)");
+      }
+    }
     cl_uint i = cl_uint(actLanes_.size()) + 1;
     setArg(k, i++, params_.mem.get());
     setArg(k, i++, state);
-    setArg(k, i++, float(sp.dt));
+    setArg(k, i++, extra_.mem.get());
+    setArg(k, i++, snap);
+    setArg(k, i++, cl_ulong(doubleBits(sp.dt)));
+    setArg(k, i++, cl_ulong(doubleBits(sp.time)));
     setArg(k, i++, seedLo);
     setArg(k, i++, seedHi);
     setArg(k, i++, cl_uint(sp.step));
     setArg(k, i++, cl_uint(g.index << 16));
+    setArg(k, i++, cl_uint(stepSubsteps(g.actions, sp.dt)));
+    setArg(k, i++, cl_uint(g.capacity));
     launch(k, roundUp(nBound, kActLocal), kActLocal, "fl_act");
   }
   if (kills) {
@@ -595,7 +549,7 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
 
     // The step's counts come back without the host waiting; later steps size their launches
     // from them.
-    f.state.resize(FL_STATE_HEADER + std::max<std::size_t>(g.actions.size(), 1));
+    f.state.resize(FL_STATE_HEADER + FL_KILL_CODES);
     cl_event e = nullptr;
     check(clEnqueueReadBuffer(q, state, CL_FALSE, 0, f.state.size() * 4, f.state.data(), 0, nullptr,
                               &e),
@@ -639,7 +593,7 @@ void finishGroup(GroupImpl& group) {
 }
 
 std::string programSource(const ActionList& actions, AttributeSet stored, bool fp64) {
-  return generateProgram(actions, stored, fp64, {}).source;
+  return generateProgram(actions, stored, fp64, emissionSource(GroupImpl{})).source;
 }
 
 }  // namespace flurry::detail::ocl

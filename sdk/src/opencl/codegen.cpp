@@ -1,10 +1,13 @@
 #include "codegen.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <sstream>
 #include <type_traits>
 
+#include "../action_traits.hpp"
 #include "flurry/error.hpp"
 
 namespace flurry::detail::ocl {
@@ -48,6 +51,8 @@ constexpr AttrInfo kAttrs[] = {
     {Attribute::Charge, "CHARGE", {"charge"}, false},
     {Attribute::Visible, "VISIBLE", {"vis"}, true},
     {Attribute::UserData, "USER_DATA", {"user"}, false},
+    {Attribute::PositionB, "POSITION_B", {"pbx", "pby", "pbz"}, false},
+    {Attribute::VelocityB, "VELOCITY_B", {"vbx", "vby", "vbz"}, false},
 };
 
 const AttrInfo& info(Attribute a) {
@@ -69,22 +74,6 @@ void basis(Vec3 n, Vec3& b1, Vec3& b2) {
   const float b = n.x * n.y * a;
   b1 = Vec3(1.0f + s * n.x * n.x * a, s * b, -s * n.x);
   b2 = Vec3(b, s + n.y * n.y * a, -n.y);
-}
-
-void put(float* v, int at, Vec3 x) {
-  v[at] = x.x;
-  v[at + 1] = x.y;
-  v[at + 2] = x.z;
-}
-
-// Which piece a planar Bounce surface is (FL_PIECE_*), or -1 for the sphere.
-int pieceOf(const Domain& d) {
-  const auto& s = d.shape();
-  if (std::holds_alternative<PlaneDomain>(s)) return 0;
-  if (std::holds_alternative<RectangleDomain>(s)) return 1;
-  if (std::holds_alternative<TriangleDomain>(s)) return 2;
-  if (std::holds_alternative<DiscDomain>(s)) return 3;
-  return -1;
 }
 
 }  // namespace
@@ -117,34 +106,34 @@ cl::FlDomain packDomain(const Domain& d) {
       [&](const auto& s) {
         using T = std::decay_t<decltype(s)>;
         if constexpr (std::is_same_v<T, PointDomain>) {
-          put(v, 0, s.p);
+          putVec(v, 0, s.p);
         } else if constexpr (std::is_same_v<T, LineDomain>) {
-          put(v, 0, s.p0);
-          put(v, 3, s.p1);
+          putVec(v, 0, s.p0);
+          putVec(v, 3, s.p1);
         } else if constexpr (std::is_same_v<T, TriangleDomain>) {
-          put(v, 0, s.p0);
-          put(v, 3, s.p1);
-          put(v, 6, s.p2);
+          putVec(v, 0, s.p0);
+          putVec(v, 3, s.p1);
+          putVec(v, 6, s.p2);
         } else if constexpr (std::is_same_v<T, PlaneDomain>) {
-          put(v, 0, s.point);
-          put(v, 3, s.normal);
+          putVec(v, 0, s.point);
+          putVec(v, 3, s.normal);
         } else if constexpr (std::is_same_v<T, RectangleDomain>) {
-          put(v, 0, s.origin);
-          put(v, 3, s.u);
-          put(v, 6, s.v);
+          putVec(v, 0, s.origin);
+          putVec(v, 3, s.u);
+          putVec(v, 6, s.v);
         } else if constexpr (std::is_same_v<T, DiscDomain>) {
           Vec3 e1, e2;
           basis(s.normal, e1, e2);
-          put(v, 0, s.center);
-          put(v, 3, e1);
-          put(v, 6, e2);
+          putVec(v, 0, s.center);
+          putVec(v, 3, e1);
+          putVec(v, 6, e2);
           v[9] = s.outerRadius;
           v[10] = s.innerRadius;
         } else if constexpr (std::is_same_v<T, BoxDomain>) {
-          put(v, 0, s.min);
-          put(v, 3, s.max);
+          putVec(v, 0, s.min);
+          putVec(v, 3, s.max);
         } else if constexpr (std::is_same_v<T, SphereDomain>) {
-          put(v, 0, s.center);
+          putVec(v, 0, s.center);
           v[3] = s.outerRadius;
           v[4] = s.innerRadius;
         } else if constexpr (std::is_same_v<T, CylinderDomain> || std::is_same_v<T, ConeDomain>) {
@@ -158,14 +147,14 @@ cl::FlDomain packDomain(const Domain& d) {
           }
           Vec3 e1, e2;
           basis(glm::normalize(axis), e1, e2);
-          put(v, 0, origin);
-          put(v, 3, axis);
-          put(v, 6, e1);
-          put(v, 9, e2);
+          putVec(v, 0, origin);
+          putVec(v, 3, axis);
+          putVec(v, 6, e1);
+          putVec(v, 9, e2);
           v[12] = s.outerRadius;
           v[13] = s.innerRadius;
         } else if constexpr (std::is_same_v<T, BlobDomain>) {
-          put(v, 0, s.center);
+          putVec(v, 0, s.center);
           v[3] = s.stddev;
         }
       },
@@ -173,177 +162,188 @@ cl::FlDomain packDomain(const Domain& d) {
   return o;
 }
 
-namespace {
+[[noreturn]] void notOnDevice(const std::string& what) {
+  throw Error("OpenCL backend: " + what + " does not run on the device yet; use Backend::Cpu");
+}
 
-struct Packer {
-  float dt;
-  cl::FlActionParams& p;
-  template <class A>
-  void operator()(const A& a) const {
-    if constexpr (std::is_same_v<A, Gravity>) {
-      put(p.f, 0, Vec3(a.acceleration.x * dt, a.acceleration.y * dt, a.acceleration.z * dt));
-    } else if constexpr (std::is_same_v<A, Damping>) {
-      put(p.f, 0,
-          Vec3(std::exp(-a.rate.x * dt), std::exp(-a.rate.y * dt), std::exp(-a.rate.z * dt)));
-    } else if constexpr (std::is_same_v<A, Bounce>) {
-      bounce(a);
-    } else if constexpr (std::is_same_v<A, Sink>) {
-      const cl::FlDomain d = packDomain(a.region);
-      std::memcpy(p.f, d.v, sizeof d.v);
-      p.u[0] = d.kind;
-      p.f[16] = a.passThrough;
-    }
-    // KillOld, Move: no constants. Actions the device does not run never get here
-    // (generateProgram rejects them first).
-  }
-  void bounce(const Bounce& a) const {
-    p.f[6] = a.restitution;
-    p.f[7] = 1.0f - a.friction;
-    p.f[8] = a.cutoff * a.cutoff;
-    const auto& shape = a.surface.shape();
-    // As kernels.hpp apply(Bounce) prepares them.
-    auto plane = [&](Vec3 P, Vec3 N) {
-      put(p.f, 0, P);
-      put(p.f, 3, N);
-      p.f[9] = std::abs(P.x) + std::abs(P.y) + std::abs(P.z);
-    };
-    if (const auto* pl = std::get_if<PlaneDomain>(&shape)) {
-      plane(pl->point, pl->normal);
-    } else if (const auto* r = std::get_if<RectangleDomain>(&shape)) {
-      const Vec3 cu = glm::cross(r->v, r->normal), cv = glm::cross(r->normal, r->u);
-      const Vec3 du = cu / glm::dot(r->u, cu), dv = cv / glm::dot(r->v, cv);
-      plane(r->origin, r->normal);
-      put(p.f, 10, du);
-      put(p.f, 13, dv);
-    } else if (const auto* t = std::get_if<TriangleDomain>(&shape)) {
-      const Vec3 e1 = t->p1 - t->p0, e2 = t->p2 - t->p0;
-      const Vec3 c1 = glm::cross(e2, t->normal), c2 = glm::cross(t->normal, e1);
-      const Vec3 d1 = c1 / glm::dot(e1, c1), d2 = c2 / glm::dot(e2, c2);
-      plane(t->p0, t->normal);
-      put(p.f, 10, d1);
-      put(p.f, 13, d2);
-    } else if (const auto* d = std::get_if<DiscDomain>(&shape)) {
-      plane(d->center, d->normal);
-      p.f[10] = d->outerRadius * d->outerRadius;
-      p.f[11] = d->innerRadius * d->innerRadius;
-    } else if (const auto* s = std::get_if<SphereDomain>(&shape)) {
-      const Vec3 C = s->center;
-      const float R = s->outerRadius;
-      put(p.f, 0, C);
-      p.f[9] = std::abs(C.x) + std::abs(C.y) + std::abs(C.z) + R;
-      p.f[10] = R;
-      p.f[11] = R * R;
-      p.f[12] = 1.0f / R;
-    }
-  }
-};
-
-}  // namespace
-
-void packActions(const ActionList& actions, float dt, std::vector<cl::FlActionParams>& out) {
+void packActions(const ActionList& actions, float dt, std::vector<cl::FlActionParams>& out,
+                 std::vector<float>& extra) {
   out.assign(std::max<std::size_t>(actions.size(), 1), cl::FlActionParams{});
-  for (std::size_t k = 0; k < actions.size(); ++k)
-    std::visit(Packer{dt, out[k]}, actions.actions()[k]);
+  extra.clear();
+  for (std::size_t k = 0; k < actions.size(); ++k) {
+    const Action& a = actions.actions()[k];
+    ActionPack p{dt, out[k], extra};
+    if (!packCoreAction(a, p) && !packForceAction(a, p) && !packSurfaceAction(a, p))
+      notOnDevice("action '" + actionName(a) + "' (actions[" + std::to_string(k) + "])");
+  }
+  if (extra.empty()) extra.push_back(0.0f);  // a buffer is never empty
 }
 
 namespace {
 
-int fuzzyMode(const Fuzzy& f) {
-  return f.spread == 0.0f ? 0 : f.distribution == Fuzzy::Distribution::Normal ? 2 : 1;
+// The gathered forces' accelerations at the state named by prefix `pre` and time `t`, into
+// pre + "ax" ... (integrate.hpp evaluate()).
+std::string evaluate(const std::vector<std::string>& accels, const std::string& pre,
+                     const std::string& t, const std::string& out) {
+  std::string s = "{ const float px = " + pre + "px, py = " + pre + "py, pz = " + pre +
+                  "pz, vx = " + pre + "vx, vy = " + pre + "vy, vz = " + pre +
+                  "vz;\n  const fl_real t = " + t +
+                  ";\n  float ax = 0.0f, ay = 0.0f, az = 0.0f;\n  (void)t;\n";
+  for (const std::string& a : accels) s += "  " + a;
+  s += "  " + out + "ax = ax; " + out + "ay = ay; " + out + "az = az; }\n";
+  return s;
 }
 
-std::size_t kindOf(const Domain& d) {
-  packDomain(d);  // throws for a kind the device cannot sample
-  return d.shape().index();
-}
-
-std::string newbornCall(const Emitter& e, std::size_t t, bool oneType) {
-  const ParticleType& p = e.types[t];
+// Move by an integrator other than semi-implicit Euler over the forces `accels` (in list
+// order), as integrate.hpp integrate() does it, operation by operation.
+// dampingParams[j]: the params of force j when it is a Damping (Exact takes its rates), else "".
+std::string integrateMove(Integrator integrator, const std::vector<std::string>& accels,
+                          const std::vector<std::string>& dampingParams, bool prev, bool age) {
   std::ostringstream c;
-  c << "fl_newborn(FL_LANE_ARGS, slot, id, age, at, " << (oneType ? 1 : 0)
-    << ", em, types + em->typeFirst + " << t << "u, rng, " << kindOf(e.shape) << "u, "
-    << kindOf(p.velocity) << "u, " << kindOf(p.color) << "u, " << kindOf(p.up) << "u, "
-    << kindOf(p.rotVelocity) << "u, " << fuzzyMode(p.lifetime) << "u, " << fuzzyMode(p.alpha)
-    << "u, " << fuzzyMode(p.size) << "u, " << fuzzyMode(p.mass) << "u, " << fuzzyMode(p.charge)
-    << "u);";
+  c << "{ /* integrator */\n";
+  if (prev) c << "prevx = px; prevy = py; prevz = pz;\n";
+  // The state at the step's start, under names the forces' code can shadow px.. with.
+  c << "const float c_px = px, c_py = py, c_pz = pz, c_vx = vx, c_vy = vy, c_vz = vz;\n"
+       "float a0ax, a0ay, a0az;\n";
+  switch (integrator) {
+    case Integrator::ExplicitEuler:
+      c << evaluate(accels, "c_", "time", "a0");
+      c << "px += vx * dt; py += vy * dt; pz += vz * dt;\n"
+           "vx += a0ax * dt; vy += a0ay * dt; vz += a0az * dt;\n";
+      break;
+    case Integrator::VelocityVerlet:
+      c << evaluate(accels, "c_", "time", "a0");
+      c << "const float p1px = px + vx * dt + 0.5f * a0ax * dt * dt, p1py = py + vy * dt + 0.5f * "
+           "a0ay * dt * dt, p1pz = pz + vz * dt + 0.5f * a0az * dt * dt;\n"
+           "const float p1vx = vx + a0ax * dt, p1vy = vy + a0ay * dt, p1vz = vz + a0az * dt;\n"
+           "float a1ax, a1ay, a1az;\n"
+        << evaluate(accels, "p1", "time + (fl_real)dt", "a1")
+        << "px = p1px; py = p1py; pz = p1pz;\n"
+           "vx += 0.5f * (a0ax + a1ax) * dt; vy += 0.5f * (a0ay + a1ay) * dt; vz += 0.5f * (a0az "
+           "+ a1az) * dt;\n";
+      break;
+    case Integrator::RK4: {
+      c << "float sppx = 0.0f, sppy = 0.0f, sppz = 0.0f, spvx = 0.0f, spvy = 0.0f, spvz = "
+           "0.0f;\n"
+           "float stpx = px, stpy = py, stpz = pz, stvx = vx, stvy = vy, stvz = vz;\n";
+      const char* h[4] = {"0.0f", "0.5f", "0.5f", "1.0f"};
+      const char* w[4] = {"1.0f", "2.0f", "2.0f", "1.0f"};
+      for (int k = 0; k < 4; ++k) {
+        c << "{ float a1ax, a1ay, a1az;\n"
+          << evaluate(accels, "st", std::string("time + (fl_real)(") + h[k] + " * dt)", "a1")
+          << "const float next = " << (k < 3 ? std::string(h[k + 1]) + " * dt" : "0.0f") << ";\n";
+        for (const char* d : {"x", "y", "z"})
+          c << "{ const float kp = stv" << d << ", kv = a1a" << d << "; spp" << d << " += " << w[k]
+            << " * kp; spv" << d << " += " << w[k] << " * kv; stp" << d << " = p" << d
+            << " + kp * next; stv" << d << " = v" << d << " + kv * next; }\n";
+        c << "}\n";
+      }
+      c << "px += sppx * (dt / 6.0f); py += sppy * (dt / 6.0f); pz += sppz * (dt / 6.0f);\n"
+           "vx += spvx * (dt / 6.0f); vy += spvy * (dt / 6.0f); vz += spvz * (dt / 6.0f);\n";
+      break;
+    }
+    case Integrator::Exact: {
+      // Constant acceleration with per-axis linear drag: Damping's rates go to k.
+      std::vector<std::string> constant;
+      c << "float kx = 0.0f, ky = 0.0f, kz = 0.0f;\n";
+      for (std::size_t j = 0; j < accels.size(); ++j)
+        if (dampingParams[j].empty()) constant.push_back(accels[j]);
+      c << evaluate(constant, "c_", "time", "a0");
+      for (std::size_t j = 0; j < accels.size(); ++j)
+        if (!dampingParams[j].empty()) {
+          const std::string& d = dampingParams[j];
+          c << "kx += " << d << "->f[3]; ky += " << d << "->f[4]; kz += " << d << "->f[5];\n";
+        }
+      for (const char* d : {"x", "y", "z"})
+        c << "{ const float g = a0a" << d << ", k = k" << d << ", v0 = v" << d << ";\n"
+          << "  if (k > 0.0f) { const float e = exp(-k * dt), term = g / k; p" << d
+          << " += term * dt + (v0 - term) * (1.0f - e) / k; v" << d
+          << " = term + (v0 - term) * e; }\n"
+          << "  else { p" << d << " += v0 * dt + 0.5f * g * dt * dt; v" << d
+          << " = v0 + g * dt; } }\n";
+      break;
+    }
+    case Integrator::SemiImplicitEuler:
+      break;
+  }
+  if (age) c << "age += dt;\n";
+  c << "}\n";
   return c.str();
 }
 
 }  // namespace
 
-std::string emitterSignature(const std::vector<Emitter>& emitters) {
-  std::string s;
-  for (const Emitter& e : emitters) {
-    for (std::size_t t = 0; t < e.types.size(); ++t) s += newbornCall(e, t, e.types.size() == 1);
-    s += '|';
-  }
-  return s;
+std::uint32_t stepSubsteps(const ActionList& actions, double dt) {
+  const Substeps& sub = actions.substeps();
+  double n = 1;
+  if (sub.maxStep > 0) n = std::max(n, std::ceil(dt / sub.maxStep));
+  return std::uint32_t(std::min<double>(n, sub.maxSubsteps));
 }
 
 GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored, bool fp64,
-                                 const std::vector<Emitter>& emitters) {
+                                 const std::string& emitSource) {
   GeneratedProgram g;
   // What the act kernel loads (reads) and stores (writes).
   AttributeSet reads, writes;
-  const bool prev = stored.has(Attribute::PrevPosition), age = stored.has(Attribute::Age);
+  const Integrator integrator = actions.integrator();
   std::ostringstream body;
-  for (std::size_t k = 0; k < actions.size(); ++k) {
-    const Action& act = actions.actions()[k];
-    const std::string ap = "&ap[" + std::to_string(k) + "]";
-    const std::string code = std::to_string(k + 1) + "u";
-    body << "  /* " << k << ": " << actionName(act) << " */\n  ";
-    if (std::holds_alternative<Gravity>(act) || std::holds_alternative<Damping>(act)) {
-      reads.insert(Attribute::Velocity);
-      writes.insert(Attribute::Velocity);
-      body << (std::holds_alternative<Gravity>(act) ? "fl_gravity(" : "fl_damping(") << ap
-           << ", &vx, &vy, &vz);\n";
-    } else if (const auto* b = std::get_if<Bounce>(&act)) {
-      reads.insert({Attribute::Position, Attribute::Velocity});
-      writes.insert({Attribute::Position, Attribute::Velocity});
-      const int piece = pieceOf(b->surface);
-      if (piece < 0 && !std::holds_alternative<SphereDomain>(b->surface.shape()))
-        throw Error(std::string("OpenCL backend: Bounce on a ") + b->surface.name() +
-                    " does not run on the device yet; use Backend::Cpu");
-      if (piece < 0)
-        body << "fl_bounce_sphere(" << ap << ", dt, &px, &py, &pz, &vx, &vy, &vz);\n";
-      else
-        body << "fl_bounce_planar(" << ap << ", " << piece
-             << ", dt, &px, &py, &pz, &vx, &vy, &vz);\n";
-    } else if (const auto* s = std::get_if<Sink>(&act)) {
-      reads.insert(Attribute::Position);
-      const bool pass = s->passThrough > 0.0f;
-      if (pass) reads.insert(Attribute::Id);
-      body << "fl_sink(" << ap << ", " << kindOf(s->region) << "u, " << (s->killInside ? 1 : 0)
-           << ", " << (pass ? 1 : 0) << ", px, py, pz, " << (pass ? "id" : "0u") << ", " << code
-           << ", &dead, seedLo, seedHi, step, streamBase + " << k << "u);\n";
-    } else if (std::holds_alternative<KillOld>(act)) {
-      reads.insert({Attribute::Age, Attribute::Lifetime});
-      body << "fl_kill_old(age, life, " << code << ", &dead);\n";
-    } else if (std::holds_alternative<Move>(act)) {
-      reads.insert({Attribute::Position, Attribute::Velocity});
-      writes.insert(Attribute::Position);
-      if (prev) {
-        writes.insert(Attribute::PrevPosition);
-        body << "prevx = px; prevy = py; prevz = pz;\n  ";
+  std::vector<std::string> pending;  // gathered forces' accelerations, for the next Move
+  std::vector<std::string> pendingDamping;
+  std::vector<std::size_t> pendingBounces;
+  const auto& acts = actions.actions();
+  for (std::size_t k = 0; k < acts.size(); ++k) {
+    const Action& act = acts[k];
+    ActionSource src;
+    src.in.index = k;
+    src.in.stored = stored;
+    src.in.params = "(ap + " + std::to_string(k) + ")";
+    src.in.code = std::to_string(k + 1) + "u";
+    src.in.stream = "(streamSub + " + std::to_string(k) + "u)";
+    if (!generateCoreAction(act, src) && !generateForceAction(act, src) &&
+        !generateSurfaceAction(act, src))
+      notOnDevice("action '" + actionName(act) + "' (actions[" + std::to_string(k) + "])");
+    reads.insert(src.reads);
+    writes.insert(src.writes);
+    g.neighbours |= src.neighbours;
+    body << "    /* " << k << ": " << actionName(act) << " */\n";
+    if (integrator != Integrator::SemiImplicitEuler) {
+      // Forces before a Move are evaluated by its integrator (fused_pass.cpp makePlan).
+      if (isForce(act)) {
+        if (src.accel.empty()) notOnDevice(actionName(act) + " under an integrator");
+        pending.push_back(src.accel);
+        pendingDamping.push_back(std::holds_alternative<Damping>(act) ? src.in.params : "");
+        body << "    /* (evaluated by the next Move's integrator) */\n";
+        continue;
       }
-      body << "fl_move(dt, &px, &py, &pz, vx, vy, vz);\n";
-      if (age) {
-        reads.insert(Attribute::Age);
-        writes.insert(Attribute::Age);
-        body << "  age += dt;\n";
+      if (std::holds_alternative<Bounce>(act)) pendingBounces.push_back(k);
+      if (std::holds_alternative<Move>(act)) {
+        if (!pendingBounces.empty())
+          notOnDevice(
+              "a Bounce before a Move under an integrator other than SemiImplicitEuler "
+              "(its curved-step guard)");
+        reads.insert({Attribute::Position, Attribute::Velocity});
+        writes.insert({Attribute::Position, Attribute::Velocity});
+        const bool prev = stored.has(Attribute::PrevPosition), age = stored.has(Attribute::Age);
+        if (prev) writes.insert(Attribute::PrevPosition);
+        if (age) {
+          reads.insert(Attribute::Age);
+          writes.insert(Attribute::Age);
+        }
+        body << integrateMove(integrator, pending, pendingDamping, prev, age);
+        pending.clear();
+        pendingDamping.clear();
+        pendingBounces.clear();
+        continue;
       }
-      if (stored.has(Attribute::Up) && stored.has(Attribute::RotVelocity)) {
-        reads.insert({Attribute::Up, Attribute::RotVelocity});
-        writes.insert(Attribute::Up);
-        body << "  fl_turn_up(dt, &upx, &upy, &upz, rotx, roty, rotz);\n";
-      }
-    } else {
-      throw Error("OpenCL backend: action '" + actionName(act) + "' (actions[" + std::to_string(k) +
-                  "]) does not run on the device yet; use Backend::Cpu");
     }
+    std::istringstream lines(src.apply);
+    for (std::string line; std::getline(lines, line);) body << "    " << line << "\n";
   }
-  const bool kills = actions.kills();
-
+  // The NaN guard reads what it checks.
+  if (stored.has(Attribute::Velocity)) reads.insert(Attribute::Velocity);
+  reads.insert(Attribute::Position);
+  const Substeps& sub = actions.substeps();
+  g.substepsByDistance = sub.maxDistance > 0 && stored.has(Attribute::Velocity);
   std::ostringstream s;
   s << "/* Flurry OpenCL program: generated for one action list. */\n"
     << "#pragma OPENCL FP_CONTRACT OFF\n";  // the CPU backend's float math has no FMAs
@@ -358,29 +358,12 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   s << " } while (0)\n#define FL_LANE_ARGS ";
   for (std::size_t k = 0; k < all.size(); ++k) s << (k ? ", " : "") << "l_" << all[k].name;
   s << "\n";
-  for (const char* f : {"params.h", "philox.h", "domain.cl", "actions.cl", "compact.cl", "emit.cl"})
+  for (const char* f : {"params.h", "philox.h", "domain.cl", "actions.cl", "forces.cl",
+                        "surfaces.cl", "compact.cl", "emit.cl"})
     s << "/* ---- " << f << " */\n" << embeddedKernel(f) << "\n";
 
-  // The newborns of each emitter and type, with their kinds as literals.
-  s << "/* ---- generated: emission per emitter and type */\n"
-       "FL_INLINE void fl_emit(FL_LANE_PARAMS, uint emitter, uint slot, uint id, float age,\n"
-       "                       float3 at, __global const FlEmitter* em,\n"
-       "                       __global const FlParticleType* types, FlRandom* rng) {\n"
-       "  switch (emitter) {\n";
-  for (std::size_t e = 0; e < emitters.size(); ++e) {
-    const Emitter& em = emitters[e];
-    s << "    case " << e << "u:\n";
-    if (em.types.size() == 1) {
-      s << "      " << newbornCall(em, 0, true) << "\n";
-    } else {
-      s << "      switch (fl_choose_type(em, types, rng)) {\n";
-      for (std::size_t t = 0; t < em.types.size(); ++t)
-        s << "        case " << t << "u: " << newbornCall(em, t, false) << " break;\n";
-      s << "      }\n";
-    }
-    s << "      break;\n";
-  }
-  s << "  }\n}\n/* ---- tail.cl */\n" << embeddedKernel("tail.cl") << "\n";
+  s << "/* ---- generated: emission */\n" << emitSource;
+  s << "/* ---- tail.cl */\n" << embeddedKernel("tail.cl") << "\n";
 
   // The fused act kernel.
   const AttributeSet touched = reads | writes;
@@ -388,11 +371,16 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
     if (touched.has(l.attribute)) g.actLanes.push_back(l);
   s << "/* ---- generated: the fused act kernel */\n__kernel void fl_act(";
   for (const auto& l : g.actLanes) s << laneDecl(l) << ", ";
-  s << "__global uchar* restrict codes, __constant FlActionParams* ap,\n"
-       "                     __global const uint* state, float dt, uint seedLo, uint seedHi,\n"
-       "                     uint step, uint streamBase) {\n"
+  s << "__global uchar* restrict codes, __global const FlActionParams* ap,\n"
+       "    __global const uint* state, __global const float* restrict extra,\n"
+       "    __global const float* restrict snap, ulong dtBits, ulong timeBits, uint seedLo,\n"
+       "    uint seedHi, uint step, uint streamBase, uint nsubStep, uint snapStride) {\n"
        "  const uint i = get_global_id(0);\n"
-       "  if (i >= state[FL_STATE_SIZE]) return;\n";
+       "  const uint n = state[FL_STATE_SIZE];\n"
+       "  if (i >= n) return;\n"
+       "  const uint snapN = n;\n"
+       "  (void)extra; (void)snap; (void)snapN; (void)snapStride; (void)seedLo; (void)seedHi;\n"
+       "  (void)step;\n";
   for (const auto& l : g.actLanes) {
     const char* type = info(l.attribute).isUint ? "uint" : "float";
     if (reads.has(l.attribute))
@@ -400,11 +388,37 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
     else
       s << "  " << type << " " << l.name << ";\n";
   }
-  s << "  uint dead = 0u;\n" << body.str();
+  // Sub-steps as fused_pass.cpp: dt / n in double, each with its own time and streams.
+  // nsubStep: by Substeps::maxStep, from the host; then by the fastest particle, which
+  // fl_max_speed left in the state (its |v|^2 as float bits).
+  s << "  uint nsub = nsubStep;\n";
+  if (g.substepsByDistance) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.9g", double(sub.maxDistance));
+    s << "  {\n    const float vmax = sqrt(as_float(state[FL_STATE_MAX_SPEED2]));\n"
+         "    if (isfinite(vmax)) {\n"
+         "      const fl_real m = ceil((fl_real)vmax * fl_real_from_bits(dtBits) / (fl_real)"
+      << buf << "f);\n      const fl_real cap = (fl_real)" << sub.maxSubsteps
+      << "u;\n      if (m > (fl_real)nsub) nsub = (uint)(m < cap ? m : cap);\n    }\n  }\n";
+  }
+  s << "  const float dt = (float)(fl_real_from_bits(dtBits) / (fl_real)nsub);\n"
+       "  uint dead = 0u;\n"
+       "  for (uint sub = 0u; sub < nsub; ++sub) {\n"
+       "    const fl_real time = fl_real_from_bits(timeBits) + (fl_real)sub * (fl_real)dt;\n"
+       "    const uint streamSub = streamBase + (sub << 8);\n"
+       "    (void)time; (void)streamSub;\n"
+    << body.str() << "  }\n";
+  // The NaN guard (fused_pass.cpp guardFinite): position and velocity, by their bits.
+  s << "  {\n    uint bad = 0u;\n";
+  for (const char* c : {"px", "py", "pz"})
+    s << "    bad |= (as_uint(" << c << ") & 0x7f800000u) == 0x7f800000u;\n";
+  if (stored.has(Attribute::Velocity))
+    for (const char* c : {"vx", "vy", "vz"})
+      s << "    bad |= (as_uint(" << c << ") & 0x7f800000u) == 0x7f800000u;\n";
+  s << "    dead = bad ? FL_NON_FINITE_CODE : dead;\n  }\n";
   for (const auto& l : g.actLanes)
     if (writes.has(l.attribute)) s << "  l_" << l.name << "[i] = " << l.name << ";\n";
-  if (kills) s << "  codes[i] = (uchar)dead;\n";
-  s << "  (void)dead;\n}\n";
+  s << "  codes[i] = (uchar)dead;\n}\n";
   g.source = s.str();
   // Correctly rounded division and sqrt: the CPU's are, and Bounce divides.
   g.options = "-cl-std=CL1.2 -cl-fp32-correctly-rounded-divide-sqrt";

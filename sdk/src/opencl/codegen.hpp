@@ -26,23 +26,86 @@ std::vector<LaneRef> lanesOf(AttributeSet stored);
 struct GeneratedProgram {
   std::string source;
   std::string options;
-  std::vector<LaneRef> actLanes;  ///< fl_act's lane parameters, in order
+  std::vector<LaneRef> actLanes;    ///< fl_act's lane parameters, in order
+  bool neighbours = false;          ///< fl_act reads the snapshot of p, v, rot
+  bool substepsByDistance = false;  ///< fl_max_speed runs before fl_act
 };
 
 /// The program for this list over these stored attributes: the embedded kernels plus one
 /// generated fused act kernel (fl_act) that runs exactly the list's actions, in order, and
-/// loads and stores exactly the lanes they use.
-/// The emission code is generated too: per emitter and particle type, a call with the domain
-/// kinds and fuzzy modes as literals (its numbers travel in buffers).
+/// loads and stores exactly the lanes they use. `emitSource` is the generated emission code
+/// (emission.hpp emissionSource), placed before tail.cl.
 GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored, bool fp64,
-                                 const std::vector<Emitter>& emitters);
+                                 const std::string& emitSource);
 
-/// What of the emitters shapes the program (domain kinds, type counts, which fuzzy values
-/// draw): a new program is needed when this changes.
-std::string emitterSignature(const std::vector<Emitter>& emitters);
+/// What the generator of one action writes into the fused act kernel.
+///
+/// The act kernel holds each particle in registers named after its lanes (px py pz, vx vy vz,
+/// r g b a, size, mass, age, life, id, prevx.., upx.., rotx.., charge, vis, user, pbx.. for
+/// PositionB, vbx.. for VelocityB) and has in scope:
+///   float dt              the (sub-)step's length
+///   fl_real time          the (sub-)step's start time (double where the device has fp64)
+///   uint seedLo, seedHi, step   the Philox key and counter parts, as on the CPU
+///   uint i, n             the particle's index and the live count at the start of the step
+///   uint dead             0, or the first kill code of this step (set it only when 0)
+///   __global const FlActionParams* ap   the list's constants (ap[k] is this action's)
+///   __global const float* extra         the list's variable-length constants
+///   __global const float* snap          neighbours: p, v, rot at the step's start:
+///                                       FL_SNAP(a, c, j) (a: 0 p, 1 v, 2 rot; c: x y z)
+///   uint snapN                          the particles in snap
+/// The strings in `in` name this action's pieces; generators fill `out`.
+struct ActionSource {
+  struct In {
+    std::size_t index = 0;  ///< k, the action's place in the list
+    AttributeSet stored;    ///< what the group stores
+    std::string params;     ///< "(ap + k)"
+    std::string code;       ///< the kill code literal, "(k+1)u"
+    std::string stream;     ///< the Philox stream expression of this action (CPU's
+                            ///< streamBase + action, with the sub-step folded in)
+  } in;
+  AttributeSet reads, writes;  ///< lanes loaded before the list and stored after it
+  std::string apply;           ///< statements: the action as its own update, in list order
+  /// Forces only (isForce): statements adding this force's acceleration at the state
+  /// (px..vz, t) to ax, ay, az, used by the integrators other than semi-implicit Euler.
+  /// They must read the state through the names px py pz vx vy vz and fl_real t only.
+  std::string accel;
+  bool neighbours = false;  ///< reads snap (the backend then copies the lanes each step)
+};
+
+/// The constants of one action for a step of dt seconds.
+struct ActionPack {
+  float dt;
+  cl::FlActionParams& p;
+  std::vector<float>& extra;
+};
+
+// Each family's generator and packer: false when the action is not the family's.
+// actions_core.cpp: Move, KillOld, CopyVertexB, Restore, Callback.
+bool generateCoreAction(const Action& a, ActionSource& s);
+bool packCoreAction(const Action& a, ActionPack& p);
+// actions_forces.cpp (kernels/forces.cl): forces, random and target actions, over-life curves.
+bool generateForceAction(const Action& a, ActionSource& s);
+bool packForceAction(const Action& a, ActionPack& p);
+// actions_surfaces.cpp (kernels/surfaces.cl): deflectors, absorbers, blockers, 2-D, and the
+// actions that read neighbours.
+bool generateSurfaceAction(const Action& a, ActionSource& s);
+bool packSurfaceAction(const Action& a, ActionPack& p);
+
+/// Throws the Error that says an action (or a variant of one) does not run on the device.
+[[noreturn]] void notOnDevice(const std::string& what);
 
 /// The actions' constants for a step of dt seconds (products with dt rounded as on the CPU).
-void packActions(const ActionList& actions, float dt, std::vector<cl::FlActionParams>& out);
+void packActions(const ActionList& actions, float dt, std::vector<cl::FlActionParams>& out,
+                 std::vector<float>& extra);
+
+/// Sub-steps of a step of dt seconds by Substeps::maxStep (fused_pass.cpp makePlan).
+std::uint32_t stepSubsteps(const ActionList& actions, double dt);
+
+inline void putVec(float* v, int at, Vec3 x) {
+  v[at] = x.x;
+  v[at + 1] = x.y;
+  v[at + 2] = x.z;
+}
 
 /// A domain as the sampling and containment code on the device reads it.
 cl::FlDomain packDomain(const Domain& d);

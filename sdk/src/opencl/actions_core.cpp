@@ -1,0 +1,87 @@
+// The core actions on the device: Move, KillOld, CopyVertexB, Restore, Callback (its OpenCL
+// body). Their functions are in kernels/actions.cl.
+#include <cstring>
+#include <string>
+
+#include "codegen.hpp"
+
+namespace flurry::detail::ocl {
+
+bool generateCoreAction(const Action& act, ActionSource& s) {
+  const AttributeSet& stored = s.in.stored;
+  if (std::holds_alternative<KillOld>(act)) {
+    s.reads.insert({Attribute::Age, Attribute::Lifetime});
+    s.apply = "fl_kill_old(age, life, " + s.in.code + ", &dead);\n";
+    return true;
+  }
+  if (std::holds_alternative<Move>(act)) {
+    // Semi-implicit Euler; codegen.cpp writes the other integrators' Move itself.
+    s.reads.insert({Attribute::Position, Attribute::Velocity});
+    s.writes.insert(Attribute::Position);
+    if (stored.has(Attribute::PrevPosition)) {
+      s.writes.insert(Attribute::PrevPosition);
+      s.apply += "prevx = px; prevy = py; prevz = pz;\n";
+    }
+    s.apply += "fl_move(dt, &px, &py, &pz, vx, vy, vz);\n";
+    if (stored.has(Attribute::Age)) {
+      s.reads.insert(Attribute::Age);
+      s.writes.insert(Attribute::Age);
+      s.apply += "age += dt;\n";
+    }
+    if (stored.has(Attribute::Up) && stored.has(Attribute::RotVelocity)) {
+      s.reads.insert({Attribute::Up, Attribute::RotVelocity});
+      s.writes.insert(Attribute::Up);
+      s.apply += "fl_turn_up(dt, &upx, &upy, &upz, rotx, roty, rotz);\n";
+    }
+    return true;
+  }
+  if (const auto* c = std::get_if<CopyVertexB>(&act)) {
+    if (c->copyPosition) {
+      s.reads.insert(Attribute::Position);
+      s.writes.insert(Attribute::PositionB);
+      s.apply += "pbx = px; pby = py; pbz = pz;\n";
+    }
+    if (c->copyVelocity) {
+      s.reads.insert(Attribute::Velocity);
+      s.writes.insert(Attribute::VelocityB);
+      s.apply += "vbx = vx; vby = vy; vbz = vz;\n";
+    }
+    return true;
+  }
+  if (std::holds_alternative<Restore>(act)) {
+    s.reads.insert({Attribute::Position, Attribute::Velocity, Attribute::PositionB});
+    s.writes.insert({Attribute::Position, Attribute::Velocity});
+    s.apply =
+        "fl_restore(" + s.in.params + ", dt, time, &px, &py, &pz, &vx, &vy, &vz, pbx, pby, pbz);\n";
+    return true;
+  }
+  if (const auto* c = std::get_if<Callback>(&act)) {
+    if (c->opencl.empty())
+      notOnDevice(
+          "a Callback without an OpenCL body (Callback::opencl; its C++ function "
+          "cannot run on the device)");
+    // The user's statements see the lanes it declared by their kernel names; braces keep its
+    // locals its own.
+    s.reads.insert(c->attributes);
+    for (int a = 0; a < int(Attribute::Count); ++a)
+      if (c->attributes.has(Attribute(a)) && Attribute(a) != Attribute::Id)
+        s.writes.insert(Attribute(a));
+    s.apply = "{\n" + c->opencl + "\n}\n";
+    return true;
+  }
+  return false;
+}
+
+bool packCoreAction(const Action& act, ActionPack& p) {
+  if (const auto* r = std::get_if<Restore>(&act)) {
+    // kernels.hpp apply(Restore) works in double from these (as bit patterns: params.h).
+    const double start = r->start, end = double(r->start) + r->duration;
+    std::memcpy(&p.p.u[0], &start, 8);
+    std::memcpy(&p.p.u[2], &end, 8);
+    return true;
+  }
+  return std::holds_alternative<KillOld>(act) || std::holds_alternative<Move>(act) ||
+         std::holds_alternative<CopyVertexB>(act) || std::holds_alternative<Callback>(act);
+}
+
+}  // namespace flurry::detail::ocl
