@@ -55,16 +55,23 @@ FL_INLINE uint fl_choose_type(__global const FlEmitter* em, __global const FlPar
 }
 
 /* One newborn of type `type`: the draws in emission.cpp's order, skipping what is not
- * stored. The kinds and modes are literals. */
+ * stored. The kinds and modes are literals; normalMode is 0 without Emitter::normalSpeed,
+ * else 1 + its fuzzy mode. */
 FL_INLINE void fl_newborn(FL_LANE_PARAMS, uint slot, uint id, float age, float3 at, int oneType,
                           __global const FlEmitter* em, __global const FlParticleType* type,
-                          FlRandom* rng, uint shapeKind, uint velKind, uint colorKind,
-                          uint upKind, uint rotKind, uint lifeMode, uint alphaMode,
-                          uint sizeMode, uint massMode, uint chargeMode) {
-  const float3 vel = fl_sample(&type->velocity, velKind, rng);
+                          FlRandom* rng, __global const float* shapes, uint shapeKind,
+                          uint velKind, uint colorKind, uint upKind, uint rotKind,
+                          uint normalMode, uint lifeMode, uint alphaMode, uint sizeMode,
+                          uint massMode, uint chargeMode) {
+  float3 vel = fl_sample_any(&type->velocity, velKind, rng, shapes);
+  const float3 shape = fl_sample_any(&em->shape, shapeKind, rng, shapes);
+  if (normalMode != 0) {
+    /* Every face emits along its normal: the shape's normal where the particle was born. */
+    const float speed = fl_fuzzy(&em->normalSpeed, normalMode - 1, rng);
+    vel = vel + fl_normal_at(&em->shape, shapeKind, shape, shapes) * speed;
+  }
   /* Born where the emitter was at its birth time, carried on for the rest of the step. The
    * CPU adds these in a different order for one type (emitBatch) and several (emitOneByOne). */
-  const float3 shape = fl_sample(&em->shape, shapeKind, rng);
   const float3 pos = oneType ? shape + (at + vel * age) : shape + at + vel * age;
   l_px[slot] = pos.x;
   l_py[slot] = pos.y;
@@ -84,7 +91,7 @@ FL_INLINE void fl_newborn(FL_LANE_PARAMS, uint slot, uint id, float age, float3 
 #endif
 #ifdef FL_HAS_COLOR
   {
-    const float3 rgb = fl_sample(&type->color, colorKind, rng);
+    const float3 rgb = fl_sample_any(&type->color, colorKind, rng, shapes);
     l_r[slot] = rgb.x;
     l_g[slot] = rgb.y;
     l_b[slot] = rgb.z;
@@ -102,7 +109,7 @@ FL_INLINE void fl_newborn(FL_LANE_PARAMS, uint slot, uint id, float age, float3 
 #endif
 #ifdef FL_HAS_UP
   {
-    const float3 up = fl_sample(&type->up, upKind, rng);
+    const float3 up = fl_sample_any(&type->up, upKind, rng, shapes);
     l_upx[slot] = up.x;
     l_upy[slot] = up.y;
     l_upz[slot] = up.z;
@@ -110,7 +117,7 @@ FL_INLINE void fl_newborn(FL_LANE_PARAMS, uint slot, uint id, float age, float3 
 #endif
 #ifdef FL_HAS_ROT_VELOCITY
   {
-    const float3 w = fl_sample(&type->rotVelocity, rotKind, rng);
+    const float3 w = fl_sample_any(&type->rotVelocity, rotKind, rng, shapes);
     l_rotx[slot] = w.x;
     l_roty[slot] = w.y;
     l_rotz[slot] = w.z;
@@ -125,6 +132,18 @@ FL_INLINE void fl_newborn(FL_LANE_PARAMS, uint slot, uint id, float age, float3 
 #endif
 #ifdef FL_HAS_USER_DATA
   l_user[slot] = 0.0f;
+#endif
+  /* The rest pose and second velocity start as a new lane's do (GroupImpl::ensureStorage):
+   * the birth position and zero, not what the slot's last particle left. */
+#ifdef FL_HAS_POSITION_B
+  l_pbx[slot] = pos.x;
+  l_pby[slot] = pos.y;
+  l_pbz[slot] = pos.z;
+#endif
+#ifdef FL_HAS_VELOCITY_B
+  l_vbx[slot] = 0.0f;
+  l_vby[slot] = 0.0f;
+  l_vbz[slot] = 0.0f;
 #endif
   (void)colorKind, (void)upKind, (void)rotKind, (void)lifeMode, (void)alphaMode, (void)sizeMode;
   (void)massMode, (void)chargeMode;

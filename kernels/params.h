@@ -31,6 +31,9 @@ typedef std::uint64_t fl_u64;
 #define FL_DOMAIN_CYLINDER 8
 #define FL_DOMAIN_CONE 9
 #define FL_DOMAIN_BLOB 10
+/* Emission only (their data lives in the step's shape table, see emission.hpp). */
+#define FL_DOMAIN_MESH 11
+#define FL_DOMAIN_UNION 12
 
 /* A domain to sample from or to test against. v[] by kind (vectors are 3 floats):
  *  point p | line p0 p1 | triangle p0 p1 p2 | plane point normal | rectangle origin u v
@@ -65,10 +68,11 @@ typedef struct FlEmitter {
   fl_u64 rate;     /* double bits: particles per second */
   float position[4];
   float velocity[4];
+  FlFuzzy normalSpeed;         /* Emitter::normalSpeed */
   fl_u32 pathFirst, pathCount; /* keyframes [pathFirst, pathFirst + pathCount) */
   fl_u32 typeFirst, typeCount; /* types [typeFirst, typeFirst + typeCount) */
   float totalWeight;           /* the types' weights summed in order, as the CPU does */
-  fl_u32 pad;
+  fl_u32 variant;              /* the case of the generated fl_emit for its kinds */
 } FlEmitter;
 
 typedef struct FlKeyframe {
@@ -76,13 +80,18 @@ typedef struct FlKeyframe {
   float position[4];
 } FlKeyframe;
 
-/* One run of births of one emitter this step: by rate, or one burst. */
+/* One run of births of one emitter this step (sdk/src/emission.cpp BirthRun). */
+#define FL_RUN_RATE 0u
+#define FL_RUN_BURST 1u
+#define FL_RUN_DISTANCE 2u
 typedef struct FlBirthRun {
-  fl_u64 first;     /* rate: index of the run's first birth since the emitter's start */
-  fl_u64 burstTime; /* double bits */
-  fl_u64 start;     /* index of the run's first newborn among this step's births */
-  fl_u32 emitter;
-  fl_u32 burst;
+  fl_u64 first; /* rate: index of the run's first birth since the emitter's start */
+  fl_u64 time;  /* double bits: a burst's time; distance: the step's start */
+  fl_u64 start; /* index of the run's first newborn among this step's births */
+  fl_u64 s0, spacing, span, dt; /* distance, double bits: births at time + dt (s0 + q
+                                   spacing) / span */
+  fl_u32 emitter; /* index into the step's emitter table */
+  fl_u32 kind;    /* FL_RUN_* */
 } FlBirthRun;
 
 /* One action's constants, computed on the host as the CPU backend computes them (so the
@@ -109,8 +118,9 @@ typedef struct FlActionParams {
 #define FL_STATE_FIRST_ID 7 /* this step: the first newborn's id */
 #define FL_STATE_SUBSTEPS 8 /* this step: sub-steps (Substeps::maxDistance), from fl_max_speed */
 #define FL_STATE_MAX_SPEED2 9 /* this step: the largest |v|^2, as float bits (atomic_max) */
-#define FL_STATE_KILLS 10   /* then one cumulative (wrapping) kill counter per kill code */
-#define FL_STATE_HEADER 10
+#define FL_STATE_HAIR_ALIVE 10 /* hair: strands whose particle outlived maxVertices (cumulative) */
+#define FL_STATE_KILLS 11   /* then one cumulative (wrapping) kill counter per kill code */
+#define FL_STATE_HEADER 11
 #define FL_KILL_CODES 255   /* codes 1..255: 1 + the killing action, 255 non-finite */
 #define FL_NON_FINITE_CODE 255
 

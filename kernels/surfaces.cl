@@ -1,12 +1,36 @@
 /* Deflectors, absorbers, blockers, 2-D constraints and the actions that read neighbours
  * (sdk/src/opencl/actions_surfaces.cpp generates their calls and packs their constants).
- * Each follows sdk/src/cpu/kernels.hpp and actions_more.hpp operation by operation. */
+ * Each follows sdk/src/cpu/kernels.hpp and actions_more.hpp operation by operation: float3
+ * arithmetic is per component (FP_CONTRACT is off) and dot products add x, y, z in glm's
+ * order, so the results agree with the CPU's to the bit. */
+
+/* ---- helpers ----------------------------------------------------------------------------
+ * Closest points, normals, dot products and clamps are domain.cl's (fl_closest,
+ * fl_normal_leaf, fl_dotv, fl_clamp), which follow domain.cpp operation by operation. */
+
+FL_INLINE float3 fl_surf_normalize(float3 a) {
+  return a * (1.0f / sqrt(fl_dotv(a, a)));
+}
+
+FL_INLINE int fl_surf_planar(uint kind) {
+  return kind == FL_DOMAIN_PLANE || kind == FL_DOMAIN_RECTANGLE || kind == FL_DOMAIN_DISC ||
+         kind == FL_DOMAIN_TRIANGLE;
+}
+
+/* Domain::distance. `shapes` is never read: actions' regions are never meshes or unions. */
+FL_INLINE float fl_surf_distance(__global const FlActionParams* a, uint kind, float3 p,
+                                 __global const float* shapes) {
+  return fl_lengthv(p - fl_closest(a->domain.v, kind, p, shapes));
+}
+
+/* ---- Bounce ------------------------------------------------------------------------------ */
 
 /* Reflects the velocity at the hit point h (normal n, time of impact tau) and places the
- * particle so that Move ends it at the reflected point (kernels.hpp Reflect). */
+ * particle so that Move ends it at the reflected point (kernels.hpp Reflect). f[6]
+ * restitution, f[7] 1 - friction, f[8] cutoff^2. */
 FL_INLINE void fl_reflect(__global const FlActionParams* a, float* px, float* py, float* pz,
-                          float* vx, float* vy, float* vz, float hx, float hy, float hz,
-                          float nx, float ny, float nz, float tau) {
+                          float* vx, float* vy, float* vz, float hx, float hy, float hz, float nx,
+                          float ny, float nz, float tau) {
   const float restitution = a->f[6], keep = a->f[7], cutoff2 = a->f[8];
   const float vn = *vx * nx + *vy * ny + *vz * nz;
   const float vnx = vn * nx, vny = vn * ny, vnz = vn * nz;
@@ -25,10 +49,10 @@ FL_INLINE void fl_reflect(__global const FlActionParams* a, float* px, float* py
 #define FL_PIECE_RECTANGLE 1
 #define FL_PIECE_TRIANGLE 2
 #define FL_PIECE_DISC 3
+#define FL_PIECE_SEGMENT 4
 
 /* Whether a point of the plane lies on the piece (piece is a literal: folded away). */
-FL_INLINE int fl_on_piece(__global const FlActionParams* a, int piece, float x, float y,
-                          float z) {
+FL_INLINE int fl_on_piece(__global const FlActionParams* a, int piece, float x, float y, float z) {
   const float wx = x - a->f[0], wy = y - a->f[1], wz = z - a->f[2];
   if (piece == FL_PIECE_RECTANGLE) {
     const float s = wx * a->f[10] + wy * a->f[11] + wz * a->f[12];
@@ -44,13 +68,17 @@ FL_INLINE int fl_on_piece(__global const FlActionParams* a, int piece, float x, 
     const float r2 = wx * wx + wy * wy + wz * wz;
     return (r2 <= a->f[10]) & (r2 >= a->f[11]);
   }
+  if (piece == FL_PIECE_SEGMENT) {
+    const float t = (wx * a->f[10] + wy * a->f[11] + wz * a->f[12]) / a->f[13];
+    return (t >= 0.0f) & (t <= 1.0f);
+  }
   return 1;
 }
 
-/* A two-sided planar deflector (kernels.hpp bouncePlanarLoop). */
-FL_INLINE void fl_bounce_planar(__global const FlActionParams* a, int piece, float dt,
-                                float* px, float* py, float* pz, float* vxs, float* vys,
-                                float* vzs) {
+/* A two-sided planar deflector (kernels.hpp bouncePlanarLoop). f[0..2] a point of the
+ * plane, f[3..5] its unit normal. */
+FL_INLINE void fl_bounce_planar(__global const FlActionParams* a, int piece, float dt, float* px,
+                                float* py, float* pz, float* vxs, float* vys, float* vzs) {
   const float Px = a->f[0], Py = a->f[1], Pz = a->f[2];
   const float Nx = a->f[3], Ny = a->f[4], Nz = a->f[5];
   const float x = *px, y = *py, z = *pz, vx = *vxs, vy = *vys, vz = *vzs;
@@ -64,10 +92,14 @@ FL_INLINE void fl_bounce_planar(__global const FlActionParams* a, int piece, flo
   if (!hit) return;
   float nx = x, ny = y, nz = z, nvx = vx, nvy = vy, nvz = vz;
   fl_reflect(a, &nx, &ny, &nz, &nvx, &nvy, &nvz, hx, hy, hz, Nx, Ny, Nz, tau);
+  /* Where Move will put it; pushed out if rounding left it on or behind the plane. */
   const float qx = nx + nvx * dt, qy = ny + nvy * dt, qz = nz + nvz * dt;
   const float qd = side * ((qx - Px) * Nx + (qy - Py) * Ny + (qz - Pz) * Nz);
-  const float margin = 4e-7f * (fabs(qx) + fabs(qy) + fabs(qz) + a->f[9]) + 1e-30f;
-  const float push = fl_maxf(2.0f * margin - qd, 0.0f) * side;
+  const float margin = 1.2e-7f * (fabs(Nx) * (fabs(qx) + fabs(Px) + fabs(nvx * dt)) +
+                                  fabs(Ny) * (fabs(qy) + fabs(Py) + fabs(nvy * dt)) +
+                                  fabs(Nz) * (fabs(qz) + fabs(Pz) + fabs(nvz * dt))) +
+                       1e-30f;
+  const float push = fl_maxf(margin - qd, 0.0f) * side;
   *px = nx + push * Nx;
   *py = ny + push * Ny;
   *pz = nz + push * Nz;
@@ -76,47 +108,382 @@ FL_INLINE void fl_bounce_planar(__global const FlActionParams* a, int piece, flo
   *vzs = nvz;
 }
 
-/* A sphere deflecting from outside (kernels.hpp bounceSphereLoop). */
-FL_INLINE void fl_bounce_sphere(__global const FlActionParams* a, float dt, float* px,
+/* A sphere deflecting from outside (inside == 0) or keeping particles in (kernels.hpp
+ * bounceSphereLoop). f[0..2] center, f[9] |C|_1 + R, f[10] R, f[11] R^2, f[12] 1/R. */
+FL_INLINE void fl_bounce_sphere(__global const FlActionParams* a, int inside, float dt, float* px,
                                 float* py, float* pz, float* vxs, float* vys, float* vzs) {
   const float Cx = a->f[0], Cy = a->f[1], Cz = a->f[2];
-  const float R2 = a->f[11], invR = a->f[12];
+  const float R = a->f[10], R2 = a->f[11], invR = a->f[12];
   const float x = *px, y = *py, z = *pz, vx = *vxs, vy = *vys, vz = *vzs;
   const float rx = x - Cx, ry = y - Cy, rz = z - Cz;
   const float c2 = rx * rx + ry * ry + rz * rz - R2;
   const float bb = rx * vx + ry * vy + rz * vz;
   const float aa = vx * vx + vy * vy + vz * vz;
   const float disc = bb * bb - aa * c2;
-  const float tHit = (-bb - sqrt(fl_maxf(disc, 0.0f))) / aa;
-  const int hit = (c2 >= 0.0f) & (disc >= 0.0f) & (bb < 0.0f) & (tHit <= dt);
-  if (!hit) return;
-  const float tau = fl_maxf(tHit, 0.0f);
-  const float hx = x + vx * tau, hy = y + vy * tau, hz = z + vz * tau;
-  const float nnx = (hx - Cx) * invR, nny = (hy - Cy) * invR, nnz = (hz - Cz) * invR;
-  float nx = x, ny = y, nz = z, nvx = vx, nvy = vy, nvz = vz;
-  fl_reflect(a, &nx, &ny, &nz, &nvx, &nvy, &nvz, hx, hy, hz, nnx, nny, nnz, tau);
-  const float qx = nx + nvx * dt - Cx, qy = ny + nvy * dt - Cy, qz = nz + nvz * dt - Cz;
-  const float qd = sqrt(qx * qx + qy * qy + qz * qz) - a->f[10];
-  const float margin = 4e-7f * (fabs(qx) + fabs(qy) + fabs(qz) + a->f[9]) + 1e-30f;
-  const float push = fl_maxf(2.0f * margin - qd, 0.0f);
-  *px = nx + push * nnx;
-  *py = ny + push * nny;
-  *pz = nz + push * nnz;
-  *vxs = nvx;
-  *vys = nvy;
-  *vzs = nvz;
+  const float root = sqrt(fl_maxf(disc, 0.0f));
+  /* Outside: the entry root; inside: the exit root. inf/NaN (aa = 0) is a miss. */
+  const float tHit = inside ? (-bb + root) / aa : (-bb - root) / aa;
+  const int hit = inside ? (c2 <= 0.0f) & (tHit <= dt)
+                         : (c2 >= 0.0f) & (disc >= 0.0f) & (bb < 0.0f) & (tHit <= dt);
+  if (hit) {
+    const float tau = fl_maxf(tHit, 0.0f);
+    const float hx = x + vx * tau, hy = y + vy * tau, hz = z + vz * tau;
+    const float nnx = (hx - Cx) * invR, nny = (hy - Cy) * invR, nnz = (hz - Cz) * invR;
+    float nx = x, ny = y, nz = z, nvx = vx, nvy = vy, nvz = vz;
+    fl_reflect(a, &nx, &ny, &nz, &nvx, &nvy, &nvz, hx, hy, hz, nnx, nny, nnz, tau);
+    const float qx = nx + nvx * dt - Cx, qy = ny + nvy * dt - Cy, qz = nz + nvz * dt - Cz;
+    /* Signed clearance on the allowed side. */
+    const float ql = sqrt(qx * qx + qy * qy + qz * qz);
+    const float qd = inside ? R - ql : ql - R;
+    const float margin = 4e-7f * (fabs(qx) + fabs(qy) + fabs(qz) + a->f[9] + fabs(nvx * dt) +
+                                  fabs(nvy * dt) + fabs(nvz * dt)) +
+                         1e-30f;
+    const float push = fl_maxf(2.0f * margin - qd, 0.0f) * (inside ? -1.0f : 1.0f);
+    *px = nx + push * nnx;
+    *py = ny + push * nny;
+    *pz = nz + push * nnz;
+    *vxs = nvx;
+    *vys = nvy;
+    *vzs = nvz;
+  }
+  if (!inside) return;
+  /* A particle that crosses the sphere more than once in a step bounces again for what is
+   * left of the step; if it still would leave, it ends inside. */
+  const float3 C = (float3)(Cx, Cy, Cz);
+  const float3 p = (float3)(*px, *py, *pz);
+  float3 v = (float3)(*vxs, *vys, *vzs);
+  const float slack = 4e-7f * (R + fl_lengthv(v) * dt);
+  if (!(fl_lengthv(p + v * dt - C) > R - slack)) return;
+  float left = dt;
+  float3 cur = p;
+  for (int bounce = 0; bounce < 16 && fl_lengthv(cur + v * left - C) > R - slack; ++bounce) {
+    const float3 r = cur - C;
+    const float bb2 = fl_dotv(r, v), aa2 = fl_dotv(v, v);
+    const float c22 = fl_dotv(r, r) - R2;
+    const float t = fl_clamp((-bb2 + sqrt(fl_maxf(bb2 * bb2 - aa2 * c22, 0.0f))) / aa2, 0.0f, left);
+    cur += v * t;
+    left -= t;
+    const float3 nrm = fl_surf_normalize(cur - C);
+    float qx = cur.x, qy = cur.y, qz = cur.z, nvx = v.x, nvy = v.y, nvz = v.z;
+    fl_reflect(a, &qx, &qy, &qz, &nvx, &nvy, &nvz, cur.x, cur.y, cur.z, nrm.x, nrm.y, nrm.z, 0.0f);
+    v = (float3)(nvx, nvy, nvz);
+  }
+  float3 pos = cur + v * left;
+  /* Inside by more than Move's rounding of p + v dt. */
+  const float margin = 4e-6f * R + 1e-6f * fl_lengthv(v) * dt;
+  if (fl_lengthv(pos - C) > R - margin)
+    pos = C + (pos - C) * (fl_maxf(R - margin, 0.5f * R) / fl_lengthv(pos - C));
+  const float3 q = pos - v * dt;
+  *px = q.x;
+  *py = q.y;
+  *pz = q.z;
+  *vxs = v.x;
+  *vys = v.y;
+  *vzs = v.z;
 }
 
-/* An absorber (kernels.hpp sinkLoop, then the pass-through draw for those it just took). */
-FL_INLINE void fl_sink(__global const FlActionParams* a, uint kind, int killInside,
-                       int passThrough, float x, float y, float z, uint id, uint code,
-                       uint* dead, uint seedLo, uint seedHi, uint step, uint stream) {
+/* A box keeping particles inside, each axis its own pair of walls (kernels.hpp
+ * bounceBoxInside). The box is a->domain.v: min, max. */
+FL_INLINE void fl_bounce_box_inside(__global const FlActionParams* a, float dt, float* px,
+                                    float* py, float* pz, float* vxs, float* vys, float* vzs) {
+  __global const float* box = a->domain.v;
+  const float e = a->f[6], keep = a->f[7], cut2 = a->f[8];
+  float* p[3] = {px, py, pz};
+  const float v[3] = {*vxs, *vys, *vzs};
+  int hit[3];
+  float wall[3], tau[3];
+  for (int k = 0; k < 3; ++k) {
+    const float x = *p[k], vk = v[k];
+    const float q = x + vk * dt;
+    hit[k] = q < box[k] || q > box[3 + k];
+    wall[k] = q > box[3 + k] ? box[3 + k] : box[k];
+    tau[k] = hit[k] ? fl_clamp((wall[k] - x) / vk, 0.0f, dt) : 0.0f;
+  }
+  if (!(hit[0] || hit[1] || hit[2])) return;
+  /* The final velocity first: reflected on the axes that hit, slowed by friction on the
+   * others. */
+  float nv[3];
+  for (int k = 0; k < 3; ++k) {
+    nv[k] = hit[k] ? -v[k] * e : v[k];
+    for (int j = 0; j < 3; ++j) {
+      if (j == k || !hit[j]) continue;
+      const int a1 = (j + 1) % 3, a2 = (j + 2) % 3;
+      const float t2 = v[a1] * v[a1] + v[a2] * v[a2];
+      if (t2 > cut2) nv[k] *= keep;
+    }
+  }
+  for (int k = 0; k < 3; ++k) {
+    if (hit[k]) {
+      const float margin = 4e-7f * (fabs(wall[k]) + fabs(nv[k] * dt)) + 1e-30f;
+      const float end =
+          fl_clamp(wall[k] + nv[k] * (dt - tau[k]), box[k] + margin, box[3 + k] - margin);
+      *p[k] = end - nv[k] * dt;
+    }
+  }
+  *vxs = nv[0];
+  *vys = nv[1];
+  *vzs = nv[2];
+}
+
+/* A box deflecting from outside: the segment's entry face, slab method (kernels.hpp
+ * bounceBoxOutside). */
+FL_INLINE void fl_bounce_box_outside(__global const FlActionParams* a, float dt, float* px,
+                                     float* py, float* pz, float* vxs, float* vys, float* vzs) {
+  __global const float* box = a->domain.v;
+  const float p[3] = {*px, *py, *pz}, v[3] = {*vxs, *vys, *vzs};
+  if (fl_inside(box, FL_DOMAIN_BOX, p[0], p[1], p[2])) return; /* already in */
+  float tEnter = 0.0f, tExit = dt;
+  int axis = -1;
+  int miss = 0;
+  for (int k = 0; k < 3 && !miss; ++k) {
+    if (v[k] == 0.0f) {
+      miss = p[k] < box[k] || p[k] > box[3 + k];
+      continue;
+    }
+    float t0 = (box[k] - p[k]) / v[k], t1 = (box[3 + k] - p[k]) / v[k];
+    if (t0 > t1) {
+      const float s = t0;
+      t0 = t1;
+      t1 = s;
+    }
+    if (t0 > tEnter) {
+      tEnter = t0;
+      axis = k;
+    }
+    tExit = t1 < tExit ? t1 : tExit; /* std::min */
+    miss = tEnter > tExit;
+  }
+  if (miss || axis < 0) return;
+  float nrm[3] = {0.0f, 0.0f, 0.0f};
+  nrm[axis] = v[axis] > 0.0f ? -1.0f : 1.0f;
+  const float hx = p[0] + v[0] * tEnter, hy = p[1] + v[1] * tEnter, hz = p[2] + v[2] * tEnter;
+  float np[3] = {p[0], p[1], p[2]}, nv[3] = {v[0], v[1], v[2]};
+  fl_reflect(a, &np[0], &np[1], &np[2], &nv[0], &nv[1], &nv[2], hx, hy, hz, nrm[0], nrm[1], nrm[2],
+             tEnter);
+  /* Keep the end of the step outside the entry face. */
+  const float face = nrm[axis] > 0.0f ? box[3 + axis] : box[axis];
+  const float q = np[axis] + nv[axis] * dt;
+  const float margin = 4e-7f * (fabs(face) + fabs(q)) + 1e-30f;
+  const float clearance = (q - face) * nrm[axis];
+  if (clearance < margin) np[axis] += (2.0f * margin - clearance) * nrm[axis];
+  *px = np[0];
+  *py = np[1];
+  *pz = np[2];
+  *vxs = nv[0];
+  *vys = nv[1];
+  *vzs = nv[2];
+}
+
+/* After a Move by an integrator other than semi-implicit Euler: a particle that its curved
+ * step left on the wrong side of the deflector, compared with where it began the step
+ * (sx, sy, sz), is put back on its side and reflected (fused_pass.cpp guard). The surface is
+ * a->domain (packBounce); a segment's wall normal and point are f[3..5] and f[0..2]. */
+FL_INLINE void fl_bounce_guard(__global const FlActionParams* a, uint kind, int inside, float sx,
+                               float sy, float sz, float* px, float* py, float* pz, float* vx,
+                               float* vy, float* vz, __global const float* shapes) {
+  __global const float* d = a->domain.v;
+  const float3 p0 = (float3)(sx, sy, sz), p1 = (float3)(*px, *py, *pz);
+  const int seg = kind == FL_DOMAIN_LINE;
+  float3 nrm, back;
+  if (fl_surf_planar(kind) || seg) {
+    nrm = seg ? fl_v3(a->f + 3) : fl_normal_leaf(d, kind, p0, shapes);
+    const float3 o = seg ? fl_v3(a->f) : fl_closest(d, kind, p0, shapes);
+    const float d0 = fl_dotv(p0 - o, nrm);
+    if (d0 < 0.0f) nrm = -nrm; /* towards the side it started on */
+    const float d1 = fl_dotv(p1 - o, nrm);
+    const float margin = 1e-6f * (1.0f + fl_lengthv(p1));
+    if (d1 >= margin) return;
+    /* Only if the step's chord passes through the piece (a plane: always). */
+    const float dd0 = fabs(d0);
+    const float3 hit = p0 + (p1 - p0) * (dd0 / (dd0 - d1));
+    if (!seg && !(fl_surf_distance(a, kind, hit, shapes) <= 1e-4f * (1.0f + fl_lengthv(hit))))
+      return;
+    back = p1 + nrm * (margin - d1);
+  } else {
+    const int in0 = fl_inside(d, kind, p0.x, p0.y, p0.z);
+    const int in1 = fl_inside(d, kind, p1.x, p1.y, p1.z);
+    if (in1 == in0 || in0 != inside) return;
+    const float3 c = fl_closest(d, kind, p1, shapes);
+    nrm = fl_normal_leaf(d, kind, c, shapes) * (inside ? -1.0f : 1.0f);
+    back = c + nrm * (1e-5f * (1.0f + fl_lengthv(c)));
+  }
+  float3 v = (float3)(*vx, *vy, *vz);
+  const float vn = fl_dotv(v, nrm);
+  if (vn < 0.0f) v -= nrm * (vn * (1.0f + a->f[6]));
+  *px = back.x;
+  *py = back.y;
+  *pz = back.z;
+  *vx = v.x;
+  *vy = v.y;
+  *vz = v.z;
+}
+
+/* ---- Sink, SinkVelocity, Block ----------------------------------------------------------- */
+
+FL_INLINE void fl_kill(uint code, uint* dead) {
+  *dead = *dead != 0u ? *dead : code;
+}
+
+/* Inside or Outside (kernels.hpp sinkLoop). */
+FL_INLINE void fl_sink(__global const FlActionParams* a, uint kind, int killInside, float x,
+                       float y, float z, uint code, uint* dead) {
   const uint in = fl_inside(a->domain.v, kind, x, y, z) ? 1u : 0u;
   const uint k = in == (killInside ? 1u : 0u) ? code : 0u;
   *dead = *dead != 0u ? *dead : k;
-  if (passThrough && *dead == code) {
-    FlRandom rng = fl_random(seedLo, seedHi, id, step, stream);
-    if (fl_uniform(&rng) < a->f[0]) *dead = 0u;
-  }
 }
 
+/* Enter or Leave in the coming Move (actions_more.hpp sinkMotionLoop). */
+FL_INLINE void fl_sink_motion(__global const FlActionParams* a, uint kind, int enter, float dt,
+                              float x, float y, float z, float vx, float vy, float vz, uint code,
+                              uint* dead) {
+  const int now = fl_inside(a->domain.v, kind, x, y, z);
+  const int next = fl_inside(a->domain.v, kind, x + vx * dt, y + vy * dt, z + vz * dt);
+  const int k = enter ? ((!now) & next) : (now & (!next));
+  const uint kk = k ? code : 0u;
+  *dead = *dead != 0u ? *dead : kk;
+}
+
+/* Hit: the coming Move crosses the plane piece (actions_more.hpp apply(Sink)). */
+FL_INLINE void fl_sink_hit(__global const FlActionParams* a, uint kind, float dt, float x, float y,
+                           float z, float vx, float vy, float vz, uint code, uint* dead,
+                           __global const float* shapes) {
+  __global const float* d = a->domain.v;
+  const float3 p = (float3)(x, y, z), v = (float3)(vx, vy, vz);
+  const float3 q = p + v * dt;
+  const float3 nrm = fl_normal_leaf(d, kind, p, shapes);
+  const float3 origin = fl_closest(d, kind, p, shapes);
+  const float d0 = fl_dotv(p - origin, nrm), d1 = fl_dotv(q - origin, nrm);
+  if (!((d0 >= 0.0f) != (d1 >= 0.0f))) return;
+  const float3 h = p + (q - p) * (d0 / (d0 - d1));
+  if (fl_surf_distance(a, kind, h, shapes) <= 1e-5f * (1.0f + fl_lengthv(h))) fl_kill(code, dead);
+}
+
+/* The particles this action just took survive with probability f[0] (actions_more.hpp
+ * passThrough). */
+FL_INLINE void fl_sink_pass(__global const FlActionParams* a, uint id, uint code, uint* dead,
+                            uint seedLo, uint seedHi, uint step, uint stream) {
+  if (*dead != code) return;
+  FlRandom rng = fl_random(seedLo, seedHi, id, step, stream);
+  if (fl_uniform(&rng) < a->f[0]) *dead = 0u;
+}
+
+/* Hides the particles inside the region (actions_more.hpp apply(Block)); the list's first
+ * blocker has set vis to 1 before. */
+FL_INLINE void fl_block(__global const FlActionParams* a, uint kind, float x, float y, float z,
+                        uint* vis) {
+  const uint in = fl_inside(a->domain.v, kind, x, y, z) ? 1u : 0u;
+  *vis &= 1u - in;
+}
+
+/* ---- Avoid, Constrain2D ------------------------------------------------------------------ */
+
+/* actions_more.hpp apply(Avoid). f[0] magnitude, f[1] epsilon, f[2] lookAhead. */
+FL_INLINE void fl_avoid(__global const FlActionParams* a, uint kind, float dt, float x, float y,
+                        float z, float* vx, float* vy, float* vz, __global const float* shapes) {
+  __global const float* d = a->domain.v;
+  const int planar = fl_surf_planar(kind);
+  const float3 p = (float3)(x, y, z), v = (float3)(*vx, *vy, *vz);
+  const float3 ahead = p + v * a->f[2];
+  int threat;
+  if (planar) {
+    const float3 nrm = fl_normal_leaf(d, kind, p, shapes);
+    const float3 o = fl_closest(d, kind, p, shapes);
+    const float d0 = fl_dotv(p - o, nrm), d1 = fl_dotv(ahead - o, nrm);
+    threat = (d0 >= 0.0f) != (d1 >= 0.0f) &&
+             fl_surf_distance(a, kind, p + (ahead - p) * (d0 / (d0 - d1)), shapes) <
+                 1e-4f * (1.0f + fl_lengthv(p));
+  } else {
+    threat = !fl_inside(d, kind, p.x, p.y, p.z) && fl_inside(d, kind, ahead.x, ahead.y, ahead.z);
+  }
+  if (!threat) return;
+  const float dist = fl_surf_distance(a, kind, p, shapes);
+  float3 away = fl_normal_leaf(d, kind, p, shapes);
+  if (planar && fl_dotv(p - fl_closest(d, kind, p, shapes), away) < 0.0f) away = -away;
+  const float3 r = v + away * (a->f[0] / (dist * dist + a->f[1]) * dt);
+  *vx = r.x;
+  *vy = r.y;
+  *vz = r.z;
+}
+
+/* actions_more.hpp apply(Constrain2D). f[0..2] point, f[3..5] unit normal. */
+FL_INLINE void fl_constrain2d(__global const FlActionParams* a, float* px, float* py, float* pz,
+                              float* vx, float* vy, float* vz) {
+  const float3 p = (float3)(*px, *py, *pz), v = (float3)(*vx, *vy, *vz);
+  const float3 point = fl_v3(a->f), nrm = fl_v3(a->f + 3);
+  const float3 q = p - nrm * fl_dotv(p - point, nrm);
+  const float3 w = v - nrm * fl_dotv(v, nrm);
+  *px = q.x;
+  *py = q.y;
+  *pz = q.z;
+  *vx = w.x;
+  *vy = w.y;
+  *vz = w.z;
+}
+
+/* ---- Neighbours: the particles as they were at the start of the step (FL_SNAP) ----------- */
+
+/* actions_more.hpp softPull: magnitude d / (|d|^2 + eps)^(3/2), zero beyond maxR. f[0]
+ * magnitude, f[1] epsilon, f[2] maxR^2. Adds to acc (adding zero changes nothing). */
+FL_INLINE void fl_soft_pull(__global const FlActionParams* a, float3 d, float3* acc) {
+  const float r2 = fl_dotv(d, d);
+  if (!(r2 <= a->f[2])) return;
+  const float s = r2 + a->f[1];
+  *acc += d * (a->f[0] / (s * sqrt(s)));
+}
+
+/* Gravitate's acceleration at p: towards every other particle (integrate.hpp accumulate). */
+FL_INLINE float3 fl_gravitate_acc(__global const FlActionParams* a, __global const float* snap,
+                                  uint snapStride, uint snapN, uint self, float3 p) {
+  float3 acc = (float3)(0.0f);
+  for (uint j = 0; j < snapN; ++j) {
+    if (j == self) continue;
+    const float3 q = (float3)(FL_SNAP(0, 0, j), FL_SNAP(0, 1, j), FL_SNAP(0, 2, j));
+    fl_soft_pull(a, q - p, &acc);
+  }
+  return acc;
+}
+
+/* Follow's acceleration at p: towards the next particle by index; the last one leads. */
+FL_INLINE float3 fl_follow_acc(__global const FlActionParams* a, __global const float* snap,
+                               uint snapStride, uint snapN, uint self, float3 p) {
+  float3 acc = (float3)(0.0f);
+  const uint next = self + 1u;
+  if (next >= snapN) return acc;
+  const float3 q = (float3)(FL_SNAP(0, 0, next), FL_SNAP(0, 1, next), FL_SNAP(0, 2, next));
+  fl_soft_pull(a, q - p, &acc);
+  return acc;
+}
+
+/* apply(Gravitate) and apply(Follow): v += acc dt. */
+FL_INLINE void fl_add_accel(float3 acc, float dt, float* vx, float* vy, float* vz) {
+  const float3 r = (float3)(*vx, *vy, *vz) + acc * dt;
+  *vx = r.x;
+  *vy = r.y;
+  *vz = r.z;
+}
+
+/* actions_more.hpp matchMean: towards the mean of the neighbours' field (snapshot attribute
+ * `field`: 1 velocity, 2 angular velocity) within maxR. f[0] rate, f[1] the dt f[3] was
+ * computed for, f[2] maxR^2, f[3] 1 - exp(-rate dt); another dt (sub-steps) computes it. */
+FL_INLINE void fl_match_mean(__global const FlActionParams* a, __global const float* snap,
+                             uint snapStride, uint snapN, uint self, uint field, float dt, float px,
+                             float py, float pz, float* ox, float* oy, float* oz) {
+  const float k = dt == a->f[1] ? a->f[3] : 1.0f - exp(-a->f[0] * dt);
+  const float r2max = a->f[2];
+  const float3 p = (float3)(px, py, pz);
+  float3 sum = (float3)(0.0f);
+  int count = 0;
+  for (uint j = 0; j < snapN; ++j) {
+    if (j == self) continue;
+    const float3 d = (float3)(FL_SNAP(0, 0, j), FL_SNAP(0, 1, j), FL_SNAP(0, 2, j)) - p;
+    if (fl_dotv(d, d) > r2max) continue;
+    sum += (float3)(FL_SNAP(field, 0, j), FL_SNAP(field, 1, j), FL_SNAP(field, 2, j));
+    ++count;
+  }
+  if (count == 0) return;
+  const float3 v = (float3)(*ox, *oy, *oz);
+  const float3 r = v + (sum / (float)count - v) * k;
+  *ox = r.x;
+  *oy = r.y;
+  *oz = r.z;
+}

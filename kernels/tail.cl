@@ -2,34 +2,52 @@
 __kernel void fl_tail(FL_LANE_PARAMS, __global const uint* holes, __global const uint* tail,
                       __global const uint* state, __global const FlBirthRun* runs,
                       __global const FlEmitter* emitters, __global const FlParticleType* types,
-                      __global const FlKeyframe* keys, uint runCount, ulong t1Bits,
-                      uint seedLo, uint seedHi, uint salt) {
+                      __global const FlKeyframe* keys, __global const float* shapes,
+                      uint runCount, ulong t1Bits, uint seedLo, uint seedHi, uint salt) {
   const uint gid = get_global_id(0), gsize = get_global_size(0);
   const uint born = state[FL_STATE_BORN], low = state[FL_STATE_LOW_HOLES];
   const uint n = state[FL_STATE_OLD_SIZE];
 
-  /* Holes below the new size that no newborn takes, filled from the tail in order. */
+  /* Holes below the new size that no newborn takes, filled from the tail: the lowest hole
+   * takes the last survivor, as on the CPU (emission.cpp), so both keep one order (neighbour
+   * actions read particles by index). */
   const uint moves = low > born ? low - born : 0u;
   for (uint j = gid; j < moves; j += gsize) {
-    const uint src = tail[j], dst = holes[born + j];
+    const uint src = tail[moves - 1u - j], dst = holes[born + j];
     FL_COPY_LANES(dst, src);
   }
 
   if (gid >= born) return;
   const uint r = gid;
-  uint k = 0; /* the run of newborn r: runs are few and sorted by start */
-  while (k + 1 < runCount && runs[k + 1].start <= r) ++k;
-  __global const FlBirthRun* run = runs + k;
+  /* The run of newborn r: the last whose start is <= r (starts ascend; live emitters can
+   * make hundreds of runs, so a binary search). */
+  uint lo = 0, hi = runCount;
+  while (hi - lo > 1) {
+    const uint mid = (lo + hi) / 2;
+    if (runs[mid].start <= r)
+      lo = mid;
+    else
+      hi = mid;
+  }
+  __global const FlBirthRun* run = runs + lo;
   __global const FlEmitter* em = emitters + run->emitter;
   const ulong q = (ulong)r - run->start;
-  const fl_real tb = run->burst ? fl_real_from_bits(run->burstTime)
-                                : fl_real_from_bits(em->start) +
-                                      (fl_real)(run->first + q + 1) / fl_real_from_bits(em->rate);
+  /* emission.cpp birthTime. */
+  fl_real tb;
+  if (run->kind == FL_RUN_RATE)
+    tb = fl_real_from_bits(em->start) + (fl_real)(run->first + q + 1) / fl_real_from_bits(em->rate);
+  else if (run->kind == FL_RUN_BURST)
+    tb = fl_real_from_bits(run->time);
+  else
+    tb = fl_real_from_bits(run->time) +
+         fl_real_from_bits(run->dt) *
+             (fl_real_from_bits(run->s0) + (fl_real)q * fl_real_from_bits(run->spacing)) /
+             fl_real_from_bits(run->span);
   const fl_real dtb = fl_real_from_bits(t1Bits) - tb;
   const float age = (float)(dtb > 0 ? dtb : (fl_real)0);
   const float3 at = fl_emitter_at(em, keys, tb);
   const uint id = state[FL_STATE_FIRST_ID] + r;
   const uint slot = r < low ? holes[r] : n + (r - low);
   FlRandom rng = fl_random(seedLo, seedHi, id, salt, FL_EMISSION_STREAM);
-  fl_emit(FL_LANE_ARGS, run->emitter, slot, id, age, at, em, types, &rng);
+  fl_emit(FL_LANE_ARGS, em->variant, slot, id, age, at, em, types, &rng, shapes);
 }

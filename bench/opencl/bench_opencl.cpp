@@ -1,5 +1,6 @@
 // The OpenCL backend on PoCL against the native CPU backend, measured in one run:
 //   - the fused update pass and the whole fountain step at 1M and 4M particles,
+//   - the whole step of a heavy effect (curl-noise turbulence, an orbit, a bounce and a sink),
 //   - time per step of a small (1k particle) fountain: the launch overhead,
 //   - kernel compile time, cold and cached (in memory, and on disk),
 //   - the machine's in-place read-modify-write bandwidth: the ceiling of an in-place update.
@@ -118,6 +119,32 @@ void FountainStep(benchmark::State& state, Backend backend) {
   state.counters["live"] = live;
 }
 
+// A heavy effect at steady state (about n alive, n/10 born and dying per step): two octaves
+// of curl-noise turbulence, a softened orbit, a bounce and a sink: compute, not bandwidth.
+ActionList heavyActions() {
+  return {Turbulence{2.0f, 0.8f, 2, Vec3(0.0f, 0.3f, 0.0f)},
+          OrbitPoint{Vec3(0.0f, 2.0f, 0.0f), 4.0f, 0.05f},
+          Gravity{Vec3(0.0f, -9.81f, 0.0f)},
+          Bounce{Domain::plane(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f)), 0.5f, 0.1f, 0.0f},
+          Sink{Domain::sphere(Vec3(0.0f, 2.0f, 0.0f), 0.1f), true, 0.0f},
+          Move{},
+          KillOld{}};
+}
+
+void HeavyStep(benchmark::State& state, Backend backend) {
+  if (backend == Backend::OpenCL && !haveDevice()) return state.SkipWithError("no OpenCL device");
+  const auto n = std::size_t(state.range(0));
+  Context ctx(options(backend));
+  Group& g = samples::buildFountain(ctx, n + n / 2, 3.0 * double(n), 1.0f / 3.0f);
+  g.setActions(heavyActions());
+  ctx.run(30);
+  const double live = double(g.size());
+  const int steps = 5;
+  timedSteps(state, ctx, g, steps);
+  state.SetItemsProcessed(std::int64_t(double(state.iterations()) * steps * live));
+  state.counters["live"] = live;
+}
+
 // A small fountain (~1k alive): what a step costs when there is almost nothing to compute.
 void SmallStep(benchmark::State& state, Backend backend) {
   if (backend == Backend::OpenCL && !haveDevice()) return state.SkipWithError("no OpenCL device");
@@ -214,6 +241,12 @@ class SummaryReporter : public benchmark::ConsoleReporter {
       if (c > 0 && o > 0)
         std::printf("    cpu / opencl: update %.2fx, whole step %.2fx (aim: <= 1.25x)\n", c / o,
                     os > 0 ? cs / os : 0.0);
+      const double hc = items_["HeavyStep/cpu/" + N], ho = items_["HeavyStep/opencl/" + N];
+      if (hc > 0 && ho > 0)
+        std::printf(
+            "    heavy effect (turbulence + orbit + bounce + sink), whole step: cpu %.3f, "
+            "opencl %.3f G particle-steps/s; opencl / cpu time %.2fx\n",
+            hc / 1e9, ho / 1e9, hc / ho);
     }
     const double sc = usPerStep_["SmallStep/cpu/"], so = usPerStep_["SmallStep/opencl/"];
     if (sc > 0 || so > 0)
@@ -255,6 +288,16 @@ BENCHMARK_CAPTURE(FountainStep, cpu, Backend::Cpu)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(FountainStep, opencl, Backend::OpenCL)
+    ->Arg(1 << 20)
+    ->Arg(1 << 22)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(HeavyStep, cpu, Backend::Cpu)
+    ->Arg(1 << 20)
+    ->Arg(1 << 22)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(HeavyStep, opencl, Backend::OpenCL)
     ->Arg(1 << 20)
     ->Arg(1 << 22)
     ->Unit(benchmark::kMillisecond)

@@ -17,10 +17,10 @@ namespace {
 // distance travelled (births `spacing` apart along the step's path).
 struct BirthRun {
   enum Kind { Rate, Burst, Distance } kind;
-  bool live;             // the emitter is g.live[index], else g.emitters[index]
+  bool live;  // the emitter is g.live[index], else g.emitters[index]
   std::uint32_t index;
-  std::uint64_t first;   // Rate: index of the first birth since the emitter's start
-  double time;           // Burst: its time; Distance: the step's start
+  std::uint64_t first;  // Rate: index of the first birth since the emitter's start
+  double time;          // Burst: its time; Distance: the step's start
   std::uint64_t count;
   double s0 = 0, spacing = 0, span = 0, dt = 0;  // Distance: first birth at s0 of span
 };
@@ -55,13 +55,15 @@ struct NewbornContext {
   GroupImpl& g;
   Lanes L;
   const StepParams& sp;
-  double t1;               // end of the step: newborns are aged to it
-  std::uint32_t firstId;   // id of newborn 0 of this step
-  std::size_t oldSize;     // appended newborns start here
+  double t1;              // end of the step: newborns are aged to it
+  std::uint32_t firstId;  // id of newborn 0 of this step
+  std::size_t oldSize;    // appended newborns start here
   const std::uint32_t* holes;
-  std::size_t holeCount;   // newborns [0, holeCount) fill these slots
+  std::size_t holeCount;  // newborns [0, holeCount) fill these slots
 
-  std::size_t slot(std::size_t i) const { return i < holeCount ? holes[i] : oldSize + (i - holeCount); }
+  std::size_t slot(std::size_t i) const {
+    return i < holeCount ? holes[i] : oldSize + (i - holeCount);
+  }
 };
 
 double birthTime(const BirthRun& run, const Emitter& em, std::uint64_t q) {
@@ -94,6 +96,9 @@ void store(const NewbornContext& nc, std::size_t slot, std::uint32_t id, float a
     L.p[c][slot] = b.pos[c];
     if (L.v[c]) L.v[c][slot] = b.vel[c];
     if (L.prev[c]) L.prev[c][slot] = b.pos[c];
+    // A newborn's rest pose is where it was born, still (as ensureStorage gives a new lane).
+    if (L.posB[c]) L.posB[c][slot] = b.pos[c];
+    if (L.velB[c]) L.velB[c][slot] = 0.0f;
     if (L.up[c]) L.up[c][slot] = b.up[c];
     if (L.rot[c]) L.rot[c][slot] = b.rot[c];
   }
@@ -114,8 +119,8 @@ void store(const NewbornContext& nc, std::size_t slot, std::uint32_t id, float a
 }
 
 // Emitters with one particle type: every draw of a batch at once (see sampling.hpp).
-void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
-               std::uint64_t q0, std::size_t i0, std::size_t m) {
+void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em, std::uint64_t q0,
+               std::size_t i0, std::size_t m) {
   const Lanes& L = nc.L;
   const ParticleType& type = em.types[0];
   // Scratch per thread, looked up once: in a shared library every thread_local access in a
@@ -198,8 +203,8 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
   for (std::size_t k = 0; k < m; ++k) {
     const double tb = birthTime(run, em, q0 + k);
     age[k] = float(std::max(0.0, nc.t1 - tb));
-    const Vec3 e = em.path.empty() ? em.position + em.velocity * float(tb - em.start)
-                                   : em.positionAt(tb);
+    const Vec3 e =
+        em.path.empty() ? em.position + em.velocity * float(tb - em.start) : em.positionAt(tb);
     px[k] += e.x + vx[k] * age[k];
     py[k] += e.y + vy[k] * age[k];
     pz[k] += e.z + vz[k] * age[k];
@@ -219,6 +224,9 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
     put(L.p[c], attr[3 + c]);
     put(L.v[c], attr[c]);
     put(L.prev[c], attr[3 + c]);
+    put(L.posB[c], attr[3 + c]);
+    if (L.velB[c])
+      for (std::size_t k = 0; k < m; ++k) L.velB[c][slot[k]] = 0.0f;
     put(L.up[c], up[c]);
     put(L.rot[c], rot[c]);
   }
@@ -268,7 +276,6 @@ void emitOneByOne(const NewbornContext& nc, const BirthRun& run, const Emitter& 
   }
 }
 
-
 // ---- Planning: who is born this step, by which emitter, when -----------------------------
 
 // The births of one emitter (static or live) over (t0, t1]: its rate, its bursts in
@@ -279,8 +286,8 @@ std::uint64_t planEmitter(const Emitter& em, EmitterState& state, bool live, std
   if (em.rate > 0) {
     const std::uint64_t target = producedBy(em, t1);
     if (target > state.emittedByRate) {
-      runs.push_back({BirthRun::Rate, live, index, state.emittedByRate, 0.0,
-                      target - state.emittedByRate});
+      runs.push_back(
+          {BirthRun::Rate, live, index, state.emittedByRate, 0.0, target - state.emittedByRate});
       total += target - state.emittedByRate;
       state.emittedByRate = target;
     }
@@ -373,7 +380,8 @@ std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, std::vector<BirthRu
   // Prime emitters spawn emitters at their birth times, where the prime was then.
   if (g.primeSpecs.size() != g.primes.size()) {
     g.primeSpecs.clear();
-    for (const PrimeEmitter& p : g.primes) g.primeSpecs.push_back(std::make_shared<EmitterSpec>(p.child));
+    for (const PrimeEmitter& p : g.primes)
+      g.primeSpecs.push_back(std::make_shared<EmitterSpec>(p.child));
   }
   for (std::size_t k = 0; k < g.primes.size(); ++k) {
     const PrimeEmitter& prime = g.primes[k];
@@ -402,7 +410,8 @@ std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, std::vector<BirthRu
     // This step's curved flight as three keys: births inside the step sit on it.
     e.emitter.path = {{a, e.position}, {0.5 * (a + b), pm}, {b, pb}};
     if (!(b > a)) e.emitter.path.resize(1);
-    const std::uint64_t n = planEmitter(e.emitter, e.state, true, std::uint32_t(k), a, b + 1e-12, runs);
+    const std::uint64_t n =
+        planEmitter(e.emitter, e.state, true, std::uint32_t(k), a, b + 1e-12, runs);
     countGeneration(g, e.generation, n);
     total += n;
     e.position = pb;
@@ -458,8 +467,8 @@ void emitAndCompact(GroupImpl& g, const StepParams& sp) {
     sp.pool->parallelFor(tasks, [&](std::size_t task) {
       const std::size_t a = task * kNewbornsPerTask;
       const std::size_t b = std::min(accepted, a + kNewbornsPerTask);
-      std::size_t r = std::size_t(std::upper_bound(runStart.begin(), runStart.end(), a) -
-                                  runStart.begin()) - 1;
+      std::size_t r =
+          std::size_t(std::upper_bound(runStart.begin(), runStart.end(), a) - runStart.begin()) - 1;
       // Split the task at run boundaries: a batch shares one emitter and birth rule.
       for (std::size_t i = a; i < b;) {
         while (i >= runStart[r + 1]) ++r;
@@ -491,8 +500,8 @@ void emitAndCompact(GroupImpl& g, const StepParams& sp) {
   thread_local std::vector<std::pair<std::uint32_t, std::uint32_t>> movesStore;
   auto& moves = movesStore;  // (from, to)
   moves.clear();
-  std::size_t src = g.size;       // candidates below this
-  std::size_t back = leftCount;   // holes at or above src are left[back..]
+  std::size_t src = g.size;      // candidates below this
+  std::size_t back = leftCount;  // holes at or above src are left[back..]
   for (std::size_t h = 0; h < leftCount && left[h] < newSize; ++h) {
     do {
       --src;

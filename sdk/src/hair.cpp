@@ -19,8 +19,7 @@ void simulateHair(GroupImpl& g, const StepParams& sp) {
   h.ensureStorage();
   for (std::size_t a = 0; a < g.lanes.size(); ++a)
     for (std::size_t c = 0; c < 4; ++c)
-      if (g.lanes[a][c] && h.lanes[a][c])
-        std::copy_n(g.lanes[a][c].u(), g.size, h.lanes[a][c].u());
+      if (g.lanes[a][c] && h.lanes[a][c]) std::copy_n(g.lanes[a][c].u(), g.size, h.lanes[a][c].u());
   h.size = g.size;
   g.size = 0;
 
@@ -60,6 +59,7 @@ void simulateHair(GroupImpl& g, const StepParams& sp) {
     g.stats.killedByAction[a] += h.stats.killedByAction[a];
   g.stats.killedByAge += h.stats.killedByAge;
   g.stats.absorbed += h.stats.absorbed;
+  g.stats.killedNonFinite += h.stats.killedNonFinite;
   // Particles still alive when their strand is full end there.
   g.stats.killedByAge += h.size;
   for (Strand& s : strands)

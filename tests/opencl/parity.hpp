@@ -52,6 +52,8 @@ inline void expectSame(const RunResult& cpu, const RunResult& cl) {
       expectClose(p.prevPosition[c], q.prevPosition[c], "prevPosition", id, c);
       expectClose(p.up[c], q.up[c], "up", id, c);
       expectClose(p.rotVelocity[c], q.rotVelocity[c], "rotVelocity", id, c);
+      expectClose(p.positionB[c], q.positionB[c], "positionB", id, c);
+      expectClose(p.velocityB[c], q.velocityB[c], "velocityB", id, c);
     }
     for (int c = 0; c < 4; ++c) expectClose(p.color[c], q.color[c], "color", id, c);
     expectClose(p.size, q.size, "size", id, 0);

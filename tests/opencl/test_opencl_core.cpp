@@ -4,3 +4,181 @@
 
 using namespace flurry;
 using namespace flurry::test;
+
+namespace {
+
+Build spraying(ActionList actions, AttributeSet require = {}) {
+  return [=](Context& ctx) -> Group& {
+    Group& g = ctx.createGroup("core", 20000);
+    g.addEmitter(spray());
+    g.setActions(actions);
+    if (!(require == AttributeSet{})) g.require(require);
+    return g;
+  };
+}
+
+}  // namespace
+
+TEST(OpenCLCore, CopyVertexBAndRestore) {
+  // Particles with a rest position fall, then from t = 1 s are steered home, arriving at 2.5 s.
+  auto rest = [](ActionList list) {
+    return [list](Context& ctx) -> Group& {
+      Group& g = ctx.createGroup("restore", 2000);
+      g.require({Attribute::PositionB, Attribute::VelocityB});
+      for (int k = 0; k < 1000; ++k) {
+        Particle p;
+        p.position = Vec3(0.01f * float(k % 37), 0.02f * float(k % 53), 0.003f * float(k));
+        p.positionB = Vec3(float(k % 10), 1.0f + 0.1f * float(k % 7), -0.5f * float(k % 3));
+        p.velocity = Vec3(0.1f * float(k % 5), 2.0f, 0.0f);
+        g.add(p);
+      }
+      g.setActions(list);
+      return g;
+    };
+  };
+  FLURRY_REQUIRE_OPENCL();
+  auto check = [&](ActionList list) {
+    const RunResult cpu = runEffect(Backend::Cpu, rest(list), 90);
+    const RunResult cl = runEffect(Backend::OpenCL, rest(list), 90);
+    expectSame(cpu, cl);
+    return cpu;
+  };
+  // 90 steps of 1/30 s: home at 2.5 s, standing still.
+  const RunResult home = check({Gravity{kDown}, Restore{1.0f, 1.5f}, Move{}});
+  const Particle& p = home.byId.begin()->second;
+  EXPECT_NEAR(glm::length(p.position - p.positionB), 0.0f, 1e-4f);
+  // CopyVertexB after Move: the rest position and velocity follow the particle.
+  const RunResult copied = check({Gravity{kDown}, Move{}, CopyVertexB{true, true}});
+  const Particle& q = copied.byId.begin()->second;
+  EXPECT_EQ(q.positionB, q.position);
+  EXPECT_EQ(q.velocityB, q.velocity);
+}
+
+TEST(OpenCLCore, CallbackWithAnOpenCLBody) {
+  // The same callback as C++ (CPU) and as OpenCL C statements (device).
+  auto build = [](bool device) {
+    return [device](Context& ctx) -> Group& {
+      Group& g = ctx.createGroup("callback", 20000);
+      g.addEmitter(spray());
+      Callback cb;
+      cb.attributes = {Attribute::Position, Attribute::Velocity, Attribute::UserData};
+      cb.function = [](Particle& p, const CallbackContext& c) {
+        p.userData += c.dt;
+        if (p.position.y > 2.0f) p.velocity.x += 0.5f;
+      };
+      if (device) cb.opencl = "user += dt;\nif (py > 2.0f) vx += 0.5f;";
+      g.setActions({Gravity{kDown}, cb, Move{}, KillOld{}});
+      return g;
+    };
+  };
+  FLURRY_REQUIRE_OPENCL();
+  const RunResult cpu = runEffect(Backend::Cpu, build(false), kSteps);
+  const RunResult cl = runEffect(Backend::OpenCL, build(true), kSteps);
+  EXPECT_GT(cpu.stats.emitted, 0u);
+  expectSame(cpu, cl);
+}
+
+TEST(OpenCLCore, ACallbackWithoutAnOpenCLBodyIsRefusedByName) {
+  FLURRY_REQUIRE_OPENCL();
+  ContextOptions o;
+  o.backend = Backend::OpenCL;
+  Context ctx(o);
+  Group& g = ctx.createGroup("cb", 100);
+  g.addEmitter(spray());
+  g.setActions({Callback{[](Particle&, const CallbackContext&) {}}, Move{}});
+  try {
+    ctx.step();
+    FAIL() << "a C++-only callback ran on the device";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("Callback"), std::string::npos) << e.what();
+  }
+}
+
+class OpenCLIntegrators : public ::testing::TestWithParam<Integrator> {};
+
+TEST_P(OpenCLIntegrators, GravityAndDrag) {
+  ActionList list{Gravity{kDown}, Damping{Vec3(0.3f, 0.1f, 0.6f)}, Move{}, KillOld{}};
+  list.setIntegrator(GetParam());
+  checkParity(spraying(list, {Attribute::PrevPosition}));
+}
+
+INSTANTIATE_TEST_SUITE_P(OpenCLCore, OpenCLIntegrators,
+                         ::testing::Values(Integrator::ExplicitEuler, Integrator::VelocityVerlet,
+                                           Integrator::RK4, Integrator::Exact));
+
+TEST(OpenCLCore, SubstepsByTimeAndByDistance) {
+  ActionList byTime{Gravity{kDown}, Bounce{Domain::plane(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f)), 0.7f},
+                    Move{}, KillOld{}};
+  byTime.setSubsteps({1.0 / 100.0, 0.0f, 16});
+  checkParity(spraying(byTime));
+  ActionList byDistance = byTime;
+  byDistance.setSubsteps({0.0, 0.05f, 16});
+  checkParity(spraying(byDistance));
+}
+
+TEST(OpenCLCore, NonFiniteParticlesAreKilledAndCounted) {
+  // A callback that poisons some particles: both backends kill and count the same ones.
+  auto build = [](bool device) {
+    return [device](Context& ctx) -> Group& {
+      Group& g = ctx.createGroup("nan", 20000);
+      g.addEmitter(spray());
+      Callback cb;
+      cb.attributes = {Attribute::Position, Attribute::Id};
+      cb.function = [](Particle& p, const CallbackContext&) {
+        if (p.id % 7 == 3 && p.position.y > 1.5f) p.position.x = std::nanf("");
+      };
+      if (device) cb.opencl = "if (id % 7u == 3u && py > 1.5f) px = NAN;";
+      g.setActions({Gravity{kDown}, Move{}, cb, KillOld{}});
+      return g;
+    };
+  };
+  FLURRY_REQUIRE_OPENCL();
+  const RunResult cpu = runEffect(Backend::Cpu, build(false), kSteps);
+  const RunResult cl = runEffect(Backend::OpenCL, build(true), kSteps);
+  EXPECT_GT(cpu.stats.killedNonFinite, 0u);
+  expectSame(cpu, cl);
+}
+
+TEST(OpenCLCore, HairStrandsMatchTheCpu) {
+  FLURRY_REQUIRE_OPENCL();
+  struct Out {
+    Strands strands;
+    GroupStats stats;
+  };
+  auto run = [](Backend backend) {
+    ContextOptions o;
+    o.seed = 11;
+    o.backend = backend;
+    Context ctx(o);
+    Group& g = ctx.createGroup("fur", 4000);
+    Emitter e = spray(Vec3(0.0f), 300);
+    e.types[0].lifetime = Fuzzy(1.5f, 0.5f);
+    g.addEmitter(e);
+    g.require({Attribute::Color, Attribute::Size});
+    g.setActions({Gravity{kDown}, Damping{Vec3(0.2f)},
+                  Bounce{Domain::plane(Vec3(0.0f, -0.5f, 0.0f), Vec3(0.0f, 1.0f, 0.0f)), 0.5f},
+                  Sink{Domain::sphere(Vec3(1.0f, 0.0f, 0.0f), 0.5f), true, 0.0f}, Move{},
+                  KillOld{}});
+    g.setHair({true, 2, 24});
+    ctx.run(30);
+    return Out{g.strands(), g.stats()};
+  };
+  const Out cpu = run(Backend::Cpu), cl = run(Backend::OpenCL);
+  ASSERT_GT(cpu.strands.size(), 100u);
+  EXPECT_EQ(cpu.stats.emitted, cl.stats.emitted);
+  EXPECT_EQ(cpu.stats.killedByAge, cl.stats.killedByAge);
+  EXPECT_EQ(cpu.stats.absorbed, cl.stats.absorbed);
+  EXPECT_EQ(cpu.stats.killedByAction, cl.stats.killedByAction);
+  ASSERT_EQ(cpu.strands.start, cl.strands.start);
+  float worst = 0;
+  for (std::size_t v = 0; v < cpu.strands.vertexCount(); ++v)
+    for (int c = 0; c < 3; ++c) {
+      const float a = cpu.strands.position[v][c], b = cl.strands.position[v][c];
+      worst = std::max(worst, std::abs(a - b));
+      ASSERT_LE(std::abs(a - b), kAbs + kRel * std::abs(a)) << "vertex " << v;
+      ASSERT_EQ(cpu.strands.color[v][c], cl.strands.color[v][c]);
+    }
+  EXPECT_EQ(cpu.strands.radius, cl.strands.radius);
+  std::printf("[ hair     ] %zu strands, %zu vertices; largest |cpu - opencl| %g\n",
+              cpu.strands.size(), cpu.strands.vertexCount(), worst);
+}

@@ -1,7 +1,283 @@
 // Parity on the device: Deflectors, absorbers, blockers, 2-D and neighbour actions
 // (kernels/surfaces.cl). Each test runs the same build on the CPU and on the device
-// (tests/opencl/parity.hpp).
+// (tests/opencl/parity.hpp) and first checks that the action visibly changes the particles
+// (hits, kills), so that a device doing nothing could not pass.
 #include "parity.hpp"
 
 using namespace flurry;
 using namespace flurry::test;
+
+namespace {
+
+// The same build without the action under test: parity alone would also pass if the action
+// did nothing on either backend.
+void expectEffect(const Build& with, const Build& without, int steps = kSteps) {
+  FLURRY_REQUIRE_OPENCL();
+  const RunResult a = runEffect(Backend::Cpu, with, steps);
+  const RunResult b = runEffect(Backend::Cpu, without, steps);
+  bool differs = a.size != b.size || a.stats.absorbed != b.stats.absorbed;
+  for (const auto& [id, p] : a.byId) {
+    auto it = b.byId.find(id);
+    if (differs || it == b.byId.end()) {
+      differs = true;
+      break;
+    }
+    differs = p.position != it->second.position || p.velocity != it->second.velocity ||
+              p.rotVelocity != it->second.rotVelocity || p.visible != it->second.visible;
+  }
+  EXPECT_TRUE(differs) << "the action changes nothing: the test could not fail";
+}
+
+// Runs parity on `actions` and checks that dropping actions[k] changes the result.
+void checkAction(const ActionList& actions, std::size_t k, Emitter e = spray(),
+                 AttributeSet require = {}, std::size_t capacity = 20000) {
+  auto build = [=](const ActionList& list) -> Build {
+    return [=](Context& ctx) -> Group& {
+      Group& g = ctx.createGroup("surfaces", capacity);
+      g.addEmitter(e);
+      g.setActions(list);
+      g.require(require);
+      return g;
+    };
+  };
+  ActionList without;
+  without.setIntegrator(actions.integrator());
+  without.setSubsteps(actions.substeps());
+  for (std::size_t j = 0; j < actions.size(); ++j)
+    if (j != k) without.add(actions.actions()[j]);
+  expectEffect(build(actions), build(without));
+  checkParity(build(actions));
+}
+
+const Bounce kFloor{Domain::plane(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f)), 0.6f, 0.1f, 0.0f};
+
+// A few particles that live through the whole run: nothing dies, so both backends keep the
+// particles in the same order (neighbour actions read others by index).
+Emitter swarm(double rate = 150) {
+  Emitter e = spray(Vec3(0.0f, 1.0f, 0.0f), rate);
+  e.types[0].lifetime = 1000.0f;
+  e.types[0].velocity = Domain::sphere(Vec3(0.0f, 1.0f, 0.0f), 2.0f);
+  e.types[0].rotVelocity = Domain::box(Vec3(-3.0f), Vec3(3.0f));
+  return e;
+}
+
+}  // namespace
+
+// ---- Bounce -------------------------------------------------------------------------------
+
+TEST(OpenCLSurfaces, BounceBoxOutside) {
+  checkAction(
+      {Gravity{kDown},
+       Bounce{Domain::box(Vec3(-1.0f, 1.6f, -0.8f), Vec3(0.7f, 2.0f, 1.0f)), 0.7f, 0.2f, 0.1f},
+       Bounce{Domain::box(Vec3(-3.0f, -0.5f, -3.0f), Vec3(3.0f, 0.3f, 3.0f)), 0.5f, 0.0f, 0.0f},
+       Move{}, KillOld{}},
+      1);
+}
+
+TEST(OpenCLSurfaces, BounceBoxInside) {
+  Bounce b{Domain::box(Vec3(-1.2f, 0.0f, -0.9f), Vec3(1.0f, 2.2f, 1.1f)), 0.8f, 0.15f, 0.2f};
+  b.inside = true;
+  checkAction({Gravity{kDown}, b, Move{}, KillOld{}}, 1);
+}
+
+TEST(OpenCLSurfaces, BounceSphereInside) {
+  Bounce b{Domain::sphere(Vec3(0.1f, 1.2f, 0.0f), 1.1f), 0.9f, 0.1f, 0.0f};
+  b.inside = true;
+  checkAction({Gravity{kDown}, b, Move{}, KillOld{}}, 1);
+}
+
+// Fast particles in a small sphere: several crossings in one step (the re-bounce loop).
+TEST(OpenCLSurfaces, BounceSphereInsideFast) {
+  Bounce b{Domain::sphere(Vec3(0.0f, 1.0f, 0.0f), 0.4f), 1.0f, 0.0f, 0.0f};
+  b.inside = true;
+  Emitter e = spray();
+  e.types[0].velocity = Domain::sphere(Vec3(0.0f), 40.0f, 30.0f);
+  checkAction({b, Move{}, KillOld{}}, 0, e);
+}
+
+TEST(OpenCLSurfaces, BounceSegments2D) {
+  Bounce floor{Domain::line(Vec3(-3.0f, -0.2f, 0.0f), Vec3(3.0f, 0.3f, 0.0f)), 0.7f, 0.1f, 0.0f};
+  Bounce wall{Domain::line(Vec3(1.0f, -1.0f, 0.0f), Vec3(1.3f, 3.0f, 0.0f)), 0.9f, 0.0f, 0.0f};
+  Bounce tilted{Domain::line(Vec3(-1.0f, 2.0f, 0.0f), Vec3(-0.2f, 1.7f, 0.0f)), 0.5f, 0.3f, 0.05f};
+  checkAction({Gravity{kDown}, Constrain2D{}, floor, wall, tilted, Move{}, KillOld{}}, 2);
+}
+
+// A segment in a tilted plane (planeNormal not z).
+TEST(OpenCLSurfaces, BounceSegmentTiltedPlane) {
+  Bounce s{Domain::line(Vec3(-3.0f, 0.0f, 0.0f), Vec3(3.0f, 0.2f, 0.5f)), 0.8f, 0.0f, 0.0f};
+  s.planeNormal = Vec3(0.0f, 0.3f, 1.0f);
+  checkAction({Gravity{kDown}, s, Move{}, KillOld{}}, 1);
+}
+
+// ---- Sink ---------------------------------------------------------------------------------
+
+TEST(OpenCLSurfaces, SinkEnter) {
+  const Domain regions[] = {
+      Domain::sphere(Vec3(0.3f, 1.8f, 0.0f), 0.6f),
+      Domain::box(Vec3(-2.0f, -1.0f, -2.0f), Vec3(2.0f, 0.5f, 0.0f)),
+      Domain::cylinder(Vec3(0.0f, 1.5f, -1.0f), Vec3(0.0f, 1.5f, 1.0f), 0.5f),
+      Domain::plane(Vec3(0.0f, 0.2f, 0.0f), Vec3(0.3f, -1.0f, 0.0f)),
+  };
+  for (const Domain& r : regions) {
+    SCOPED_TRACE(r.name());
+    Sink k{r, true, 0.0f, Sink::Mode::Enter};
+    checkAction({Gravity{kDown}, k, Move{}, KillOld{}}, 1);
+  }
+}
+
+TEST(OpenCLSurfaces, SinkLeaveWithPassThrough) {
+  Sink k{Domain::sphere(Vec3(0.0f, 1.0f, 0.0f), 1.2f), true, 0.4f, Sink::Mode::Leave};
+  checkAction({Gravity{kDown}, k, Move{}, KillOld{}}, 1);
+}
+
+TEST(OpenCLSurfaces, SinkHitEveryPiece) {
+  const Domain pieces[] = {
+      Domain::plane(Vec3(0.0f, 0.5f, 0.0f), Vec3(0.1f, 1.0f, 0.0f)),
+      Domain::rectangle(Vec3(-1.0f, 1.8f, -1.0f), Vec3(1.5f, 0.0f, 0.2f), Vec3(0.3f, 0.2f, 1.6f)),
+      Domain::disc(Vec3(0.0f, 0.4f, 0.0f), Vec3(0.2f, 1.0f, 0.1f), 1.5f, 0.3f),
+      Domain::triangle(Vec3(-2.0f, 0.3f, -2.0f), Vec3(2.0f, 0.6f, -1.0f), Vec3(0.0f, 0.2f, 2.0f)),
+  };
+  for (const Domain& r : pieces) {
+    SCOPED_TRACE(r.name());
+    Sink k{r, true, 0.0f, Sink::Mode::Hit};
+    checkAction({Gravity{kDown}, k, Move{}, KillOld{}}, 1);
+  }
+}
+
+TEST(OpenCLSurfaces, SinkHitWithPassThroughAndSubsteps) {
+  ActionList list{Gravity{kDown},
+                  Sink{Domain::disc(Vec3(0.0f, 1.5f, 0.0f), Vec3(0.0f, 1.0f, 0.0f), 1.0f), true,
+                       0.5f, Sink::Mode::Hit},
+                  kFloor, Move{}, KillOld{}};
+  list.setSubsteps(Substeps{1.0 / 90.0});
+  checkAction(list, 1);
+}
+
+TEST(OpenCLSurfaces, SinkVelocity) {
+  checkAction({Gravity{kDown}, SinkVelocity{Domain::sphere(Vec3(0.0f, -4.0f, 0.0f), 2.0f), true},
+               Move{}, KillOld{}},
+              1);
+  checkAction({Gravity{kDown},
+               SinkVelocity{Domain::box(Vec3(-2.0f, -5.0f, -2.0f), Vec3(2.0f, 5.0f, 2.0f)), false},
+               Move{}, KillOld{}},
+              1);
+}
+
+// ---- Block --------------------------------------------------------------------------------
+
+TEST(OpenCLSurfaces, BlockSeveral) {
+  checkAction({Gravity{kDown}, Block{Domain::box(Vec3(-0.5f, 1.0f, -2.0f), Vec3(0.5f, 2.0f, 2.0f))},
+               Move{}, Block{Domain::sphere(Vec3(1.0f, 1.0f, 0.0f), 0.8f)}, KillOld{}},
+              1, spray(), {Attribute::Visible});
+  checkAction({Gravity{kDown}, Block{Domain::box(Vec3(-0.5f, 1.0f, -2.0f), Vec3(0.5f, 2.0f, 2.0f))},
+               Move{}, Block{Domain::sphere(Vec3(1.0f, 1.0f, 0.0f), 0.8f)}, KillOld{}},
+              3, spray(), {Attribute::Visible});
+}
+
+// ---- Avoid, Constrain2D -------------------------------------------------------------------
+
+TEST(OpenCLSurfaces, AvoidEveryObstacle) {
+  const Domain obstacles[] = {
+      Domain::sphere(Vec3(0.2f, 2.2f, 0.0f), 0.6f),
+      Domain::sphere(Vec3(0.2f, 2.0f, 0.0f), 0.8f, 0.4f),
+      Domain::box(Vec3(-1.0f, 1.8f, -0.5f), Vec3(0.5f, 2.3f, 1.0f)),
+      Domain::blob(Vec3(0.0f, 2.0f, 0.3f), 0.5f),
+      Domain::cylinder(Vec3(-1.0f, 2.0f, 0.0f), Vec3(1.0f, 2.2f, 0.0f), 0.4f, 0.1f),
+      Domain::cylinder(Vec3(0.0f, 1.6f, -1.0f), Vec3(0.0f, 1.9f, 1.0f), 0.5f, 0.25f),
+      Domain::cone(Vec3(0.0f, 2.8f, 0.0f), Vec3(0.2f, 1.7f, 0.0f), 0.9f, 0.3f),
+      Domain::cone(Vec3(0.0f, 2.8f, 0.0f), Vec3(0.0f, 1.7f, 0.1f), 0.9f),
+      Domain::plane(Vec3(0.0f, 2.0f, 0.0f), Vec3(0.2f, 1.0f, 0.0f)),
+      Domain::rectangle(Vec3(-1.0f, 1.8f, -1.0f), Vec3(1.5f, 0.0f, 0.2f), Vec3(0.3f, 0.2f, 1.6f)),
+      Domain::disc(Vec3(0.0f, 2.0f, 0.0f), Vec3(0.2f, 1.0f, 0.1f), 1.2f, 0.3f),
+      Domain::triangle(Vec3(-2.0f, 1.9f, -2.0f), Vec3(2.0f, 2.1f, -1.0f), Vec3(0.0f, 1.8f, 2.0f)),
+  };
+  for (const Domain& o : obstacles) {
+    SCOPED_TRACE(o.name());
+    checkAction({Gravity{kDown}, Avoid{o, 2.0f, 1e-2f, 0.3f}, kFloor, Move{}, KillOld{}}, 1);
+  }
+}
+
+TEST(OpenCLSurfaces, Constrain2D) {
+  checkAction({Gravity{kDown}, Constrain2D{Vec3(0.1f, 0.2f, 0.3f), Vec3(0.3f, 0.2f, 1.0f)}, kFloor,
+               Move{}, KillOld{}},
+              1);
+}
+
+// ---- Neighbours ---------------------------------------------------------------------------
+
+TEST(OpenCLSurfaces, Gravitate) {
+  checkAction({Gravitate{0.05f, 1e-2f, 1.5f}, kFloor, Move{}}, 0, swarm());
+}
+
+TEST(OpenCLSurfaces, GravitateIntegrators) {
+  for (Integrator in : {Integrator::ExplicitEuler, Integrator::VelocityVerlet, Integrator::RK4}) {
+    SCOPED_TRACE(integratorName(in));
+    ActionList list{Gravitate{0.05f, 1e-2f}, Gravity{Vec3(0.0f, -1.0f, 0.0f)}, Move{}};
+    list.setIntegrator(in);
+    checkAction(list, 0, swarm(60));
+  }
+}
+
+TEST(OpenCLSurfaces, Follow) {
+  checkAction({Follow{3.0f, 1e-2f}, kFloor, Move{}}, 0, swarm());
+  checkAction({Follow{3.0f, 1e-2f, 0.5f}, Damping{Vec3(0.3f)}, Move{}}, 0, swarm());
+}
+
+TEST(OpenCLSurfaces, FollowIntegrators) {
+  for (Integrator in : {Integrator::ExplicitEuler, Integrator::VelocityVerlet, Integrator::RK4}) {
+    SCOPED_TRACE(integratorName(in));
+    ActionList list{Follow{3.0f, 1e-2f}, Damping{Vec3(0.2f)}, Move{}};
+    list.setIntegrator(in);
+    checkAction(list, 0, swarm());
+  }
+}
+
+TEST(OpenCLSurfaces, MatchVelocity) {
+  checkAction({MatchVelocity{2.0f, 1e-3f, 0.6f}, kFloor, Move{}}, 0, swarm());
+}
+
+// Sub-steps: the approach fraction for the sub-step's dt, computed on the device.
+TEST(OpenCLSurfaces, MatchVelocitySubsteps) {
+  ActionList list{MatchVelocity{2.0f, 1e-3f, 0.6f}, kFloor, Move{}};
+  list.setSubsteps(Substeps{1.0 / 70.0});
+  checkAction(list, 0, swarm(80));
+}
+
+TEST(OpenCLSurfaces, MatchRotVelocity) {
+  checkAction({MatchRotVelocity{1.5f, 1e-3f, 0.7f}, kFloor, Move{}}, 0, swarm(),
+              {Attribute::RotVelocity, Attribute::Up});
+}
+
+// ---- Disabled until codegen.cpp and kernels/tail.cl catch up -----------------------------
+// Both pass with the two changes described in each comment (checked on a patched copy).
+
+// The integrators' curved-step guard after Move (fused_pass.cpp guard): codegen.cpp refuses
+// a Bounce before an integrating Move; it is to keep the step's start position and call
+// surfaces.cl fl_bounce_guard for each such Bounce after the integrator.
+TEST(OpenCLSurfaces, BounceUnderIntegrators) {
+  Bounce sphere{Domain::sphere(Vec3(0.1f, 1.2f, 0.0f), 1.1f), 0.9f, 0.1f, 0.0f};
+  sphere.inside = true;
+  Bounce box{Domain::box(Vec3(-1.2f, 1.6f, -0.9f), Vec3(1.0f, 2.2f, 1.1f)), 0.8f, 0.15f, 0.2f};
+  Bounce seg{Domain::line(Vec3(-3.0f, -0.2f, 0.0f), Vec3(3.0f, 0.3f, 0.0f)), 0.7f, 0.1f, 0.0f};
+  const Bounce bounces[] = {kFloor, sphere, box, seg};
+  for (Integrator in : {Integrator::ExplicitEuler, Integrator::VelocityVerlet, Integrator::RK4}) {
+    for (const Bounce& b : bounces) {
+      SCOPED_TRACE(std::string(integratorName(in)) + " " + b.surface.name());
+      ActionList list{Gravity{kDown}, Damping{Vec3(0.3f)}, b, Move{}, KillOld{}};
+      list.setIntegrator(in);
+      checkAction(list, 2);
+    }
+  }
+}
+
+// Particles die and the holes are closed from the tail: the neighbour actions read others
+// by index, so the order must be the CPU's, whose first hole takes the last survivor
+// (emission.cpp); tail.cl's fl_tail gives it the first (it is to read tail[moves - 1 - j]).
+TEST(OpenCLSurfaces, NeighboursWhileParticlesDie) {
+  checkAction({Gravitate{0.05f, 1e-2f, 1.5f}, Gravity{kDown}, kFloor, Move{}, KillOld{}}, 0,
+              spray(Vec3(0.0f, 1.0f, 0.0f), 150));
+  checkAction({Follow{3.0f, 1e-2f}, Gravity{kDown}, kFloor, Move{}, KillOld{}}, 0,
+              spray(Vec3(0.0f, 1.0f, 0.0f), 150));
+  checkAction({MatchVelocity{2.0f, 1e-3f, 0.6f}, Gravity{kDown}, kFloor, Move{}, KillOld{}}, 0,
+              spray(Vec3(0.0f, 1.0f, 0.0f), 150));
+}

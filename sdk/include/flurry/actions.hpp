@@ -255,7 +255,7 @@ struct Bounce {
   float restitution = 1.0f;
   float friction = 0.0f;
   float cutoff = 0.0f;
-  bool inside = false;  ///< sphere, box: keep particles in rather than out
+  bool inside = false;                 ///< sphere, box: keep particles in rather than out
   Vec3 planeNormal{0.0f, 0.0f, 1.0f};  ///< a segment's 2-D plane
 };
 
@@ -318,9 +318,15 @@ struct CallbackContext {
 };
 
 /// Calls a C++ function on every particle (gathered into a Particle and scattered back).
-/// `attributes` names what it reads or writes, so the group stores them. On the OpenCL
-/// backend `opencl` holds the body of an OpenCL C function
-/// `void callback(Particle* p, float dt, float time)`; without it the list cannot run there.
+/// `attributes` names what it reads or writes, so the group stores them.
+///
+/// On the OpenCL backend `opencl` holds OpenCL C statements run for each particle inside the
+/// fused kernel; without it the list cannot run there. They see the attributes named in
+/// `attributes` as variables: position px py pz, velocity vx vy vz, color r g b a, size,
+/// mass, age, life (lifetime), id (read only), prevx prevy prevz, upx upy upz, rotx roty rotz
+/// (angular velocity), charge, vis (visible, uint), user (user data), pbx pby pbz
+/// (PositionB), vbx vby vbz (VelocityB); and float dt, time (the step's start). For example
+/// `"user += dt; if (py > 2.0f) vx += 0.5f;"`.
 struct Callback {
   std::function<void(Particle&, const CallbackContext&)> function;
   AttributeSet attributes{Attribute::Position, Attribute::Velocity};

@@ -10,21 +10,25 @@ namespace flurry::detail::ocl {
 
 namespace {
 
-// Which piece a planar Bounce surface is (FL_PIECE_*), or -1 for the sphere.
+// Which planar piece a Bounce surface is (FL_PIECE_*), or -1 for a solid.
 int pieceOf(const Domain& d) {
   const auto& s = d.shape();
   if (std::holds_alternative<PlaneDomain>(s)) return 0;
   if (std::holds_alternative<RectangleDomain>(s)) return 1;
   if (std::holds_alternative<TriangleDomain>(s)) return 2;
   if (std::holds_alternative<DiscDomain>(s)) return 3;
+  if (std::holds_alternative<LineDomain>(s)) return 4;
   return -1;
 }
 
 // As kernels.hpp apply(Bounce) prepares them. f[]: [0..2] plane point, [3..5] unit normal,
-// [6] restitution, [7] 1 - friction, [8] cutoff^2, [9] scale (|P.x|+|P.y|+|P.z|, sphere
-// |C|_1 + R), then by surface: rectangle/triangle [10..12] dual u, [13..15] dual v |
-// disc [10] outer^2, [11] inner^2 | sphere [10] R, [11] R^2, [12] 1/R (center in [0..2]).
-void packBounce(const Bounce& a, float* f) {
+// [6] restitution, [7] 1 - friction, [8] cutoff^2, then by surface: rectangle/triangle
+// [10..12] dual u, [13..15] dual v | disc [10] outer^2, [11] inner^2 | segment [10..12] its
+// direction, [13] its length^2 | sphere [0..2] center, [9] |C|_1 + R, [10] R, [11] R^2,
+// [12] 1/R; the surface itself in `domain` (boxes, and the integrators' guard).
+void packBounce(const Bounce& a, cl::FlActionParams& p) {
+  p.domain = packDomain(a.surface);
+  float* f = p.f;
   f[6] = a.restitution;
   f[7] = 1.0f - a.friction;
   f[8] = a.cutoff * a.cutoff;
@@ -32,7 +36,6 @@ void packBounce(const Bounce& a, float* f) {
   auto plane = [&](Vec3 P, Vec3 N) {
     putVec(f, 0, P);
     putVec(f, 3, N);
-    f[9] = std::abs(P.x) + std::abs(P.y) + std::abs(P.z);
   };
   if (const auto* pl = std::get_if<PlaneDomain>(&shape)) {
     plane(pl->point, pl->normal);
@@ -53,6 +56,12 @@ void packBounce(const Bounce& a, float* f) {
     plane(d->center, d->normal);
     f[10] = d->outerRadius * d->outerRadius;
     f[11] = d->innerRadius * d->innerRadius;
+  } else if (const auto* ln = std::get_if<LineDomain>(&shape)) {
+    // 2-D: a wall standing on the group's plane, its normal in that plane.
+    const Vec3 dir = ln->p1 - ln->p0;
+    plane(ln->p0, glm::normalize(glm::cross(dir, a.planeNormal)));
+    putVec(f, 10, dir);
+    f[13] = glm::dot(dir, dir);
   } else if (const auto* s = std::get_if<SphereDomain>(&shape)) {
     const Vec3 C = s->center;
     const float R = s->outerRadius;
@@ -64,48 +73,177 @@ void packBounce(const Bounce& a, float* f) {
   }
 }
 
+// The kind literal of a region the device tests. Meshes and unions need domain.cl's shape
+// table, which the act kernel does not have: the calls pass `extra` in its place, never read
+// for the other kinds.
+std::string kindOf(const Domain& d) {
+  if (d.shape().index() > FL_DOMAIN_BLOB) notOnDevice(std::string("a ") + d.name() + " region");
+  return std::to_string(d.shape().index()) + "u";
+}
+
+// Gravitate, Follow, Match*: f[0] magnitude (rate), f[1] epsilon, f[2] maxRadius^2.
+void packPull(float magnitude, float epsilon, float maxRadius, float* f) {
+  f[0] = magnitude;
+  f[1] = epsilon;
+  f[2] = maxRadius * maxRadius;
+}
+
+const char* kSnapArgs = "snap, snapStride, snapN, i";
+
 }  // namespace
 
 bool generateSurfaceAction(const Action& act, ActionSource& s) {
   const std::string& ap = s.in.params;
+  const std::string pv = "&px, &py, &pz, &vx, &vy, &vz);\n";
   if (const auto* b = std::get_if<Bounce>(&act)) {
     s.reads.insert({Attribute::Position, Attribute::Velocity});
     s.writes.insert({Attribute::Position, Attribute::Velocity});
-    const int piece = pieceOf(b->surface);
-    const bool sphere = std::holds_alternative<SphereDomain>(b->surface.shape());
-    if ((piece < 0 && !sphere) || b->inside)
-      notOnDevice(std::string("Bounce ") + (b->inside ? "inside a " : "on a ") + b->surface.name());
-    if (piece < 0)
-      s.apply = "fl_bounce_sphere(" + ap + ", dt, &px, &py, &pz, &vx, &vy, &vz);\n";
-    else
-      s.apply = "fl_bounce_planar(" + ap + ", " + std::to_string(piece) +
-                ", dt, &px, &py, &pz, &vx, &vy, &vz);\n";
+    const auto& shape = b->surface.shape();
+    const std::string in = b->inside ? "1" : "0";
+    if (std::holds_alternative<SphereDomain>(shape))
+      s.apply = "fl_bounce_sphere(" + ap + ", " + in + ", dt, " + pv;
+    else if (std::holds_alternative<BoxDomain>(shape))
+      s.apply = std::string(b->inside ? "fl_bounce_box_inside(" : "fl_bounce_box_outside(") + ap +
+                ", dt, " + pv;
+    else if (pieceOf(b->surface) >= 0)
+      s.apply =
+          "fl_bounce_planar(" + ap + ", " + std::to_string(pieceOf(b->surface)) + ", dt, " + pv;
+    else  // validation allows no other surface
+      notOnDevice(std::string("Bounce on a ") + b->surface.name());
     return true;
   }
   if (const auto* k = std::get_if<Sink>(&act)) {
-    if (k->mode != Sink::Mode::Inside && k->mode != Sink::Mode::Outside)
-      notOnDevice("a Sink in Enter, Leave or Hit mode");
-    const bool killInside = k->mode == Sink::Mode::Inside ? k->killInside : !k->killInside;
+    using M = Sink::Mode;
+    const std::string kind = kindOf(k->region);
     s.reads.insert(Attribute::Position);
-    const bool pass = k->passThrough > 0.0f;
-    if (pass) s.reads.insert(Attribute::Id);
-    s.apply = "fl_sink(" + ap + ", " + std::to_string(k->region.shape().index()) + "u, " +
-              (killInside ? "1" : "0") + ", " + (pass ? "1" : "0") + ", px, py, pz, " +
-              (pass ? "id" : "0u") + ", " + s.in.code + ", &dead, seedLo, seedHi, step, " +
-              s.in.stream + ");\n";
+    if (k->mode == M::Inside || k->mode == M::Outside) {
+      const bool killInside = k->mode == M::Inside ? k->killInside : !k->killInside;
+      s.apply = "fl_sink(" + ap + ", " + kind + ", " + (killInside ? "1" : "0") + ", px, py, pz, " +
+                s.in.code + ", &dead);\n";
+    } else if (k->mode == M::Enter || k->mode == M::Leave) {
+      s.reads.insert(Attribute::Velocity);
+      s.apply = "fl_sink_motion(" + ap + ", " + kind + ", " + (k->mode == M::Enter ? "1" : "0") +
+                ", dt, px, py, pz, vx, vy, vz, " + s.in.code + ", &dead);\n";
+    } else {  // Hit: validation makes the region a plane piece
+      s.reads.insert(Attribute::Velocity);
+      s.apply = "fl_sink_hit(" + ap + ", " + kind + ", dt, px, py, pz, vx, vy, vz, " + s.in.code +
+                ", &dead, extra);\n";
+    }
+    if (k->passThrough > 0.0f) {
+      s.reads.insert(Attribute::Id);
+      s.apply += "fl_sink_pass(" + ap + ", id, " + s.in.code + ", &dead, seedLo, seedHi, step, " +
+                 s.in.stream + ");\n";
+    }
+    return true;
+  }
+  if (const auto* k = std::get_if<SinkVelocity>(&act)) {
+    s.reads.insert(Attribute::Velocity);
+    s.apply = "fl_sink(" + ap + ", " + kindOf(k->velocity) + ", " + (k->killInside ? "1" : "0") +
+              ", vx, vy, vz, " + s.in.code + ", &dead);\n";
+    return true;
+  }
+  if (const auto* b = std::get_if<Block>(&act)) {
+    s.reads.insert({Attribute::Position, Attribute::Visible});
+    s.writes.insert(Attribute::Visible);
+    // The list's first blocker starts from "visible" (the CPU's BlockContext.firstBlocker).
+    // The generator sees one action at a time; the preprocessor, reading the kernel in list
+    // order, meets the first Block first and keeps its index (also when the step's code is
+    // placed twice, as in hair mode).
+    const std::string k = std::to_string(s.in.index);
+    s.apply = "#ifndef FL_FIRST_BLOCKER\n#define FL_FIRST_BLOCKER " + k +
+              "\n#endif\n#if FL_FIRST_BLOCKER == " + k + "\nvis = 1u;\n#endif\nfl_block(" + ap +
+              ", " + kindOf(b->region) + ", px, py, pz, &vis);\n";
+    return true;
+  }
+  if (const auto* k = std::get_if<Avoid>(&act)) {
+    s.reads.insert({Attribute::Position, Attribute::Velocity});
+    s.writes.insert(Attribute::Velocity);
+    s.apply = "fl_avoid(" + ap + ", " + kindOf(k->obstacle) +
+              ", dt, px, py, pz, &vx, &vy, &vz, extra);\n";
+    return true;
+  }
+  if (std::holds_alternative<Constrain2D>(act)) {
+    s.reads.insert({Attribute::Position, Attribute::Velocity});
+    s.writes.insert({Attribute::Position, Attribute::Velocity});
+    s.apply = "fl_constrain2d(" + ap + ", " + pv;
+    return true;
+  }
+  if (std::holds_alternative<Gravitate>(act) || std::holds_alternative<Follow>(act)) {
+    const std::string fn =
+        std::holds_alternative<Gravitate>(act) ? "fl_gravitate_acc(" : "fl_follow_acc(";
+    s.neighbours = true;
+    s.reads.insert({Attribute::Position, Attribute::Velocity});
+    s.writes.insert(Attribute::Velocity);
+    const std::string acc = fn + ap + ", " + kSnapArgs + ", (float3)(px, py, pz))";
+    s.apply = "fl_add_accel(" + acc + ", dt, &vx, &vy, &vz);\n";
+    // integrate.hpp accumulate(): this force's acceleration, then added to the sum.
+    s.accel = "{ const float3 acc = " + acc + "; ax += acc.x; ay += acc.y; az += acc.z; }\n";
+    return true;
+  }
+  if (std::holds_alternative<MatchVelocity>(act)) {
+    s.neighbours = true;
+    s.reads.insert({Attribute::Position, Attribute::Velocity});
+    s.writes.insert(Attribute::Velocity);
+    s.apply = "fl_match_mean(" + ap + ", " + kSnapArgs + ", 1u, dt, px, py, pz, &vx, &vy, &vz);\n";
+    return true;
+  }
+  if (std::holds_alternative<MatchRotVelocity>(act)) {
+    s.neighbours = true;
+    s.reads.insert({Attribute::Position, Attribute::RotVelocity});
+    s.writes.insert(Attribute::RotVelocity);
+    s.apply =
+        "fl_match_mean(" + ap + ", " + kSnapArgs + ", 2u, dt, px, py, pz, &rotx, &roty, &rotz);\n";
     return true;
   }
   return false;
 }
 
 bool packSurfaceAction(const Action& act, ActionPack& p) {
+  float* f = p.p.f;
   if (const auto* b = std::get_if<Bounce>(&act)) {
-    packBounce(*b, p.p.f);
+    packBounce(*b, p.p);
     return true;
   }
   if (const auto* k = std::get_if<Sink>(&act)) {
     p.p.domain = packDomain(k->region);
-    p.p.f[0] = k->passThrough;
+    f[0] = k->passThrough;
+    return true;
+  }
+  if (const auto* k = std::get_if<SinkVelocity>(&act)) {
+    p.p.domain = packDomain(k->velocity);
+    return true;
+  }
+  if (const auto* b = std::get_if<Block>(&act)) {
+    p.p.domain = packDomain(b->region);
+    return true;
+  }
+  if (const auto* k = std::get_if<Avoid>(&act)) {
+    p.p.domain = packDomain(k->obstacle);
+    f[0] = k->magnitude;
+    f[1] = k->epsilon;
+    f[2] = k->lookAhead;
+    return true;
+  }
+  if (const auto* k = std::get_if<Constrain2D>(&act)) {
+    putVec(f, 0, k->point);
+    putVec(f, 3, glm::normalize(k->normal));
+    return true;
+  }
+  if (const auto* k = std::get_if<Gravitate>(&act)) {
+    packPull(k->magnitude, k->epsilon, k->maxRadius, f);
+    return true;
+  }
+  if (const auto* k = std::get_if<Follow>(&act)) {
+    packPull(k->magnitude, k->epsilon, k->maxRadius, f);
+    return true;
+  }
+  const MatchVelocity* mv = std::get_if<MatchVelocity>(&act);
+  const auto* mr = std::get_if<MatchRotVelocity>(&act);
+  if (mv || mr) {
+    // actions_more.hpp approach(rate, dt) for the step's dt; sub-steps compute their own.
+    const float rate = mv ? mv->magnitude : mr->magnitude;
+    packPull(rate, p.dt, mv ? mv->maxRadius : mr->maxRadius, f);
+    f[3] = 1.0f - std::exp(-rate * p.dt);
     return true;
   }
   return false;

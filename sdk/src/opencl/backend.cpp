@@ -30,9 +30,10 @@ namespace flurry::detail::ocl {
 static_assert(sizeof(cl::FlDomain) == 72 && alignof(cl::FlDomain) == 4);
 static_assert(sizeof(cl::FlFuzzy) == 16);
 static_assert(sizeof(cl::FlParticleType) == 4 * 72 + 5 * 16 + 8);
-static_assert(sizeof(cl::FlEmitter) == 72 + 16 + 32 + 24 && offsetof(cl::FlEmitter, start) == 72);
+static_assert(sizeof(cl::FlEmitter) == 72 + 16 + 32 + 16 + 24 &&
+              offsetof(cl::FlEmitter, start) == 72);
 static_assert(sizeof(cl::FlKeyframe) == 24 && offsetof(cl::FlKeyframe, position) == 8);
-static_assert(sizeof(cl::FlBirthRun) == 32 && offsetof(cl::FlBirthRun, emitter) == 24);
+static_assert(sizeof(cl::FlBirthRun) == 64 && offsetof(cl::FlBirthRun, emitter) == 56);
 static_assert(sizeof(cl::FlActionParams) == 72 + 32 * 4 + 8 * 4 &&
               offsetof(cl::FlActionParams, f) == 72 && offsetof(cl::FlActionParams, u) == 200);
 static_assert(FL_TILE % 16 == 0);
@@ -172,19 +173,25 @@ class ClGroup final : public DeviceMirror {
     while (!inFlight_.empty()) retire(g, true);
   }
   void apply(GroupImpl& g, const std::vector<std::uint32_t>& state);
+  void queueHair(GroupImpl& g, const StepParams& sp, std::size_t births);
+  void readStrands(GroupImpl& g, std::size_t births);
 
   std::shared_ptr<Shared> shared_;
   std::vector<DeviceLane> lanes_;
   AttributeSet laneSet_;
   bool allocated_ = false;
   Mem codes_, tileDead_, tileOff_, holes_, tailList_;
-  GrowBuffer state_, params_, extra_, snap_, runs_, emitters_, types_, keys_;
+  GrowBuffer state_, params_, extra_, snap_, runs_, emitters_, types_, keys_, shapes_;
   std::size_t tiles_ = 0;
 
   Program program_;
   ActionList programActions_;
   bool programValid_ = false;
   std::string emitterSignature_;
+  bool hairProgram_ = false;  // the program has fl_hair
+  Kernel hair_;
+  GrowBuffer strandP_, strandC_, strandR_, strandCount_;
+  std::uint32_t lastHairAlive_ = 0;
   std::vector<LaneRef> actLanes_;
   bool neighbours_ = false, substepsByDistance_ = false;
   Kernel act_, count_, scan_, list_, scanList_, tailKernel_, maxSpeed_;
@@ -249,7 +256,7 @@ void ClGroup::allocate(GroupImpl& g) {
 
 void ClGroup::buildProgram(GroupImpl& g) {
   const GeneratedProgram gen =
-      generateProgram(g.actions, g.stored, shared_->fp64(), emissionSource(g));
+      generateProgram(g.actions, g.stored, shared_->fp64(), emissionSource(g), g.hair.enabled);
   emitterSignature_ = emitterSignature(g);
   Program p(shared_->runtime->program(gen.source, gen.options));
   cl_int err = CL_SUCCESS;
@@ -261,6 +268,7 @@ void ClGroup::buildProgram(GroupImpl& g) {
   Kernel act = kernel("fl_act"), count = kernel("fl_count"), scan = kernel("fl_scan"),
          list = kernel("fl_list"), scanList = kernel("fl_scan_list"), tail = kernel("fl_tail"),
          maxSpeed = kernel("fl_max_speed");
+  Kernel hair = g.hair.enabled ? kernel("fl_hair") : Kernel();
   program_ = std::move(p);
   act_ = std::move(act);
   count_ = std::move(count);
@@ -269,6 +277,8 @@ void ClGroup::buildProgram(GroupImpl& g) {
   scanList_ = std::move(scanList);
   tailKernel_ = std::move(tail);
   maxSpeed_ = std::move(maxSpeed);
+  hair_ = std::move(hair);
+  hairProgram_ = g.hair.enabled;
   actLanes_ = gen.actLanes;
   neighbours_ = gen.neighbours;
   substepsByDistance_ = gen.substepsByDistance;
@@ -332,6 +342,7 @@ void ClGroup::upload(GroupImpl& g) {
   size_ = g.size;
   nextId_ = g.nextId;
   lastDropped_ = 0;
+  lastHairAlive_ = 0;
   lastKills_.assign(FL_KILL_CODES, 0u);
   (void)nActions;
   hostDirty_ = false;
@@ -344,6 +355,8 @@ void ClGroup::apply(GroupImpl& g, const std::vector<std::uint32_t>& s) {
   // The device's counters are 32-bit and wrap; the host sums their deltas in 64 bits.
   g.stats.droppedAtCapacity += std::uint32_t(s[FL_STATE_DROPPED] - lastDropped_);
   lastDropped_ = s[FL_STATE_DROPPED];
+  g.stats.killedByAge += std::uint32_t(s[FL_STATE_HAIR_ALIVE] - lastHairAlive_);
+  lastHairAlive_ = s[FL_STATE_HAIR_ALIVE];
   const auto& acts = programActions_.actions();
   {
     const std::size_t k = FL_NON_FINITE_CODE - 1;
@@ -388,6 +401,80 @@ void ClGroup::retire(GroupImpl& g, bool wait) {
   inFlight_.pop_front();
 }
 
+void ClGroup::queueHair(GroupImpl& g, const StepParams& sp, std::size_t births) {
+  const std::size_t vertices = births * g.hair.maxVertices;
+  strandP_.reserve(context(), vertices * 3 * 4);
+  strandC_.reserve(context(), vertices * 4 * 4);
+  strandR_.reserve(context(), vertices * 4);
+  strandCount_.reserve(context(), births * 4);
+  cl_kernel k = hair_.get();
+  cl_uint i = 0;
+  for (const auto& l : lanes_) setArg(k, i++, l.mem.get());
+  setArg(k, i++, params_.mem.get());
+  setArg(k, i++, state_.mem.get());
+  setArg(k, i++, extra_.mem.get());
+  setArg(k, i++, extra_.mem.get());  // no snapshot: hair refuses neighbour actions
+  setArg(k, i++, cl_ulong(doubleBits(sp.dt)));
+  setArg(k, i++, cl_ulong(doubleBits(sp.time + sp.dt)));  // hair.cpp: hs.time
+  setArg(k, i++, cl_uint(sp.seed));
+  setArg(k, i++, cl_uint(sp.seed >> 32));
+  setArg(k, i++, cl_uint(sp.step));
+  setArg(k, i++, cl_uint(g.index << 16));
+  setArg(k, i++, cl_uint(stepSubsteps(g.actions, sp.dt)));
+  setArg(k, i++, cl_uint(0));
+  setArg(k, i++, cl_uint(g.hair.every));
+  setArg(k, i++, cl_uint(g.hair.maxVertices));
+  setArg(k, i++, strandP_.mem.get());
+  setArg(k, i++, strandC_.mem.get());
+  setArg(k, i++, strandR_.mem.get());
+  setArg(k, i++, strandCount_.mem.get());
+  const std::size_t global = roundUp(births, kSmallLocal), local = kSmallLocal;
+  check(clEnqueueNDRangeKernel(queue(), k, 1, nullptr, &global, &local, 0, nullptr, nullptr),
+        "fl_hair");
+}
+
+void ClGroup::readStrands(GroupImpl& g, std::size_t births) {
+  // Newborns beyond capacity were dropped: the device wrote strands for those born.
+  const std::size_t born = std::min(births, g.capacity);
+  const std::size_t maxV = g.hair.maxVertices;
+  std::vector<std::uint32_t> count(born);
+  std::vector<float> P(born * maxV * 3), C(born * maxV * 4), R(born * maxV);
+  cl_command_queue q = queue();
+  check(clEnqueueReadBuffer(q, strandCount_.mem.get(), CL_FALSE, 0, born * 4, count.data(), 0,
+                            nullptr, nullptr),
+        "clEnqueueReadBuffer (strands)");
+  check(clEnqueueReadBuffer(q, strandP_.mem.get(), CL_FALSE, 0, P.size() * 4, P.data(), 0, nullptr,
+                            nullptr),
+        "clEnqueueReadBuffer (strands)");
+  check(clEnqueueReadBuffer(q, strandC_.mem.get(), CL_FALSE, 0, C.size() * 4, C.data(), 0, nullptr,
+                            nullptr),
+        "clEnqueueReadBuffer (strands)");
+  check(clEnqueueReadBuffer(q, strandR_.mem.get(), CL_FALSE, 0, R.size() * 4, R.data(), 0, nullptr,
+                            nullptr),
+        "clEnqueueReadBuffer (strands)");
+  check(clFinish(q), "clFinish");
+  std::vector<Vec3> p;
+  std::vector<Vec4> c;
+  std::vector<float> r;
+  for (std::size_t s = 0; s < born; ++s) {
+    const std::size_t m = std::min<std::size_t>(count[s], maxV);
+    if (m < 2) continue;  // hair.cpp: a strand needs two vertices
+    p.resize(m);
+    c.resize(m);
+    r.resize(m);
+    for (std::size_t v = 0; v < m; ++v) {
+      const std::size_t o = s * maxV + v;
+      p[v] = Vec3(P[3 * o], P[3 * o + 1], P[3 * o + 2]);
+      c[v] = Vec4(C[4 * o], C[4 * o + 1], C[4 * o + 2], C[4 * o + 3]);
+      r[v] = R[o];
+    }
+    g.strands.add(p, c, r);
+  }
+  size_ = 0;
+  g.size = 0;
+  deviceNewer_ = false;
+}
+
 void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   checkEmissionSupported(g);
   if (!allocated_ || laneSet_ != g.stored) {
@@ -400,7 +487,8 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     programValid_ = false;
   }
   // Emitters may be edited at any time (Group::emitters()); the program follows their kinds.
-  if (programValid_ && emitterSignature(g) != emitterSignature_) programValid_ = false;
+  if (programValid_ && (emitterSignature(g) != emitterSignature_ || g.hair.enabled != hairProgram_))
+    programValid_ = false;
   if (!programValid_) buildProgram(g);
 
   packActions(g.actions, float(sp.dt), params_host_, extra_host_);
@@ -532,6 +620,7 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     write(emitters_, t.emitters.data(), t.emitters.size() * sizeof(cl::FlEmitter));
     write(types_, t.types.data(), t.types.size() * sizeof(cl::FlParticleType));
     write(keys_, t.keys.data(), t.keys.size() * sizeof(cl::FlKeyframe));
+    write(shapes_, t.shapes.data(), t.shapes.size() * sizeof(float));
     cl_kernel k = tailKernel_.get();
     cl_uint i = cl_uint(lanes_.size()) + 2;
     setArg(k, i++, state);
@@ -539,6 +628,7 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     setArg(k, i++, emitters_.mem.get());
     setArg(k, i++, types_.mem.get());
     setArg(k, i++, keys_.mem.get());
+    setArg(k, i++, shapes_.mem.get());
     setArg(k, i++, cl_uint(t.runs.size()));
     setArg(k, i++, cl_ulong(doubleBits(sp.time + sp.dt)));
     setArg(k, i++, seedLo);
@@ -546,6 +636,10 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     setArg(k, i++, cl_uint(g.index));
     const std::size_t fill = kills ? std::min(roundUp(nBound, kSmallLocal), kMaxFillItems) : 0;
     launch(k, roundUp(std::max<std::size_t>(births, fill), kSmallLocal), kSmallLocal, "fl_tail");
+    if (g.hair.enabled && births > 0) {
+      queueHair(g, sp, births);
+      f.births = 0;  // the group is empty again after the step
+    }
 
     // The step's counts come back without the host waiting; later steps size their launches
     // from them.
@@ -559,6 +653,11 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   }
   check(clFlush(q), "clFlush");
   deviceNewer_ = true;
+  if (g.hair.enabled && births > 0) {
+    // Strands are host data: the step's come back now.
+    drain(g);
+    readStrands(g, births);
+  }
   while (inFlight_.size() > kMaxInFlight) retire(g, true);
   while (!inFlight_.empty()) {  // take what is done without waiting
     const std::size_t before = inFlight_.size();

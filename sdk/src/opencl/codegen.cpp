@@ -96,9 +96,12 @@ std::vector<LaneRef> lanesOf(AttributeSet stored) {
 }
 
 cl::FlDomain packDomain(const Domain& d) {
+  // Meshes and unions need a data table (emission.cpp packs them, with their data, for
+  // emitters); fl_inside and the actions' fl_sample have none.
   if (d.shape().index() > FL_DOMAIN_BLOB)
     throw Error(std::string("OpenCL backend: a ") + d.name() +
-                " domain is not supported on the device yet; use Backend::Cpu");
+                " domain as an action's region or surface does not run on the device yet; use "
+                "Backend::Cpu");
   cl::FlDomain o{};
   o.kind = cl::fl_u32(d.shape().index());
   float* v = o.v;
@@ -114,6 +117,7 @@ cl::FlDomain packDomain(const Domain& d) {
           putVec(v, 0, s.p0);
           putVec(v, 3, s.p1);
           putVec(v, 6, s.p2);
+          putVec(v, 9, s.normal);  // for Emitter::normalSpeed
         } else if constexpr (std::is_same_v<T, PlaneDomain>) {
           putVec(v, 0, s.point);
           putVec(v, 3, s.normal);
@@ -121,6 +125,7 @@ cl::FlDomain packDomain(const Domain& d) {
           putVec(v, 0, s.origin);
           putVec(v, 3, s.u);
           putVec(v, 6, s.v);
+          putVec(v, 9, s.normal);
         } else if constexpr (std::is_same_v<T, DiscDomain>) {
           Vec3 e1, e2;
           basis(s.normal, e1, e2);
@@ -129,6 +134,7 @@ cl::FlDomain packDomain(const Domain& d) {
           putVec(v, 6, e2);
           v[9] = s.outerRadius;
           v[10] = s.innerRadius;
+          putVec(v, 11, s.normal);
         } else if constexpr (std::is_same_v<T, BoxDomain>) {
           putVec(v, 0, s.min);
           putVec(v, 3, s.max);
@@ -280,8 +286,104 @@ std::uint32_t stepSubsteps(const ActionList& actions, double dt) {
   return std::uint32_t(std::min<double>(n, sub.maxSubsteps));
 }
 
+// One step of the list for one particle: the sub-step count, the sub-steps, the NaN guard.
+// In scope: dtBits, t0 (the step's start time), nsubStep, state, and the lane registers.
+std::string stepSource(const std::string& body, const Substeps& sub, bool byDistance,
+                       AttributeSet stored, bool guarded) {
+  std::ostringstream s;
+  if (guarded) s << "  const float fl_start_x = px, fl_start_y = py, fl_start_z = pz;\n";
+  // Sub-steps as fused_pass.cpp: dt / n in double, each with its own time and streams.
+  // nsubStep: by Substeps::maxStep, from the host; then by the fastest particle, which
+  // fl_max_speed left in the state (its |v|^2 as float bits).
+  s << "  uint nsub = nsubStep;\n";
+  if (byDistance) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.9g", double(sub.maxDistance));
+    s << "  {\n    const float vmax = sqrt(as_float(state[FL_STATE_MAX_SPEED2]));\n"
+         "    if (isfinite(vmax)) {\n"
+         "      const fl_real m = ceil((fl_real)vmax * fl_real_from_bits(dtBits) / (fl_real)"
+      << buf << "f);\n      const fl_real cap = (fl_real)" << sub.maxSubsteps
+      << "u;\n      if (m > (fl_real)nsub) nsub = (uint)(m < cap ? m : cap);\n    }\n  }\n";
+  }
+  s << "  const float dt = (float)(fl_real_from_bits(dtBits) / (fl_real)nsub);\n"
+       "  uint dead = 0u;\n"
+       "  for (uint sub = 0u; sub < nsub; ++sub) {\n"
+       "    const fl_real time = t0 + (fl_real)sub * (fl_real)dt;\n"
+       "    const uint streamSub = streamBase + (sub << 8);\n"
+       "    (void)time; (void)streamSub;\n"
+    << body << "  }\n";
+  // The NaN guard (fused_pass.cpp guardFinite): position and velocity, by their bits.
+  s << "  {\n    uint bad = 0u;\n";
+  for (const char* c : {"px", "py", "pz"})
+    s << "    bad |= (as_uint(" << c << ") & 0x7f800000u) == 0x7f800000u;\n";
+  if (stored.has(Attribute::Velocity))
+    for (const char* c : {"vx", "vy", "vz"})
+      s << "    bad |= (as_uint(" << c << ") & 0x7f800000u) == 0x7f800000u;\n";
+  s << "    dead = bad ? FL_NON_FINITE_CODE : dead;\n  }\n";
+  return s.str();
+}
+
+// Hair mode (hair.cpp simulateHair): each newborn runs the list to its death in one work
+// item, recording a strand vertex every `every` steps. The group is empty before the step's
+// emission, so newborn r is in slot r. Kills are counted into the state per kill code; those
+// that outlive their strand into FL_STATE_HAIR_ALIVE (the CPU counts them as killed by age).
+std::string hairKernel(const std::string& stepCode, const std::vector<LaneRef>& all,
+                       AttributeSet stored) {
+  std::ostringstream s;
+  s << "/* ---- generated: hair mode */\n__kernel void fl_hair(FL_LANE_PARAMS,\n"
+       "    __global const FlActionParams* ap, __global uint* state,\n"
+       "    __global const float* restrict extra, __global const float* restrict snap,\n"
+       "    ulong dtBits, ulong timeBits, uint seedLo, uint seedHi, uint step0,\n"
+       "    uint streamBase, uint nsubStep, uint snapStride, uint every, uint maxVertices,\n"
+       "    __global float* restrict strandP, __global float* restrict strandC,\n"
+       "    __global float* restrict strandR, __global uint* restrict strandCount) {\n"
+       "  const uint i = get_global_id(0);\n"
+       "  const uint born = state[FL_STATE_BORN];\n"
+       "  if (i == 0u) state[FL_STATE_SIZE] = 0u; /* a hair group keeps strands, not particles */\n"
+       "  if (i >= born) return;\n"
+       "  const uint n = 0u, snapN = 0u;\n"
+       "  (void)extra; (void)snap; (void)snapN; (void)snapStride; (void)seedLo; (void)seedHi;\n"
+       "  (void)n;\n";
+  for (const auto& l : all)
+    s << "  " << (info(l.attribute).isUint ? "uint " : "float ") << l.name << " = l_" << l.name
+      << "[i];\n";
+  const bool color = stored.has(Attribute::Color), size = stored.has(Attribute::Size);
+  s << "  uint count = 0u;\n"
+       "#define FL_RECORD() do { if (count < maxVertices) { const uint o = i * maxVertices + count;"
+       " strandP[3u * o] = px; strandP[3u * o + 1u] = py; strandP[3u * o + 2u] = pz;"
+    << (color ? " strandC[4u * o] = r; strandC[4u * o + 1u] = g; strandC[4u * o + 2u] = b;"
+                " strandC[4u * o + 3u] = a;"
+              : " strandC[4u * o] = 1.0f; strandC[4u * o + 1u] = 1.0f; strandC[4u * o + 2u] ="
+                " 1.0f; strandC[4u * o + 3u] = 1.0f;")
+    << " strandR[o] = " << (size ? "size" : "0.05f") << "; ++count; } } while (0)\n"
+    << "  FL_RECORD();\n"
+       "  const uint maxSteps = maxVertices * every;\n"
+       "  fl_real t0 = fl_real_from_bits(timeBits);\n"
+       "  uint alive = 1u;\n"
+       "  for (uint k = 1u; k <= maxSteps; ++k) {\n"
+       "    const uint step = step0 + (k - 1u);\n"
+       "    uint killed;\n"
+       "    {\n"
+    << stepCode
+    << "      killed = dead;\n"
+       "    }\n"
+       "    if (killed != 0u) {\n"
+       "      atomic_inc(&state[FL_STATE_KILLS + killed - 1u]);\n"
+       "      alive = 0u;\n"
+       "      break;\n"
+       "    }\n"
+       "    if (k % every == 0u) FL_RECORD();\n"
+       "    t0 += fl_real_from_bits(dtBits);\n"
+       "  }\n"
+       "#undef FL_RECORD\n"
+       "  if (alive) atomic_inc(&state[FL_STATE_HAIR_ALIVE]);\n"
+       "  strandCount[i] = count;\n"
+       "}\n";
+  return s.str();
+}
+
 GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored, bool fp64,
-                                 const std::string& emitSource) {
+                                 const std::string& emitSource, bool hair) {
   GeneratedProgram g;
   // What the act kernel loads (reads) and stores (writes).
   AttributeSet reads, writes;
@@ -290,6 +392,7 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   std::vector<std::string> pending;  // gathered forces' accelerations, for the next Move
   std::vector<std::string> pendingDamping;
   std::vector<std::size_t> pendingBounces;
+  bool guarded = false;  // some Bounce is guarded: keep where each particle began the step
   const auto& acts = actions.actions();
   for (std::size_t k = 0; k < acts.size(); ++k) {
     const Action& act = acts[k];
@@ -317,10 +420,6 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
       }
       if (std::holds_alternative<Bounce>(act)) pendingBounces.push_back(k);
       if (std::holds_alternative<Move>(act)) {
-        if (!pendingBounces.empty())
-          notOnDevice(
-              "a Bounce before a Move under an integrator other than SemiImplicitEuler "
-              "(its curved-step guard)");
         reads.insert({Attribute::Position, Attribute::Velocity});
         writes.insert({Attribute::Position, Attribute::Velocity});
         const bool prev = stored.has(Attribute::PrevPosition), age = stored.has(Attribute::Age);
@@ -330,6 +429,15 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
           writes.insert(Attribute::Age);
         }
         body << integrateMove(integrator, pending, pendingDamping, prev, age);
+        // A curved step (or its bounce) that ended behind a deflector, compared with where
+        // the particle began the step, is put back (fused_pass.cpp guard).
+        for (std::size_t b : pendingBounces) {
+          const auto& bounce = std::get<Bounce>(acts[b]);
+          body << "    fl_bounce_guard((ap + " << b << "), " << bounce.surface.shape().index()
+               << "u, " << (bounce.inside ? 1 : 0)
+               << ", fl_start_x, fl_start_y, fl_start_z, &px, &py, &pz, &vx, &vy, &vz, extra);\n";
+          guarded = true;
+        }
         pending.clear();
         pendingDamping.clear();
         pendingBounces.clear();
@@ -388,37 +496,16 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
     else
       s << "  " << type << " " << l.name << ";\n";
   }
-  // Sub-steps as fused_pass.cpp: dt / n in double, each with its own time and streams.
-  // nsubStep: by Substeps::maxStep, from the host; then by the fastest particle, which
-  // fl_max_speed left in the state (its |v|^2 as float bits).
-  s << "  uint nsub = nsubStep;\n";
-  if (g.substepsByDistance) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.9g", double(sub.maxDistance));
-    s << "  {\n    const float vmax = sqrt(as_float(state[FL_STATE_MAX_SPEED2]));\n"
-         "    if (isfinite(vmax)) {\n"
-         "      const fl_real m = ceil((fl_real)vmax * fl_real_from_bits(dtBits) / (fl_real)"
-      << buf << "f);\n      const fl_real cap = (fl_real)" << sub.maxSubsteps
-      << "u;\n      if (m > (fl_real)nsub) nsub = (uint)(m < cap ? m : cap);\n    }\n  }\n";
-  }
-  s << "  const float dt = (float)(fl_real_from_bits(dtBits) / (fl_real)nsub);\n"
-       "  uint dead = 0u;\n"
-       "  for (uint sub = 0u; sub < nsub; ++sub) {\n"
-       "    const fl_real time = fl_real_from_bits(timeBits) + (fl_real)sub * (fl_real)dt;\n"
-       "    const uint streamSub = streamBase + (sub << 8);\n"
-       "    (void)time; (void)streamSub;\n"
-    << body.str() << "  }\n";
-  // The NaN guard (fused_pass.cpp guardFinite): position and velocity, by their bits.
-  s << "  {\n    uint bad = 0u;\n";
-  for (const char* c : {"px", "py", "pz"})
-    s << "    bad |= (as_uint(" << c << ") & 0x7f800000u) == 0x7f800000u;\n";
-  if (stored.has(Attribute::Velocity))
-    for (const char* c : {"vx", "vy", "vz"})
-      s << "    bad |= (as_uint(" << c << ") & 0x7f800000u) == 0x7f800000u;\n";
-  s << "    dead = bad ? FL_NON_FINITE_CODE : dead;\n  }\n";
+  const std::string stepCode = stepSource(body.str(), sub, g.substepsByDistance, stored, guarded);
+  s << "  const fl_real t0 = fl_real_from_bits(timeBits);\n" << stepCode;
   for (const auto& l : g.actLanes)
     if (writes.has(l.attribute)) s << "  l_" << l.name << "[i] = " << l.name << ";\n";
   s << "  codes[i] = (uchar)dead;\n}\n";
+  if (hair) {
+    if (g.neighbours) notOnDevice("hair mode with actions that read neighbours");
+    if (g.substepsByDistance) notOnDevice("hair mode with sub-steps by distance");
+    s << hairKernel(stepCode, all, stored);
+  }
   g.source = s.str();
   // Correctly rounded division and sqrt: the CPU's are, and Bounce divides.
   g.options = "-cl-std=CL1.2 -cl-fp32-correctly-rounded-divide-sqrt";

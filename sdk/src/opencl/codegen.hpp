@@ -34,9 +34,10 @@ struct GeneratedProgram {
 /// The program for this list over these stored attributes: the embedded kernels plus one
 /// generated fused act kernel (fl_act) that runs exactly the list's actions, in order, and
 /// loads and stores exactly the lanes they use. `emitSource` is the generated emission code
-/// (emission.hpp emissionSource), placed before tail.cl.
+/// (emission.hpp emissionSource), placed before tail.cl. With `hair`, the program also has
+/// fl_hair, which runs each newborn's whole life as a strand (hair mode).
 GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored, bool fp64,
-                                 const std::string& emitSource);
+                                 const std::string& emitSource, bool hair = false);
 
 /// What the generator of one action writes into the fused act kernel.
 ///

@@ -1,12 +1,24 @@
 // Emission on the device: the host's planning of births and the generated fl_emit.
+//
+// The planning is sdk/src/emission.cpp's, rule for rule (it runs on a handful of emitters,
+// so the host does it exactly as the CPU backend does): rates, bursts, emission by
+// distance, prime emitters spawning live emitters that fly, emit and die with bursts and
+// children. Its runs become FlBirthRuns in the CPU's order, so newborn r of a step gets the
+// same id (firstId + r) and the same random stream on both backends; each run points at an
+// FlEmitter entry packed from the (static or live) emitter as it is this step.
 #include "emission.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
+#include <map>
+#include <set>
 #include <sstream>
 
+#include "../sampling.hpp"
 #include "flurry/error.hpp"
+#include "flurry/random.hpp"
 
 namespace flurry::detail::ocl {
 
@@ -18,13 +30,184 @@ std::uint64_t doubleBits(double d) {
   return b;
 }
 
-// emission.cpp producedBy: births a rate has produced by time t.
+// ---- Planning: sdk/src/emission.cpp, verbatim in effect ------------------------------------
+
+struct BirthRun {
+  enum Kind { Rate, Burst, Distance } kind;
+  bool live;  // the emitter is g.live[index], else g.emitters[index]
+  std::uint32_t index;
+  std::uint64_t first;  // Rate: index of the first birth since the emitter's start
+  double time;          // Burst: its time; Distance: the step's start
+  std::uint64_t count;
+  double s0 = 0, spacing = 0, span = 0, dt = 0;  // Distance: first birth at s0 of span
+};
+
 std::uint64_t producedBy(const Emitter& e, double t) {
   const double elapsed = std::min(t, e.stop) - e.start;
   if (elapsed <= 0) return 0;
   const double x = e.rate * elapsed;
   return std::uint64_t(std::floor(x + 1e-9 * std::max(1.0, x)));
 }
+
+double birthTime(const BirthRun& run, const Emitter& em, std::uint64_t q) {
+  switch (run.kind) {
+    case BirthRun::Rate:
+      return em.start + double(run.first + q + 1) / em.rate;
+    case BirthRun::Burst:
+      return run.time;
+    default:
+      return run.time + run.dt * (run.s0 + double(q) * run.spacing) / run.span;
+  }
+}
+
+std::uint64_t planEmitter(const Emitter& em, EmitterState& state, bool live, std::uint32_t index,
+                          double t0, double t1, std::vector<BirthRun>& runs) {
+  std::uint64_t total = 0;
+  if (em.rate > 0) {
+    const std::uint64_t target = producedBy(em, t1);
+    if (target > state.emittedByRate) {
+      runs.push_back(
+          {BirthRun::Rate, live, index, state.emittedByRate, 0.0, target - state.emittedByRate});
+      total += target - state.emittedByRate;
+      state.emittedByRate = target;
+    }
+  }
+  for (const Burst& b : em.bursts) {
+    for (std::uint32_t r = 0; r < b.repeat; ++r) {
+      const double tb = b.time + r * b.interval;
+      if (tb >= t0 && tb < t1 && tb >= em.start && tb <= em.stop && b.count > 0) {
+        runs.push_back({BirthRun::Burst, live, index, 0, tb, b.count});
+        total += b.count;
+      }
+    }
+  }
+  if (em.spacing > 0) {
+    const double a = std::max(t0, em.start), b = std::min(t1, em.stop);
+    if (b > a) {
+      const double span = glm::length(em.positionAt(b) - em.positionAt(a));
+      const double s0 = em.spacing - state.travelled;
+      if (span >= s0) {
+        const auto count = std::uint64_t(std::floor((span - s0) / em.spacing)) + 1;
+        BirthRun run{BirthRun::Distance, live, index, 0, a, count};
+        run.s0 = s0;
+        run.spacing = em.spacing;
+        run.span = span;
+        run.dt = b - a;
+        runs.push_back(run);
+        total += count;
+        state.travelled = span - (s0 + double(count - 1) * em.spacing);
+      } else {
+        state.travelled += span;
+      }
+    }
+  }
+  return total;
+}
+
+void fly(const EmitterSpec& spec, Vec3 p0, Vec3 v0, double t, Vec3& p, Vec3& v) {
+  const float k = spec.drag, tf = float(t);
+  const Vec3 a = spec.acceleration;
+  if (k > 0.0f) {
+    const float e = std::exp(-k * tf);
+    const Vec3 terminal = a / k;
+    v = terminal + (v0 - terminal) * e;
+    p = p0 + terminal * tf + (v0 - terminal) * ((1.0f - e) / k);
+  } else {
+    v = v0 + a * tf;
+    p = p0 + v0 * tf + a * (0.5f * tf * tf);
+  }
+}
+
+void spawn(GroupImpl& g, const StepParams& sp, std::shared_ptr<const EmitterSpec> spec,
+           double birth, Vec3 place, Vec3 parentVelocity, std::uint32_t generation,
+           const Domain* shape) {
+  const std::uint32_t id = g.nextEmitterId++;
+  Random rng(sp.seed, id, g.index, stream::kEmitterEvent);
+  LiveEmitter e;
+  e.id = id;
+  e.position = place + (shape ? shape->sample(rng) : Vec3(0.0f));
+  e.velocity = spec->velocity.sample(rng) + parentVelocity * spec->inheritVelocity;
+  const double life = std::max(1e-6f, spec->lifetime.sample(rng));
+  e.birth = birth;
+  e.death = birth + life;
+  e.generation = generation;
+  e.emitter = spec->emitter;
+  e.emitter.start = birth;
+  e.emitter.stop = std::min(e.death, birth + (spec->emitter.stop - spec->emitter.start));
+  for (Burst& b : e.emitter.bursts) b.time += birth;
+  e.spec = spec.get();
+  e.keepAlive = std::move(spec);
+  g.live.push_back(std::move(e));
+  ++g.stats.emittersSpawned;
+}
+
+void countGeneration(GroupImpl& g, std::uint32_t generation, std::uint64_t n) {
+  if (g.stats.emittedByGeneration.size() <= generation)
+    g.stats.emittedByGeneration.resize(generation + 1, 0);
+  g.stats.emittedByGeneration[generation] += n;
+}
+
+std::uint64_t planAll(GroupImpl& g, const StepParams& sp, std::vector<BirthRun>& runs) {
+  const double t0 = sp.time, t1 = sp.time + sp.dt;
+  std::uint64_t total = 0;
+  for (std::uint32_t e = 0; e < g.emitters.size(); ++e) {
+    const std::uint64_t n = planEmitter(g.emitters[e], g.emitterState[e], false, e, t0, t1, runs);
+    countGeneration(g, 0, n);
+    total += n;
+  }
+  if (g.primeSpecs.size() != g.primes.size()) {
+    g.primeSpecs.clear();
+    for (const PrimeEmitter& p : g.primes)
+      g.primeSpecs.push_back(std::make_shared<EmitterSpec>(p.child));
+  }
+  for (std::size_t k = 0; k < g.primes.size(); ++k) {
+    const PrimeEmitter& prime = g.primes[k];
+    Emitter counter;
+    counter.rate = prime.rate;
+    counter.bursts = prime.bursts;
+    counter.start = prime.start;
+    counter.stop = prime.stop;
+    std::vector<BirthRun> spawns;
+    planEmitter(counter, g.primeState[k], false, 0, t0, t1, spawns);
+    for (const BirthRun& run : spawns)
+      for (std::uint64_t q = 0; q < run.count; ++q) {
+        const double tb = birthTime(run, counter, q);
+        spawn(g, sp, g.primeSpecs[k], tb, prime.positionAt(tb), prime.velocity, 1, &prime.shape);
+      }
+  }
+  for (std::size_t k = 0; k < g.live.size(); ++k) {
+    LiveEmitter& e = g.live[k];
+    const double a = std::max(t0, e.birth), b = std::min(t1, e.death);
+    if (b < a) continue;
+    const double stateTime = std::max(t0, e.birth);
+    Vec3 pb, vb, pm, vm;
+    fly(*e.spec, e.position, e.velocity, b - stateTime, pb, vb);
+    fly(*e.spec, e.position, e.velocity, 0.5 * (b - stateTime), pm, vm);
+    e.emitter.path = {{a, e.position}, {0.5 * (a + b), pm}, {b, pb}};
+    if (!(b > a)) e.emitter.path.resize(1);
+    const std::uint64_t n =
+        planEmitter(e.emitter, e.state, true, std::uint32_t(k), a, b + 1e-12, runs);
+    countGeneration(g, e.generation, n);
+    total += n;
+    e.position = pb;
+    e.velocity = vb;
+    if (e.death <= t1) {
+      const EmitterSpec& spec = *e.spec;
+      if (spec.deathBurst > 0) {
+        runs.push_back({BirthRun::Burst, true, std::uint32_t(k), 0, e.death, spec.deathBurst});
+        countGeneration(g, e.generation, spec.deathBurst);
+        total += spec.deathBurst;
+      }
+      const double death = e.death;
+      const std::uint32_t generation = e.generation + 1;
+      for (std::uint32_t c = 0; c < spec.deathChildren; ++c)
+        spawn(g, sp, spec.next, death, pb, vb, generation, nullptr);
+    }
+  }
+  return total;
+}
+
+// ---- The generated code: one fl_emit case per distinct emitter code ------------------------
 
 cl::FlFuzzy packFuzzy(const Fuzzy& f) {
   return {f.center, f.spread, f.distribution == Fuzzy::Distribution::Normal ? 1u : 0u, 0u};
@@ -34,8 +217,13 @@ int fuzzyMode(const Fuzzy& f) {
   return f.spread == 0.0f ? 0 : f.distribution == Fuzzy::Distribution::Normal ? 2 : 1;
 }
 
+// 0 without a speed along the normal (emission.cpp's alongNormal), else 1 + its fuzzy mode.
+int normalMode(const Emitter& e) {
+  const bool alongNormal = !(e.normalSpeed.constant() && e.normalSpeed.center == 0.0f);
+  return alongNormal ? 1 + fuzzyMode(e.normalSpeed) : 0;
+}
+
 std::size_t kindOf(const Domain& d) {
-  packDomain(d);  // throws for a kind the device cannot sample
   return d.shape().index();
 }
 
@@ -43,129 +231,268 @@ std::string newbornCall(const Emitter& e, std::size_t t, bool oneType) {
   const ParticleType& p = e.types[t];
   std::ostringstream c;
   c << "fl_newborn(FL_LANE_ARGS, slot, id, age, at, " << (oneType ? 1 : 0)
-    << ", em, types + em->typeFirst + " << t << "u, rng, " << kindOf(e.shape) << "u, "
+    << ", em, types + em->typeFirst + " << t << "u, rng, shapes, " << kindOf(e.shape) << "u, "
     << kindOf(p.velocity) << "u, " << kindOf(p.color) << "u, " << kindOf(p.up) << "u, "
-    << kindOf(p.rotVelocity) << "u, " << fuzzyMode(p.lifetime) << "u, " << fuzzyMode(p.alpha)
-    << "u, " << fuzzyMode(p.size) << "u, " << fuzzyMode(p.mass) << "u, " << fuzzyMode(p.charge)
-    << "u);";
+    << kindOf(p.rotVelocity) << "u, " << normalMode(e) << "u, " << fuzzyMode(p.lifetime) << "u, "
+    << fuzzyMode(p.alpha) << "u, " << fuzzyMode(p.size) << "u, " << fuzzyMode(p.mass) << "u, "
+    << fuzzyMode(p.charge) << "u);";
   return c.str();
+}
+
+// The statements of one emitter's case: what its kinds and modes make of fl_newborn.
+std::string variantCode(const Emitter& em) {
+  if (em.types.size() == 1) return "      " + newbornCall(em, 0, true) + "\n";
+  std::string s = "      switch (fl_choose_type(em, types, rng)) {\n";
+  for (std::size_t t = 0; t < em.types.size(); ++t)
+    s += "        case " + std::to_string(t) + "u: " + newbornCall(em, t, false) + " break;\n";
+  return s + "      }\n";
+}
+
+// The distinct emitter codes of a group, in a fixed order: its emitters, then every level
+// of its prime emitters' children (as given, and as the copies live emitters are spawned
+// from), then of its live emitters' (whose primes may be gone), so that the live emitters
+// a step spawns find theirs in the program built before it.
+struct Variants {
+  std::vector<std::string> code;
+  std::map<std::string, std::uint32_t> index;
+
+  void add(const Emitter& e) {
+    std::string c = variantCode(e);
+    if (index.emplace(c, std::uint32_t(code.size())).second) code.push_back(std::move(c));
+  }
+  void addChain(const EmitterSpec* s) {
+    std::set<const EmitterSpec*> seen;  // a `next` chain may loop back
+    for (; s && seen.insert(s).second; s = s->next.get()) add(s->emitter);
+  }
+  std::uint32_t of(const Emitter& e) const {
+    const auto it = index.find(variantCode(e));
+    if (it == index.end())
+      throw Error("OpenCL backend: an emitter's code is missing from the group's program");
+    return it->second;
+  }
+};
+
+Variants variantsOf(const GroupImpl& g) {
+  Variants v;
+  for (const Emitter& e : g.emitters) v.add(e);
+  for (const PrimeEmitter& p : g.primes) v.addChain(&p.child);
+  for (const auto& spec : g.primeSpecs) v.addChain(spec.get());
+  for (const LiveEmitter& e : g.live) v.addChain(e.spec);
+  return v;
+}
+
+// ---- The step's tables -------------------------------------------------------------------
+
+void setWord(float& f, std::uint32_t w) {
+  std::memcpy(&f, &w, sizeof w);
+}
+
+void setDouble(std::vector<float>& d, std::size_t at, double x) {
+  const std::uint64_t b = doubleBits(x);
+  setWord(d[at], std::uint32_t(b));
+  setWord(d[at + 1], std::uint32_t(b >> 32));
+}
+
+// Domains as the device reads them; meshes and unions put their data into the shape table
+// (domain.cl documents the layout), once per step each.
+struct ShapePacker {
+  std::vector<float>& data;
+  std::map<const void*, std::uint32_t> meshes;
+  std::map<const void*, std::array<std::uint32_t, 3>> unions;  // parts, leaves, leaf count
+
+  std::uint32_t mesh(const MeshData& m) {
+    const auto it = meshes.find(&m);
+    if (it != meshes.end()) return it->second;
+    const auto off = cl::fl_u32(data.size());
+    for (std::size_t k = 0; k < m.triangles.size(); ++k) {
+      const glm::uvec3 t = m.triangles[k];
+      data.resize(data.size() + 2);
+      setDouble(data, data.size() - 2, m.cumulativeArea[k]);
+      for (const Vec3& x : {m.vertices[t.x], m.vertices[t.y], m.vertices[t.z], m.normals[k]})
+        data.insert(data.end(), {x.x, x.y, x.z});
+    }
+    meshes.emplace(&m, off);
+    return off;
+  }
+
+  static void leavesOf(const Domain& d, std::vector<const Domain*>& out) {
+    if (const auto* u = std::get_if<UnionDomain>(&d.shape()))
+      for (const Domain& part : u->parts->parts) leavesOf(part, out);
+    else
+      out.push_back(&d);
+  }
+
+  void put(std::size_t at, const cl::FlDomain& o) {
+    static_assert(sizeof(cl::FlDomain) == 18 * sizeof(float));
+    std::memcpy(data.data() + at, &o, sizeof o);
+  }
+
+  cl::FlDomain pack(const Domain& d) {
+    cl::FlDomain o{};
+    if (const auto* m = std::get_if<MeshDomain>(&d.shape())) {
+      o.kind = FL_DOMAIN_MESH;
+      setWord(o.v[0], mesh(*m->mesh));
+      setWord(o.v[1], cl::fl_u32(m->mesh->triangles.size()));
+      return o;
+    }
+    const auto* u = std::get_if<UnionDomain>(&d.shape());
+    if (!u) return packDomain(d);
+    const UnionData& un = *u->parts;
+    auto it = unions.find(&un);
+    if (it == unions.end()) {
+      // The record first, then its parts' own data after it (the vector may move: indices).
+      const std::size_t off = data.size();
+      data.resize(off + un.parts.size() * 20);
+      for (std::size_t j = 0; j < un.parts.size(); ++j) {
+        const cl::FlDomain part = pack(un.parts[j]);
+        setDouble(data, off + j * 20, un.cumulativeMeasure[j]);
+        put(off + j * 20 + 2, part);
+      }
+      std::vector<const Domain*> leaves;
+      leavesOf(d, leaves);
+      const std::size_t at = data.size();
+      data.resize(at + leaves.size() * 18);
+      for (std::size_t j = 0; j < leaves.size(); ++j) {
+        const cl::FlDomain leaf = pack(*leaves[j]);
+        put(at + j * 18, leaf);
+      }
+      it = unions
+               .emplace(&un, std::array<std::uint32_t, 3>{cl::fl_u32(off), cl::fl_u32(at),
+                                                          cl::fl_u32(leaves.size())})
+               .first;
+    }
+    o.kind = FL_DOMAIN_UNION;
+    setWord(o.v[0], it->second[0]);
+    setWord(o.v[1], cl::fl_u32(un.parts.size()));
+    setWord(o.v[2], cl::fl_u32(drawCount(d)));
+    setWord(o.v[3], it->second[1]);
+    setWord(o.v[4], it->second[2]);
+    return o;
+  }
+};
+
+// One emitter as fl_tail and fl_newborn read it; returns its index in t.emitters.
+std::uint32_t packEmitter(const Emitter& em, std::uint32_t variant, StepTables& t,
+                          ShapePacker& shapes) {
+  cl::FlEmitter o{};
+  o.shape = shapes.pack(em.shape);
+  o.start = doubleBits(em.start);
+  o.rate = doubleBits(em.rate);
+  for (int c = 0; c < 3; ++c) {
+    o.position[c] = em.position[c];
+    o.velocity[c] = em.velocity[c];
+  }
+  o.normalSpeed = packFuzzy(em.normalSpeed);
+  o.pathFirst = cl::fl_u32(t.keys.size());
+  o.pathCount = cl::fl_u32(em.path.size());
+  for (const Keyframe& k : em.path)
+    t.keys.push_back({doubleBits(k.time), {k.position.x, k.position.y, k.position.z, 0.0f}});
+  o.typeFirst = cl::fl_u32(t.types.size());
+  o.typeCount = cl::fl_u32(em.types.size());
+  float totalWeight = 0;
+  for (const ParticleType& p : em.types) {
+    totalWeight += p.weight;
+    cl::FlParticleType q{};
+    q.velocity = shapes.pack(p.velocity);
+    q.color = shapes.pack(p.color);
+    q.up = shapes.pack(p.up);
+    q.rotVelocity = shapes.pack(p.rotVelocity);
+    q.alpha = packFuzzy(p.alpha);
+    q.size = packFuzzy(p.size);
+    q.mass = packFuzzy(p.mass);
+    q.lifetime = packFuzzy(p.lifetime);
+    q.charge = packFuzzy(p.charge);
+    q.weight = p.weight;
+    t.types.push_back(q);
+  }
+  o.totalWeight = totalWeight;
+  o.variant = variant;
+  t.emitters.push_back(o);
+  return cl::fl_u32(t.emitters.size() - 1);
 }
 
 }  // namespace
 
 std::string emitterSignature(const GroupImpl& g) {
-  const std::vector<Emitter>& emitters = g.emitters;
   std::string s;
-  for (const Emitter& e : emitters) {
-    for (std::size_t t = 0; t < e.types.size(); ++t) s += newbornCall(e, t, e.types.size() == 1);
-    s += '|';
-  }
+  for (const std::string& c : variantsOf(g).code) s += c + '|';
   return s;
 }
 
 std::string emissionSource(const GroupImpl& g) {
-  const std::vector<Emitter>& emitters = g.emitters;
+  const Variants v = variantsOf(g);
   std::ostringstream s;
-  // The newborns of each emitter and type, with their kinds as literals.
-  s << "/* ---- generated: emission per emitter and type */\n"
-       "FL_INLINE void fl_emit(FL_LANE_PARAMS, uint emitter, uint slot, uint id, float age,\n"
+  // The newborns of each emitter code, with its kinds as literals.
+  s << "/* ---- generated: emission per emitter code */\n"
+       "FL_INLINE void fl_emit(FL_LANE_PARAMS, uint variant, uint slot, uint id, float age,\n"
        "                       float3 at, __global const FlEmitter* em,\n"
-       "                       __global const FlParticleType* types, FlRandom* rng) {\n"
-       "  switch (emitter) {\n";
-  for (std::size_t e = 0; e < emitters.size(); ++e) {
-    const Emitter& em = emitters[e];
-    s << "    case " << e << "u:\n";
-    if (em.types.size() == 1) {
-      s << "      " << newbornCall(em, 0, true) << "\n";
-    } else {
-      s << "      switch (fl_choose_type(em, types, rng)) {\n";
-      for (std::size_t t = 0; t < em.types.size(); ++t)
-        s << "        case " << t << "u: " << newbornCall(em, t, false) << " break;\n";
-      s << "      }\n";
-    }
-    s << "      break;\n";
-  }
+       "                       __global const FlParticleType* types, FlRandom* rng,\n"
+       "                       __global const float* shapes) {\n"
+       "  switch (variant) {\n";
+  for (std::size_t k = 0; k < v.code.size(); ++k)
+    s << "    case " << k << "u:\n" << v.code[k] << "      break;\n";
   s << "  }\n}\n";
   return s.str();
 }
 
 // What the device does not run yet is refused, naming it, rather than silently ignored.
 void checkEmissionSupported(const GroupImpl& g) {
-  auto refuse = [&](const std::string& what) {
-    throw Error("OpenCL backend: group '" + g.name + "' uses " + what +
-                ", which does not run on the device yet; use Backend::Cpu");
-  };
-  if (!g.primes.empty() || !g.live.empty()) refuse("prime emitters");
-  if (g.hair.enabled) refuse("hair mode");
-  for (std::size_t i = 0; i < g.emitters.size(); ++i) {
-    const auto& e = g.emitters[i];
-    const std::string name = "emitters[" + std::to_string(i) + "]";
-    if (e.spacing > 0) refuse(name + ".spacing (emission by distance)");
-    if (e.normalSpeed.center != 0.0f || e.normalSpeed.spread != 0.0f) refuse(name + ".normalSpeed");
-  }
+  (void)g;  // everything the CPU emits runs on the device (hair mode in backend.cpp)
 }
 
 std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, StepTables& t) {
-  // emission.cpp step 1, verbatim in effect: which emitter gives birth, how many, when.
-  const double t0 = sp.time, t1 = sp.time + sp.dt;
-  std::uint64_t total = 0;
-  for (std::uint32_t e = 0; e < g.emitters.size(); ++e) {
-    const Emitter& em = g.emitters[e];
-    auto& state = g.emitterState[e];
-    if (em.rate > 0) {
-      const std::uint64_t target = producedBy(em, t1);
-      if (target > state.emittedByRate) {
-        t.runs.push_back({state.emittedByRate, 0, total, e, 0u});
-        total += target - state.emittedByRate;
-        state.emittedByRate = target;
-      }
-    }
-    for (const Burst& b : em.bursts)
-      for (std::uint32_t r = 0; r < b.repeat; ++r) {
-        const double tb = b.time + r * b.interval;
-        if (tb >= t0 && tb < t1 && b.count > 0) {
-          t.runs.push_back({0, doubleBits(tb), total, e, 1u});
-          total += b.count;
-        }
-      }
-  }
+  // The codes as the program was built from them (the backend compared the signature just
+  // now): planning spawns emitters and may renew the primes' copies.
+  const Variants variants = variantsOf(g);
+  thread_local std::vector<BirthRun> runsStore;
+  auto& runs = runsStore;
+  runs.clear();
+  const std::uint64_t total = planAll(g, sp, runs);
   g.stats.emitted += total;
-  if (total == 0) return 0;
-  for (const Emitter& em : g.emitters) {
-    cl::FlEmitter o{};
-    o.shape = packDomain(em.shape);
-    o.start = doubleBits(em.start);
-    o.rate = doubleBits(em.rate);
-    for (int c = 0; c < 3; ++c) {
-      o.position[c] = em.position[c];
-      o.velocity[c] = em.velocity[c];
+  if (total > 0) {
+    ShapePacker shapes{t.shapes, {}, {}};
+    std::map<std::pair<bool, std::uint32_t>, std::uint32_t> entries;  // (live, index) -> entry
+    std::map<const EmitterSpec*, std::uint32_t> specVariant;  // live emitters share their spec's
+    std::uint64_t start = 0;
+    for (const BirthRun& run : runs) {
+      auto it = entries.find({run.live, run.index});
+      if (it == entries.end()) {
+        std::uint32_t variant;
+        if (run.live) {
+          const LiveEmitter& e = g.live[run.index];
+          auto sv = specVariant.find(e.spec);
+          if (sv == specVariant.end())
+            sv = specVariant.emplace(e.spec, variants.of(e.emitter)).first;
+          variant = sv->second;
+        } else {
+          variant = variants.of(g.emitters[run.index]);
+        }
+        const Emitter& em = run.live ? g.live[run.index].emitter : g.emitters[run.index];
+        it = entries
+                 .emplace(std::make_pair(run.live, run.index), packEmitter(em, variant, t, shapes))
+                 .first;
+      }
+      cl::FlBirthRun r{};
+      r.first = run.first;
+      r.time = doubleBits(run.time);
+      r.start = start;
+      r.s0 = doubleBits(run.s0);
+      r.spacing = doubleBits(run.spacing);
+      r.span = doubleBits(run.span);
+      r.dt = doubleBits(run.dt);
+      r.emitter = it->second;
+      r.kind = run.kind == BirthRun::Rate    ? FL_RUN_RATE
+               : run.kind == BirthRun::Burst ? FL_RUN_BURST
+                                             : FL_RUN_DISTANCE;
+      t.runs.push_back(r);
+      start += run.count;
     }
-    o.pathFirst = cl::fl_u32(t.keys.size());
-    o.pathCount = cl::fl_u32(em.path.size());
-    for (const Keyframe& k : em.path)
-      t.keys.push_back({doubleBits(k.time), {k.position.x, k.position.y, k.position.z, 0.0f}});
-    o.typeFirst = cl::fl_u32(t.types.size());
-    o.typeCount = cl::fl_u32(em.types.size());
-    float totalWeight = 0;
-    for (const ParticleType& p : em.types) {
-      totalWeight += p.weight;
-      cl::FlParticleType q{};
-      q.velocity = packDomain(p.velocity);
-      q.color = packDomain(p.color);
-      q.up = packDomain(p.up);
-      q.rotVelocity = packDomain(p.rotVelocity);
-      q.alpha = packFuzzy(p.alpha);
-      q.size = packFuzzy(p.size);
-      q.mass = packFuzzy(p.mass);
-      q.lifetime = packFuzzy(p.lifetime);
-      q.charge = packFuzzy(p.charge);
-      q.weight = p.weight;
-      t.types.push_back(q);
-    }
-    o.totalWeight = totalWeight;
-    t.emitters.push_back(o);
   }
+  // Live emitters that died this step go after their last births are packed (retireDead).
+  const double t1 = sp.time + sp.dt;
+  std::erase_if(g.live, [&](const LiveEmitter& e) { return e.death <= t1; });
   if (t.keys.empty()) t.keys.push_back({});
+  if (t.shapes.empty()) t.shapes.push_back(0.0f);
   return total;
 }
 

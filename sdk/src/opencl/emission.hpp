@@ -1,7 +1,8 @@
 // Emission on the device. The host plans each step's births (which emitter, how many,
-// when: emission.cpp's rules, run on a handful of emitters) into runs and tables; the
-// generated fl_emit (one call per emitter and particle type, domain kinds and fuzzy modes
-// as literals) writes the newborns on the device, in fl_tail.
+// when: emission.cpp's rules, run on a handful of emitters, prime and live emitters
+// included) into runs and tables; the generated fl_emit (one case per distinct emitter
+// code: domain kinds and fuzzy modes as literals) writes the newborns on the device, in
+// fl_tail.
 #pragma once
 
 #include <cstdint>
@@ -20,13 +21,16 @@ struct StepTables {
   std::vector<cl::FlEmitter> emitters;
   std::vector<cl::FlParticleType> types;
   std::vector<cl::FlKeyframe> keys;
+  /// Mesh and union domains' data (domain.cl: FL_MESH_STRIDE, FL_UNION_STRIDE); integers
+  /// and doubles as bit patterns.
+  std::vector<float> shapes;
 };
 
 /// Refuses, naming it, what of the group's emission the device does not run.
 void checkEmissionSupported(const GroupImpl& g);
 
-/// This step's births into `t` (and the group's emitter state and counts, as the CPU's
-/// planning does); returns how many.
+/// This step's births into `t` (and the group's emitter state, live emitters and counts, as
+/// the CPU's planning does: spawns, motion, deaths); returns how many.
 std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, StepTables& t);
 
 /// The generated emission code: fl_emit(), dispatching on the emitter (and type).
