@@ -116,11 +116,11 @@ __kernel void fl_list(__global const uchar* codes, __global const uint* tileOff,
   fl_list_body(t, codes, tileOff, holes, tail, state);
 }
 
-/* Small groups (a few tiles): count, scan and list in one launch of one work item, so a
- * step is three launches. */
-__kernel void fl_scan_list(__global const uchar* codes, __global uint* tileDead,
-                           __global uint* tileOff, __global uint* holes, __global uint* tail,
-                           __global uint* state, uint births, uint capacity, uint tiles) {
+/* Small groups (a few tiles): count, scan and list in one work item. */
+FL_INLINE void fl_scan_list_body(__global const uchar* codes, __global uint* tileDead,
+                                 __global uint* tileOff, __global uint* holes,
+                                 __global uint* tail, __global uint* state, uint births,
+                                 uint capacity, uint tiles) {
   const uint n = state[FL_STATE_SIZE];
   for (uint t = 0; t < tiles; ++t) {
     const uint begin = t * FL_TILE, end = min(n, begin + FL_TILE);
@@ -128,6 +128,12 @@ __kernel void fl_scan_list(__global const uchar* codes, __global uint* tileDead,
   }
   fl_scan_body(codes, tileDead, tileOff, state, tiles, births, capacity);
   for (uint t = 0; t < tiles; ++t) fl_list_body(t, codes, tileOff, holes, tail, state);
+}
+
+__kernel void fl_scan_list(__global const uchar* codes, __global uint* tileDead,
+                           __global uint* tileOff, __global uint* holes, __global uint* tail,
+                           __global uint* state, uint births, uint capacity, uint tiles) {
+  fl_scan_list_body(codes, tileDead, tileOff, holes, tail, state, births, capacity, tiles);
 }
 
 /* The fastest particle's |v|^2 into the state, for sub-steps by distance (fused_pass.cpp

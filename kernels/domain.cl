@@ -180,10 +180,12 @@ FL_INLINE float3 fl_sample(__global const FlDomain* d, uint kind, FlRandom* rng)
   return fl_sample_u(d->v, kind, u);
 }
 
-/* ---- Meshes and unions (emission): their data is in the step's shape table `shapes`
- * (emission.cpp packShape), the FlDomain holds where. Integers travel as float bits.
- *  mesh:  v[0] offset, v[1] triangles; per triangle FL_MESH_STRIDE floats: the running
- *         area sum (double bits, low word first), vertices a b c, unit normal
+/* ---- Meshes and unions: their data is in a table `shapes` (emission.hpp ShapePacker): the
+ * step's shape table for emitters, the list's `extra` for actions; the FlDomain holds where.
+ * Integers travel as float bits.
+ *  mesh:  v[0] offset, v[1] triangles, v[2..4] and v[5..7] the bounds' min and max; per
+ *         triangle FL_MESH_STRIDE floats: the running area sum (double bits, low word
+ *         first), vertices a b c, unit normal
  *  union: v[0] offset, v[1] parts, v[2] draws per sample (sampling.cpp drawCount),
  *         v[3] offset and v[4] count of its leaves (the non-union parts, nested unions
  *         flattened in order: what the nearest part is chosen from);
@@ -612,10 +614,11 @@ FL_INLINE float3 fl_normal_leaf(__global const float* v, uint kind, float3 p,
   }
 }
 
-/* A union's normal is that of its part nearest to p (the first of equals; a nested union's
- * distance is its nearest leaf's, so the flattened leaves give the same part). */
-FL_NOINLINE float3 fl_normal_union(__global const float* v, float3 p,
-                                   __global const float* shapes) {
+/* The leaf of a union nearest to p, as domain.cpp nearestPart: the first of equals by
+ * distance (a nested union's distance is its nearest leaf's, so the flattened leaves give
+ * the same part). */
+FL_INLINE __global const FlDomain* fl_union_nearest(__global const float* v, float3 p,
+                                                    __global const float* shapes) {
   __global const float* leaves = shapes + fl_word(v + 3);
   const uint n = fl_word(v + 4);
   uint best = 0;
@@ -628,7 +631,13 @@ FL_NOINLINE float3 fl_normal_union(__global const float* v, float3 p,
       best = k;
     }
   }
-  __global const FlDomain* part = (__global const FlDomain*)(leaves + best * 18u);
+  return (__global const FlDomain*)(leaves + best * 18u);
+}
+
+/* A union's normal is that of its part nearest to p. */
+FL_NOINLINE float3 fl_normal_union(__global const float* v, float3 p,
+                                   __global const float* shapes) {
+  __global const FlDomain* part = fl_union_nearest(v, p, shapes);
   return fl_normal_leaf(part->v, part->kind, p, shapes);
 }
 
@@ -637,4 +646,83 @@ FL_INLINE float3 fl_normal_at(__global const FlDomain* d, uint kind, float3 p,
                               __global const float* shapes) {
   if (kind == FL_DOMAIN_UNION) return fl_normal_union(d->v, p, shapes);
   return fl_normal_leaf(d->v, kind, p, shapes);
+}
+
+/* ---- Meshes and unions as actions' regions (containment, closest points); `shapes` is the
+ * act kernel's `extra`. */
+
+FL_INLINE float3 fl_crossv(float3 a, float3 b) { /* glm::cross */
+  return (float3)(a.y * b.z - b.y * a.z, a.z * b.x - b.z * a.x, a.x * b.y - b.x * a.y);
+}
+
+/* domain.cpp inside(MeshDomain): nothing outside the bounds; else the parity of the crossings
+ * of a skewed ray from p (Moller-Trumbore), each test as the CPU's. */
+FL_INLINE int fl_inside_mesh(__global const float* v, float x, float y, float z,
+                             __global const float* shapes) {
+  if (x < v[2] || y < v[3] || z < v[4] || x > v[5] || y > v[6] || z > v[7]) return 0;
+  const float3 d0 = (float3)(1.0f, 0.1234567f, 0.0765432f);
+  const float3 dir = d0 * (1.0f / sqrt(fl_dotv(d0, d0))); /* glm::normalize */
+  const float3 p = (float3)(x, y, z);
+  __global const float* m = shapes + fl_word(v);
+  const uint n = fl_word(v + 1);
+  uint crossings = 0;
+  for (uint k = 0; k < n; ++k) {
+    __global const float* t = m + k * FL_MESH_STRIDE + 2;
+    const float3 a = fl_v3(t), e1 = fl_v3(t + 3) - a, e2 = fl_v3(t + 6) - a;
+    const float3 h = fl_crossv(dir, e2);
+    const float det = fl_dotv(e1, h);
+    if (fabs(det) < 1e-12f) continue;
+    const float inv = 1.0f / det;
+    const float3 s = p - a;
+    const float u = fl_dotv(s, h) * inv;
+    if (u < 0.0f || u > 1.0f) continue;
+    const float3 q = fl_crossv(s, e1);
+    const float w = fl_dotv(dir, q) * inv;
+    if (w < 0.0f || u + w > 1.0f) continue;
+    if (fl_dotv(e2, q) * inv > 0.0f) ++crossings;
+  }
+  return (int)(crossings & 1u);
+}
+
+/* domain.cpp inside(UnionDomain): in some part, that is in some leaf. */
+FL_NOINLINE int fl_inside_union(__global const float* v, float x, float y, float z,
+                                __global const float* shapes) {
+  __global const float* leaves = shapes + fl_word(v + 3);
+  const uint n = fl_word(v + 4);
+  for (uint k = 0; k < n; ++k) {
+    __global const FlDomain* part = (__global const FlDomain*)(leaves + k * 18u);
+    const int in = part->kind == FL_DOMAIN_MESH ? fl_inside_mesh(part->v, x, y, z, shapes)
+                                                : fl_inside(part->v, part->kind, x, y, z);
+    if (in) return 1;
+  }
+  return 0;
+}
+
+/* fl_inside for every kind, meshes and unions too (kind a literal: the tests fold away). */
+FL_INLINE int fl_inside_any(__global const float* v, uint kind, float x, float y, float z,
+                            __global const float* shapes) {
+  if (kind == FL_DOMAIN_MESH) return fl_inside_mesh(v, x, y, z, shapes);
+  if (kind == FL_DOMAIN_UNION) return fl_inside_union(v, x, y, z, shapes);
+  return fl_inside(v, kind, x, y, z);
+}
+
+/* domain.cpp closestShape(UnionDomain): its nearest part's closest point. */
+FL_NOINLINE float3 fl_closest_union(__global const float* v, float3 p,
+                                    __global const float* shapes) {
+  __global const FlDomain* part = fl_union_nearest(v, p, shapes);
+  return fl_closest(part->v, part->kind, p, shapes);
+}
+
+/* Domain::closestPoint for every kind. */
+FL_INLINE float3 fl_closest_any(__global const float* v, uint kind, float3 p,
+                                __global const float* shapes) {
+  if (kind == FL_DOMAIN_UNION) return fl_closest_union(v, p, shapes);
+  return fl_closest(v, kind, p, shapes);
+}
+
+/* Domain::normal for every kind, from the domain's v[]. */
+FL_INLINE float3 fl_normal_any(__global const float* v, uint kind, float3 p,
+                               __global const float* shapes) {
+  if (kind == FL_DOMAIN_UNION) return fl_normal_union(v, p, shapes);
+  return fl_normal_leaf(v, kind, p, shapes);
 }

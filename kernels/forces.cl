@@ -200,33 +200,35 @@ FL_INLINE void fl_vortex_acc(__global const FlActionParams* a, float px, float p
   *az += (uz - vz) * a->f[11];
 }
 
-/* ---- Jet: f[0..2] center, [3] radius; domain: the acceleration (kind a literal) -------- */
+/* ---- Jet: f[0..2] center, [3] radius; domain: the acceleration (kind a literal; a mesh's
+ * or union's data in `shapes`, the act kernel's extra) ---------------------------------- */
 
 FL_INLINE int fl_jet_accel(__global const FlActionParams* a, uint kind, float px, float py,
                            float pz, uint id, uint seedLo, uint seedHi, uint step, uint stream,
-                           float3* acc) {
+                           float3* acc, __global const float* shapes) {
   const float dx = px - a->f[0], dy = py - a->f[1], dz = pz - a->f[2];
   if (!(dx * dx + dy * dy + dz * dz <= a->f[3] * a->f[3])) return 0;
   FlRandom rng = fl_random(seedLo, seedHi, id, step, stream);
-  *acc = fl_sample(&a->domain, kind, &rng); /* a point domain: its point, no draw */
+  /* a point domain: its point, no draw */
+  *acc = fl_sample_any(&a->domain, kind, &rng, shapes);
   return 1;
 }
 
 FL_INLINE void fl_jet(__global const FlActionParams* a, uint kind, float dt, float px, float py,
                       float pz, float* vx, float* vy, float* vz, uint id, uint seedLo, uint seedHi,
-                      uint step, uint stream) {
+                      uint step, uint stream, __global const float* shapes) {
   float3 acc;
-  if (!fl_jet_accel(a, kind, px, py, pz, id, seedLo, seedHi, step, stream, &acc)) return;
+  if (!fl_jet_accel(a, kind, px, py, pz, id, seedLo, seedHi, step, stream, &acc, shapes)) return;
   *vx = *vx + acc.x * dt;
   *vy = *vy + acc.y * dt;
   *vz = *vz + acc.z * dt;
 }
 
 FL_INLINE void fl_jet_acc(__global const FlActionParams* a, uint kind, float px, float py, float pz,
-                          uint id, uint seedLo, uint seedHi, uint step, uint stream, float* ax,
-                          float* ay, float* az) {
+                          uint id, uint seedLo, uint seedHi, uint step, uint stream,
+                          __global const float* shapes, float* ax, float* ay, float* az) {
   float3 acc;
-  if (!fl_jet_accel(a, kind, px, py, pz, id, seedLo, seedHi, step, stream, &acc)) return;
+  if (!fl_jet_accel(a, kind, px, py, pz, id, seedLo, seedHi, step, stream, &acc, shapes)) return;
   *ax += acc.x;
   *ay += acc.y;
   *az += acc.z;
@@ -264,18 +266,20 @@ FL_INLINE void fl_explosion_acc(__global const FlActionParams* a, fl_real t, flo
   *az += dz * s;
 }
 
-/* ---- Random actions: domain, the draw (kind a literal); falloff ------------------------ */
+/* ---- Random actions: domain, the draw (kind a literal; a mesh's or union's data in
+ * `shapes`); falloff ------------------------------------------------------------------- */
 
 FL_INLINE float3 fl_force_draw(__global const FlActionParams* a, uint kind, uint id, uint seedLo,
-                               uint seedHi, uint step, uint stream) {
+                               uint seedHi, uint step, uint stream, __global const float* shapes) {
   FlRandom rng = fl_random(seedLo, seedHi, id, step, stream);
-  return fl_sample(&a->domain, kind, &rng);
+  return fl_sample_any(&a->domain, kind, &rng, shapes);
 }
 
 FL_INLINE void fl_random_accel(__global const FlActionParams* a, uint kind, float dt, float px,
                                float py, float pz, float* vx, float* vy, float* vz, uint id,
-                               uint seedLo, uint seedHi, uint step, uint stream) {
-  const float3 s = fl_force_draw(a, kind, id, seedLo, seedHi, step, stream);
+                               uint seedLo, uint seedHi, uint step, uint stream,
+                               __global const float* shapes) {
+  const float3 s = fl_force_draw(a, kind, id, seedLo, seedHi, step, stream, shapes);
   const float k = dt * fl_force_falloff(a, px, py, pz);
   *vx = *vx + s.x * k;
   *vy = *vy + s.y * k;
@@ -284,8 +288,9 @@ FL_INLINE void fl_random_accel(__global const FlActionParams* a, uint kind, floa
 
 FL_INLINE void fl_random_accel_acc(__global const FlActionParams* a, uint kind, float px, float py,
                                    float pz, uint id, uint seedLo, uint seedHi, uint step,
-                                   uint stream, float* ax, float* ay, float* az) {
-  const float3 s = fl_force_draw(a, kind, id, seedLo, seedHi, step, stream);
+                                   uint stream, __global const float* shapes, float* ax,
+                                   float* ay, float* az) {
+  const float3 s = fl_force_draw(a, kind, id, seedLo, seedHi, step, stream, shapes);
   const float w = fl_force_falloff(a, px, py, pz);
   *ax += s.x * w;
   *ay += s.y * w;
@@ -294,8 +299,8 @@ FL_INLINE void fl_random_accel_acc(__global const FlActionParams* a, uint kind, 
 
 FL_INLINE void fl_random_displace(__global const FlActionParams* a, uint kind, float dt, float* px,
                                   float* py, float* pz, uint id, uint seedLo, uint seedHi,
-                                  uint step, uint stream) {
-  const float3 s = fl_force_draw(a, kind, id, seedLo, seedHi, step, stream);
+                                  uint step, uint stream, __global const float* shapes) {
+  const float3 s = fl_force_draw(a, kind, id, seedLo, seedHi, step, stream, shapes);
   *px = *px + s.x * dt;
   *py = *py + s.y * dt;
   *pz = *pz + s.z * dt;
@@ -303,8 +308,9 @@ FL_INLINE void fl_random_displace(__global const FlActionParams* a, uint kind, f
 
 /* RandomVelocity, RandomRotVelocity: the drawn vector replaces the lane. */
 FL_INLINE void fl_random_set(__global const FlActionParams* a, uint kind, float* x, float* y,
-                             float* z, uint id, uint seedLo, uint seedHi, uint step, uint stream) {
-  const float3 s = fl_force_draw(a, kind, id, seedLo, seedHi, step, stream);
+                             float* z, uint id, uint seedLo, uint seedHi, uint step, uint stream,
+                             __global const float* shapes) {
+  const float3 s = fl_force_draw(a, kind, id, seedLo, seedHi, step, stream, shapes);
   *x = s.x;
   *y = s.y;
   *z = s.z;

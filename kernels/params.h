@@ -31,7 +31,8 @@ typedef std::uint64_t fl_u64;
 #define FL_DOMAIN_CYLINDER 8
 #define FL_DOMAIN_CONE 9
 #define FL_DOMAIN_BLOB 10
-/* Emission only (their data lives in the step's shape table, see emission.hpp). */
+/* Their data lives in a table of floats (emission: the step's shape table; actions: the
+ * list's `extra`), at the offset their FlDomain holds (see emission.hpp ShapePacker). */
 #define FL_DOMAIN_MESH 11
 #define FL_DOMAIN_UNION 12
 
@@ -98,8 +99,8 @@ typedef struct FlBirthRun {
  * products with dt round the same way), by the packer of the action's family
  * (sdk/src/opencl/actions_*.cpp), which documents its f[] and u[] there. `domain` holds the
  * action's region, surface or sampled domain (fl_sample and fl_inside read it directly);
- * data longer than f[] (keys over life, triangles, grids) goes into the program's `extra`
- * floats, at offsets the packer puts in u[]. */
+ * data longer than f[] (keys over life, a mesh's or union's data, grids) goes into the
+ * list's `extra` floats, at offsets the packer puts in u[] or in the domain. */
 typedef struct FlActionParams {
   FlDomain domain;
   float f[32];

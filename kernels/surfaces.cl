@@ -5,8 +5,10 @@
  * order, so the results agree with the CPU's to the bit. */
 
 /* ---- helpers ----------------------------------------------------------------------------
- * Closest points, normals, dot products and clamps are domain.cl's (fl_closest,
- * fl_normal_leaf, fl_dotv, fl_clamp), which follow domain.cpp operation by operation. */
+ * Closest points, normals, containment, dot products and clamps are domain.cl's
+ * (fl_closest_any, fl_normal_any, fl_inside_any, fl_dotv, fl_clamp), which follow
+ * domain.cpp operation by operation. A mesh's or union's data is in `shapes`, the act
+ * kernel's `extra` (actions_surfaces.cpp packs it there). */
 
 FL_INLINE float3 fl_surf_normalize(float3 a) {
   return a * (1.0f / sqrt(fl_dotv(a, a)));
@@ -17,10 +19,10 @@ FL_INLINE int fl_surf_planar(uint kind) {
          kind == FL_DOMAIN_TRIANGLE;
 }
 
-/* Domain::distance. `shapes` is never read: actions' regions are never meshes or unions. */
+/* Domain::distance. */
 FL_INLINE float fl_surf_distance(__global const FlActionParams* a, uint kind, float3 p,
                                  __global const float* shapes) {
-  return fl_lengthv(p - fl_closest(a->domain.v, kind, p, shapes));
+  return fl_lengthv(p - fl_closest_any(a->domain.v, kind, p, shapes));
 }
 
 /* ---- Bounce ------------------------------------------------------------------------------ */
@@ -326,8 +328,8 @@ FL_INLINE void fl_kill(uint code, uint* dead) {
 
 /* Inside or Outside (kernels.hpp sinkLoop). */
 FL_INLINE void fl_sink(__global const FlActionParams* a, uint kind, int killInside, float x,
-                       float y, float z, uint code, uint* dead) {
-  const uint in = fl_inside(a->domain.v, kind, x, y, z) ? 1u : 0u;
+                       float y, float z, uint code, uint* dead, __global const float* shapes) {
+  const uint in = fl_inside_any(a->domain.v, kind, x, y, z, shapes) ? 1u : 0u;
   const uint k = in == (killInside ? 1u : 0u) ? code : 0u;
   *dead = *dead != 0u ? *dead : k;
 }
@@ -335,9 +337,10 @@ FL_INLINE void fl_sink(__global const FlActionParams* a, uint kind, int killInsi
 /* Enter or Leave in the coming Move (actions_more.hpp sinkMotionLoop). */
 FL_INLINE void fl_sink_motion(__global const FlActionParams* a, uint kind, int enter, float dt,
                               float x, float y, float z, float vx, float vy, float vz, uint code,
-                              uint* dead) {
-  const int now = fl_inside(a->domain.v, kind, x, y, z);
-  const int next = fl_inside(a->domain.v, kind, x + vx * dt, y + vy * dt, z + vz * dt);
+                              uint* dead, __global const float* shapes) {
+  const int now = fl_inside_any(a->domain.v, kind, x, y, z, shapes);
+  const int next =
+      fl_inside_any(a->domain.v, kind, x + vx * dt, y + vy * dt, z + vz * dt, shapes);
   const int k = enter ? ((!now) & next) : (now & (!next));
   const uint kk = k ? code : 0u;
   *dead = *dead != 0u ? *dead : kk;
@@ -370,8 +373,8 @@ FL_INLINE void fl_sink_pass(__global const FlActionParams* a, uint id, uint code
 /* Hides the particles inside the region (actions_more.hpp apply(Block)); the list's first
  * blocker has set vis to 1 before. */
 FL_INLINE void fl_block(__global const FlActionParams* a, uint kind, float x, float y, float z,
-                        uint* vis) {
-  const uint in = fl_inside(a->domain.v, kind, x, y, z) ? 1u : 0u;
+                        uint* vis, __global const float* shapes) {
+  const uint in = fl_inside_any(a->domain.v, kind, x, y, z, shapes) ? 1u : 0u;
   *vis &= 1u - in;
 }
 
@@ -386,19 +389,20 @@ FL_INLINE void fl_avoid(__global const FlActionParams* a, uint kind, float dt, f
   const float3 ahead = p + v * a->f[2];
   int threat;
   if (planar) {
-    const float3 nrm = fl_normal_leaf(d, kind, p, shapes);
-    const float3 o = fl_closest(d, kind, p, shapes);
+    const float3 nrm = fl_normal_any(d, kind, p, shapes);
+    const float3 o = fl_closest_any(d, kind, p, shapes);
     const float d0 = fl_dotv(p - o, nrm), d1 = fl_dotv(ahead - o, nrm);
     threat = (d0 >= 0.0f) != (d1 >= 0.0f) &&
              fl_surf_distance(a, kind, p + (ahead - p) * (d0 / (d0 - d1)), shapes) <
                  1e-4f * (1.0f + fl_lengthv(p));
   } else {
-    threat = !fl_inside(d, kind, p.x, p.y, p.z) && fl_inside(d, kind, ahead.x, ahead.y, ahead.z);
+    threat = !fl_inside_any(d, kind, p.x, p.y, p.z, shapes) &&
+             fl_inside_any(d, kind, ahead.x, ahead.y, ahead.z, shapes);
   }
   if (!threat) return;
   const float dist = fl_surf_distance(a, kind, p, shapes);
-  float3 away = fl_normal_leaf(d, kind, p, shapes);
-  if (planar && fl_dotv(p - fl_closest(d, kind, p, shapes), away) < 0.0f) away = -away;
+  float3 away = fl_normal_any(d, kind, p, shapes);
+  if (planar && fl_dotv(p - fl_closest_any(d, kind, p, shapes), away) < 0.0f) away = -away;
   const float3 r = v + away * (a->f[0] / (dist * dist + a->f[1]) * dt);
   *vx = r.x;
   *vy = r.y;

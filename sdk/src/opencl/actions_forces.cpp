@@ -10,6 +10,7 @@
 #include <string>
 
 #include "codegen.hpp"
+#include "emission.hpp"
 
 namespace flurry::detail::ocl {
 
@@ -25,10 +26,14 @@ void putFalloff(float* f, const Falloff& fo) {
   f[kFalloff + 4] = fo.power;
 }
 
-// A domain the device samples: its kind as a literal (fl_sample folds its switch on it).
-std::string kindOf(const Domain& d, const std::string& what) {
-  if (d.shape().index() > FL_DOMAIN_BLOB) notOnDevice(what + " from a " + d.name() + " domain");
+// A domain the device samples: its kind as a literal (fl_sample_any folds its switch on
+// it); a mesh's or union's data is in the list's `extra` (packSampled), which the calls pass.
+std::string kindOf(const Domain& d) {
   return std::to_string(d.shape().index()) + "u";
+}
+
+cl::FlDomain packSampled(const Domain& d, ActionPack& p) {
+  return ShapePacker{p.extra, {}, {}}.pack(d);
 }
 
 // The random-stream arguments the fl_* functions take after the lanes.
@@ -102,9 +107,10 @@ bool generateForceAction(const Action& act, ActionSource& s) {
   if (const auto* j = std::get_if<Jet>(&act)) {
     velocityForce();
     s.reads.insert(A::Id);
-    const std::string kind = kindOf(j->acceleration, "Jet's acceleration");
-    s.apply = call("fl_jet", ap + ", " + kind + ", dt, " + kP + ", " + kPV + ", " + rngArgs(s));
-    s.accel = acc("fl_jet_acc", ap + ", " + kind + ", " + kP + ", " + rngArgs(s));
+    const std::string kind = kindOf(j->acceleration);
+    s.apply = call("fl_jet",
+                   ap + ", " + kind + ", dt, " + kP + ", " + kPV + ", " + rngArgs(s) + ", extra");
+    s.accel = acc("fl_jet_acc", ap + ", " + kind + ", " + kP + ", " + rngArgs(s) + ", extra");
     return true;
   }
   if (std::holds_alternative<Explosion>(act)) {
@@ -116,31 +122,32 @@ bool generateForceAction(const Action& act, ActionSource& s) {
   if (const auto* r = std::get_if<RandomAccel>(&act)) {
     velocityForce();
     s.reads.insert(A::Id);
-    const std::string kind = kindOf(r->acceleration, "RandomAccel");
-    s.apply =
-        call("fl_random_accel", ap + ", " + kind + ", dt, " + kP + ", " + kPV + ", " + rngArgs(s));
-    s.accel = acc("fl_random_accel_acc", ap + ", " + kind + ", " + kP + ", " + rngArgs(s));
+    const std::string kind = kindOf(r->acceleration);
+    s.apply = call("fl_random_accel",
+                   ap + ", " + kind + ", dt, " + kP + ", " + kPV + ", " + rngArgs(s) + ", extra");
+    s.accel =
+        acc("fl_random_accel_acc", ap + ", " + kind + ", " + kP + ", " + rngArgs(s) + ", extra");
     return true;
   }
   if (const auto* r = std::get_if<RandomDisplace>(&act)) {
     s.reads.insert({A::Position, A::Id});
     s.writes.insert(A::Position);
-    s.apply = call("fl_random_displace", ap + ", " + kindOf(r->displacement, "RandomDisplace") +
-                                             ", dt, " + kPP + ", " + rngArgs(s));
+    s.apply = call("fl_random_displace", ap + ", " + kindOf(r->displacement) + ", dt, " + kPP +
+                                             ", " + rngArgs(s) + ", extra");
     return true;
   }
   if (const auto* r = std::get_if<RandomVelocity>(&act)) {
     s.reads.insert(A::Id);
     s.writes.insert(A::Velocity);
-    s.apply = call("fl_random_set", ap + ", " + kindOf(r->velocity, "RandomVelocity") + ", " + kPV +
-                                        ", " + rngArgs(s));
+    s.apply = call("fl_random_set",
+                   ap + ", " + kindOf(r->velocity) + ", " + kPV + ", " + rngArgs(s) + ", extra");
     return true;
   }
   if (const auto* r = std::get_if<RandomRotVelocity>(&act)) {
     s.reads.insert(A::Id);
     s.writes.insert(A::RotVelocity);
-    s.apply = call("fl_random_set", ap + ", " + kindOf(r->rotVelocity, "RandomRotVelocity") +
-                                        ", &rotx, &roty, &rotz, " + rngArgs(s));
+    s.apply = call("fl_random_set", ap + ", " + kindOf(r->rotVelocity) + ", &rotx, &roty, &rotz, " +
+                                        rngArgs(s) + ", extra");
     return true;
   }
   if (std::holds_alternative<Turbulence>(act)) {
@@ -283,7 +290,7 @@ bool packForceAction(const Action& act, ActionPack& p) {
   if (const auto* j = std::get_if<Jet>(&act)) {
     putVec(f, 0, j->center);
     f[3] = j->radius;
-    p.p.domain = packDomain(j->acceleration);
+    p.p.domain = packSampled(j->acceleration, p);
     return true;
   }
   if (const auto* e = std::get_if<Explosion>(&act)) {
@@ -297,20 +304,20 @@ bool packForceAction(const Action& act, ActionPack& p) {
     return true;
   }
   if (const auto* r = std::get_if<RandomAccel>(&act)) {
-    p.p.domain = packDomain(r->acceleration);
+    p.p.domain = packSampled(r->acceleration, p);
     putFalloff(f, r->falloff);
     return true;
   }
   if (const auto* r = std::get_if<RandomDisplace>(&act)) {
-    p.p.domain = packDomain(r->displacement);
+    p.p.domain = packSampled(r->displacement, p);
     return true;
   }
   if (const auto* r = std::get_if<RandomVelocity>(&act)) {
-    p.p.domain = packDomain(r->velocity);
+    p.p.domain = packSampled(r->velocity, p);
     return true;
   }
   if (const auto* r = std::get_if<RandomRotVelocity>(&act)) {
-    p.p.domain = packDomain(r->rotVelocity);
+    p.p.domain = packSampled(r->rotVelocity, p);
     return true;
   }
   if (const auto* t = std::get_if<Turbulence>(&act)) {

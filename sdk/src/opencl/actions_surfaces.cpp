@@ -5,6 +5,7 @@
 #include <string>
 
 #include "codegen.hpp"
+#include "emission.hpp"
 
 namespace flurry::detail::ocl {
 
@@ -73,12 +74,15 @@ void packBounce(const Bounce& a, cl::FlActionParams& p) {
   }
 }
 
-// The kind literal of a region the device tests. Meshes and unions need domain.cl's shape
-// table, which the act kernel does not have: the calls pass `extra` in its place, never read
-// for the other kinds.
+// The kind literal of a region the device tests. The calls pass the list's `extra` as the
+// table where a mesh's or union's data is (packRegion), read for those kinds only.
 std::string kindOf(const Domain& d) {
-  if (d.shape().index() > FL_DOMAIN_BLOB) notOnDevice(std::string("a ") + d.name() + " region");
   return std::to_string(d.shape().index()) + "u";
+}
+
+// A region, obstacle or velocity domain: a mesh's or union's data into `extra`.
+cl::FlDomain packRegion(const Domain& d, ActionPack& p) {
+  return ShapePacker{p.extra, {}, {}}.pack(d);
 }
 
 // Gravitate, Follow, Match*: f[0] magnitude (rate), f[1] epsilon, f[2] maxRadius^2.
@@ -119,11 +123,11 @@ bool generateSurfaceAction(const Action& act, ActionSource& s) {
     if (k->mode == M::Inside || k->mode == M::Outside) {
       const bool killInside = k->mode == M::Inside ? k->killInside : !k->killInside;
       s.apply = "fl_sink(" + ap + ", " + kind + ", " + (killInside ? "1" : "0") + ", px, py, pz, " +
-                s.in.code + ", &dead);\n";
+                s.in.code + ", &dead, extra);\n";
     } else if (k->mode == M::Enter || k->mode == M::Leave) {
       s.reads.insert(Attribute::Velocity);
       s.apply = "fl_sink_motion(" + ap + ", " + kind + ", " + (k->mode == M::Enter ? "1" : "0") +
-                ", dt, px, py, pz, vx, vy, vz, " + s.in.code + ", &dead);\n";
+                ", dt, px, py, pz, vx, vy, vz, " + s.in.code + ", &dead, extra);\n";
     } else {  // Hit: validation makes the region a plane piece
       s.reads.insert(Attribute::Velocity);
       s.apply = "fl_sink_hit(" + ap + ", " + kind + ", dt, px, py, pz, vx, vy, vz, " + s.in.code +
@@ -139,7 +143,7 @@ bool generateSurfaceAction(const Action& act, ActionSource& s) {
   if (const auto* k = std::get_if<SinkVelocity>(&act)) {
     s.reads.insert(Attribute::Velocity);
     s.apply = "fl_sink(" + ap + ", " + kindOf(k->velocity) + ", " + (k->killInside ? "1" : "0") +
-              ", vx, vy, vz, " + s.in.code + ", &dead);\n";
+              ", vx, vy, vz, " + s.in.code + ", &dead, extra);\n";
     return true;
   }
   if (const auto* b = std::get_if<Block>(&act)) {
@@ -152,7 +156,7 @@ bool generateSurfaceAction(const Action& act, ActionSource& s) {
     const std::string k = std::to_string(s.in.index);
     s.apply = "#ifndef FL_FIRST_BLOCKER\n#define FL_FIRST_BLOCKER " + k +
               "\n#endif\n#if FL_FIRST_BLOCKER == " + k + "\nvis = 1u;\n#endif\nfl_block(" + ap +
-              ", " + kindOf(b->region) + ", px, py, pz, &vis);\n";
+              ", " + kindOf(b->region) + ", px, py, pz, &vis, extra);\n";
     return true;
   }
   if (const auto* k = std::get_if<Avoid>(&act)) {
@@ -205,20 +209,20 @@ bool packSurfaceAction(const Action& act, ActionPack& p) {
     return true;
   }
   if (const auto* k = std::get_if<Sink>(&act)) {
-    p.p.domain = packDomain(k->region);
+    p.p.domain = packRegion(k->region, p);
     f[0] = k->passThrough;
     return true;
   }
   if (const auto* k = std::get_if<SinkVelocity>(&act)) {
-    p.p.domain = packDomain(k->velocity);
+    p.p.domain = packRegion(k->velocity, p);
     return true;
   }
   if (const auto* b = std::get_if<Block>(&act)) {
-    p.p.domain = packDomain(b->region);
+    p.p.domain = packRegion(b->region, p);
     return true;
   }
   if (const auto* k = std::get_if<Avoid>(&act)) {
-    p.p.domain = packDomain(k->obstacle);
+    p.p.domain = packRegion(k->obstacle, p);
     f[0] = k->magnitude;
     f[1] = k->epsilon;
     f[2] = k->lookAhead;

@@ -43,8 +43,8 @@ namespace {
 constexpr std::size_t kActLocal = 256;   // fixed: PoCL compiles once per (kernel, local size)
 constexpr std::size_t kSmallLocal = 64;  // count, list and tail
 constexpr std::size_t kMaxInFlight = 4;  // steps queued before the host waits for the oldest
-constexpr std::size_t kMaxFillItems = 1 << 16;
-constexpr std::size_t kSmallTiles = 4;  // up to 4096 particles: count-scan-list in one item
+constexpr std::size_t kMaxFillItems = 1 << 12;  // PoCL pays ~1 us per work-group, even an idle one
+constexpr std::size_t kSmallTiles = 4;          // up to 4096 particles: count-scan-list in one item
 
 std::size_t roundUp(std::size_t x, std::size_t m) {
   return (x + m - 1) / m * m;
@@ -80,7 +80,8 @@ struct InFlight {
   Event done;
   std::vector<std::uint32_t> state;
   std::uint64_t births = 0;
-  StepTables tables;  // the step's non-blocking writes read these
+  StepTables tables;
+  std::vector<std::uint64_t> blob;  // the tables back to back: the step's one write reads it
 };
 
 struct DeviceLane {
@@ -181,7 +182,7 @@ class ClGroup final : public DeviceMirror {
   AttributeSet laneSet_;
   bool allocated_ = false;
   Mem codes_, tileDead_, tileOff_, holes_, tailList_;
-  GrowBuffer state_, params_, extra_, snap_, runs_, emitters_, types_, keys_, shapes_;
+  GrowBuffer state_, params_, extra_, snap_, tables_;
   std::size_t tiles_ = 0;
 
   Program program_;
@@ -189,7 +190,7 @@ class ClGroup final : public DeviceMirror {
   bool programValid_ = false;
   std::string emitterSignature_;
   bool hairProgram_ = false;  // the program has fl_hair
-  Kernel hair_;
+  Kernel hair_, small_;
   GrowBuffer strandP_, strandC_, strandR_, strandCount_;
   std::uint32_t lastHairAlive_ = 0;
   std::vector<LaneRef> actLanes_;
@@ -269,6 +270,7 @@ void ClGroup::buildProgram(GroupImpl& g) {
          list = kernel("fl_list"), scanList = kernel("fl_scan_list"), tail = kernel("fl_tail"),
          maxSpeed = kernel("fl_max_speed");
   Kernel hair = g.hair.enabled ? kernel("fl_hair") : Kernel();
+  Kernel small = gen.small ? kernel("fl_small") : Kernel();
   program_ = std::move(p);
   act_ = std::move(act);
   count_ = std::move(count);
@@ -278,6 +280,7 @@ void ClGroup::buildProgram(GroupImpl& g) {
   tailKernel_ = std::move(tail);
   maxSpeed_ = std::move(maxSpeed);
   hair_ = std::move(hair);
+  small_ = std::move(small);
   hairProgram_ = g.hair.enabled;
   actLanes_ = gen.actLanes;
   neighbours_ = gen.neighbours;
@@ -502,7 +505,10 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
           "clEnqueueWriteBuffer (action parameters)");
     params_uploaded_ = params_host_;
   }
-  if (extra_uploaded_ != extra_host_) {
+  // Compared as bytes: the floats hold integers and doubles as bit patterns (NaN patterns
+  // among them), so a comparison of values could never say equal, or miss a -0.
+  if (extra_uploaded_.size() != extra_host_.size() ||
+      std::memcmp(extra_uploaded_.data(), extra_host_.data(), extra_host_.size() * 4) != 0) {
     drain(g);
     const std::size_t bytes = extra_host_.size() * sizeof(float);
     extra_.reserve(context(), bytes, CL_MEM_READ_ONLY);
@@ -537,6 +543,32 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     if (e) profiled_.emplace_back(what, Event(e));
   };
 
+  // The emission tables travel in one buffer, at 64-byte aligned offsets: one write a
+  // step instead of five (each costs a few microseconds on PoCL).
+  auto& t = f.tables;
+  std::uint32_t off[5] = {};
+  if (births > 0) {
+    auto& blob = f.blob;
+    auto append = [&](int at, const void* data, std::size_t bytes) {
+      off[at] = std::uint32_t(blob.size() * 8);
+      blob.resize(blob.size() + (bytes + 63) / 64 * 8);
+      if (bytes) std::memcpy(reinterpret_cast<char*>(blob.data()) + off[at], data, bytes);
+    };
+    append(0, t.runs.data(), t.runs.size() * sizeof(cl::FlBirthRun));
+    append(1, t.emitters.data(), t.emitters.size() * sizeof(cl::FlEmitter));
+    append(2, t.types.data(), t.types.size() * sizeof(cl::FlParticleType));
+    append(3, t.keys.data(), t.keys.size() * sizeof(cl::FlKeyframe));
+    append(4, t.shapes.data(), t.shapes.size() * sizeof(float));
+    tables_.reserve(context(), blob.size() * 8, CL_MEM_READ_ONLY);
+    check(clEnqueueWriteBuffer(q, tables_.mem.get(), CL_FALSE, 0, blob.size() * 8, blob.data(), 0,
+                               nullptr, nullptr),
+          "clEnqueueWriteBuffer (emitters)");
+  } else {
+    tables_.reserve(context(), 64, CL_MEM_READ_ONLY);
+  }
+  // A small group's step is one launch (fl_small) when its program has it.
+  const std::size_t tiles = (nBound + FL_TILE - 1) / FL_TILE;
+  const bool oneLaunch = acts && small_ && tiles <= kSmallTiles && !g.hair.enabled;
   if (acts) {
     cl_kernel k = act_.get();
     if (substepsByDistance_) {
@@ -567,6 +599,12 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
       }
     }
     cl_uint i = cl_uint(actLanes_.size()) + 1;
+    if (oneLaunch) {
+      k = small_.get();
+      i = 0;
+      for (const auto& l : lanes_) setArg(k, i++, l.mem.get());
+      setArg(k, i++, codes_.get());
+    }
     setArg(k, i++, params_.mem.get());
     setArg(k, i++, state);
     setArg(k, i++, extra_.mem.get());
@@ -579,10 +617,27 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     setArg(k, i++, cl_uint(g.index << 16));
     setArg(k, i++, cl_uint(stepSubsteps(g.actions, sp.dt)));
     setArg(k, i++, cl_uint(g.capacity));
-    launch(k, roundUp(nBound, kActLocal), kActLocal, "fl_act");
+    if (oneLaunch) {
+      setArg(k, i++, tileDead_.get());
+      setArg(k, i++, tileOff_.get());
+      setArg(k, i++, holes_.get());
+      setArg(k, i++, tailList_.get());
+      setArg(k, i++, cl_uint(births));
+      setArg(k, i++, cap);
+      setArg(k, i++, cl_uint(tiles));
+      setArg(k, i++, tables_.mem.get());
+      for (int at = 1; at < 5; ++at) setArg(k, i++, cl_uint(off[at]));
+      setArg(k, i++, cl_uint(f.tables.runs.size()));
+      setArg(k, i++, cl_ulong(doubleBits(sp.time + sp.dt)));
+      setArg(k, i++, cl_uint(g.index));
+      launch(k, kActLocal, kActLocal, "fl_small");
+    } else {
+      launch(k, roundUp(nBound, kActLocal), kActLocal, "fl_act");
+    }
   }
-  if (kills) {
-    const std::size_t tiles = (nBound + FL_TILE - 1) / FL_TILE;
+  if (oneLaunch) {
+    // fl_small did the rest of the step
+  } else if (kills) {
     if (tiles <= kSmallTiles) {
       setArg(scanList_.get(), 5, state);
       setArg(scanList_.get(), 6, cl_uint(births));
@@ -609,33 +664,19 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     launch(scan_.get(), 1, 1, "fl_scan");
   }
   if (births > 0 || kills) {
-    auto& t = f.tables;
-    auto write = [&](GrowBuffer& b, const void* data, std::size_t bytes) {
-      b.reserve(context(), std::max<std::size_t>(bytes, 64), CL_MEM_READ_ONLY);
-      if (bytes)
-        check(clEnqueueWriteBuffer(q, b.mem.get(), CL_FALSE, 0, bytes, data, 0, nullptr, nullptr),
-              "clEnqueueWriteBuffer (emitters)");
-    };
-    write(runs_, t.runs.data(), t.runs.size() * sizeof(cl::FlBirthRun));
-    write(emitters_, t.emitters.data(), t.emitters.size() * sizeof(cl::FlEmitter));
-    write(types_, t.types.data(), t.types.size() * sizeof(cl::FlParticleType));
-    write(keys_, t.keys.data(), t.keys.size() * sizeof(cl::FlKeyframe));
-    write(shapes_, t.shapes.data(), t.shapes.size() * sizeof(float));
     cl_kernel k = tailKernel_.get();
     cl_uint i = cl_uint(lanes_.size()) + 2;
     setArg(k, i++, state);
-    setArg(k, i++, runs_.mem.get());
-    setArg(k, i++, emitters_.mem.get());
-    setArg(k, i++, types_.mem.get());
-    setArg(k, i++, keys_.mem.get());
-    setArg(k, i++, shapes_.mem.get());
+    setArg(k, i++, tables_.mem.get());
+    for (int at = 1; at < 5; ++at) setArg(k, i++, cl_uint(off[at]));
     setArg(k, i++, cl_uint(t.runs.size()));
     setArg(k, i++, cl_ulong(doubleBits(sp.time + sp.dt)));
     setArg(k, i++, seedLo);
     setArg(k, i++, seedHi);
     setArg(k, i++, cl_uint(g.index));
     const std::size_t fill = kills ? std::min(roundUp(nBound, kSmallLocal), kMaxFillItems) : 0;
-    launch(k, roundUp(std::max<std::size_t>(births, fill), kSmallLocal), kSmallLocal, "fl_tail");
+    if (!oneLaunch)
+      launch(k, roundUp(std::max<std::size_t>(births, fill), kSmallLocal), kSmallLocal, "fl_tail");
     if (g.hair.enabled && births > 0) {
       queueHair(g, sp, births);
       f.births = 0;  // the group is empty again after the step

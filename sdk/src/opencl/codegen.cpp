@@ -96,12 +96,12 @@ std::vector<LaneRef> lanesOf(AttributeSet stored) {
 }
 
 cl::FlDomain packDomain(const Domain& d) {
-  // Meshes and unions need a data table (emission.cpp packs them, with their data, for
-  // emitters); fl_inside and the actions' fl_sample have none.
+  // Meshes and unions need a data table: emission.hpp ShapePacker packs them with it (for
+  // emitters, and actions' regions and sampled domains). Nothing else takes them (validation
+  // refuses them as a Bounce surface); refused here rather than packed wrong.
   if (d.shape().index() > FL_DOMAIN_BLOB)
     throw Error(std::string("OpenCL backend: a ") + d.name() +
-                " domain as an action's region or surface does not run on the device yet; use "
-                "Backend::Cpu");
+                " domain here does not run on the device yet; use Backend::Cpu");
   cl::FlDomain o{};
   o.kind = cl::fl_u32(d.shape().index());
   float* v = o.v;
@@ -295,7 +295,11 @@ std::string stepSource(const std::string& body, const Substeps& sub, bool byDist
   // Sub-steps as fused_pass.cpp: dt / n in double, each with its own time and streams.
   // nsubStep: by Substeps::maxStep, from the host; then by the fastest particle, which
   // fl_max_speed left in the state (its |v|^2 as float bits).
-  s << "  uint nsub = nsubStep;\n";
+  // A list without sub-steps gets a literal 1, so the loop folds away.
+  if (sub.maxStep > 0 || byDistance)
+    s << "  uint nsub = nsubStep;\n";
+  else
+    s << "  const uint nsub = 1u; (void)nsubStep;\n";
   if (byDistance) {
     char buf[64];
     std::snprintf(buf, sizeof buf, "%.9g", double(sub.maxDistance));
@@ -305,7 +309,11 @@ std::string stepSource(const std::string& body, const Substeps& sub, bool byDist
       << buf << "f);\n      const fl_real cap = (fl_real)" << sub.maxSubsteps
       << "u;\n      if (m > (fl_real)nsub) nsub = (uint)(m < cap ? m : cap);\n    }\n  }\n";
   }
-  s << "  const float dt = (float)(fl_real_from_bits(dtBits) / (fl_real)nsub);\n"
+  if (sub.maxStep > 0 || byDistance)
+    s << "  const float dt = (float)(fl_real_from_bits(dtBits) / (fl_real)nsub);\n";
+  else
+    s << "  const float dt = (float)fl_real_from_bits(dtBits);\n";
+  s << ""
        "  uint dead = 0u;\n"
        "  for (uint sub = 0u; sub < nsub; ++sub) {\n"
        "    const fl_real time = t0 + (fl_real)sub * (fl_real)dt;\n"
@@ -477,30 +485,59 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   const AttributeSet touched = reads | writes;
   for (const auto& l : all)
     if (touched.has(l.attribute)) g.actLanes.push_back(l);
-  s << "/* ---- generated: the fused act kernel */\n__kernel void fl_act(";
-  for (const auto& l : g.actLanes) s << laneDecl(l) << ", ";
-  s << "__global uchar* restrict codes, __global const FlActionParams* ap,\n"
-       "    __global const uint* state, __global const float* restrict extra,\n"
-       "    __global const float* restrict snap, ulong dtBits, ulong timeBits, uint seedLo,\n"
-       "    uint seedHi, uint step, uint streamBase, uint nsubStep, uint snapStride) {\n"
-       "  const uint i = get_global_id(0);\n"
-       "  const uint n = state[FL_STATE_SIZE];\n"
-       "  if (i >= n) return;\n"
-       "  const uint snapN = n;\n"
-       "  (void)extra; (void)snap; (void)snapN; (void)snapStride; (void)seedLo; (void)seedHi;\n"
-       "  (void)step;\n";
+  // The per-particle part, shared by fl_act and fl_small.
+  std::ostringstream one;
   for (const auto& l : g.actLanes) {
     const char* type = info(l.attribute).isUint ? "uint" : "float";
     if (reads.has(l.attribute))
-      s << "  " << type << " " << l.name << " = l_" << l.name << "[i];\n";
+      one << "  " << type << " " << l.name << " = l_" << l.name << "[i];\n";
     else
-      s << "  " << type << " " << l.name << ";\n";
+      one << "  " << type << " " << l.name << ";\n";
   }
   const std::string stepCode = stepSource(body.str(), sub, g.substepsByDistance, stored, guarded);
-  s << "  const fl_real t0 = fl_real_from_bits(timeBits);\n" << stepCode;
+  one << stepCode;
   for (const auto& l : g.actLanes)
-    if (writes.has(l.attribute)) s << "  l_" << l.name << "[i] = " << l.name << ";\n";
-  s << "  codes[i] = (uchar)dead;\n}\n";
+    if (writes.has(l.attribute)) one << "  l_" << l.name << "[i] = " << l.name << ";\n";
+  one << "  codes[i] = (uchar)dead;\n";
+  const char* actArgs =
+      "__global uchar* restrict codes, __global const FlActionParams* restrict ap,\n"
+      "    __global uint* state, __global const float* restrict extra,\n"
+      "    __global const float* restrict snap, ulong dtBits, ulong timeBits, uint seedLo,\n"
+      "    uint seedHi, uint step, uint streamBase, uint nsubStep, uint snapStride";
+  const char* actPrologue =
+      "  const uint n = state[FL_STATE_SIZE];\n"
+      "  const uint snapN = n;\n"
+      "  (void)extra; (void)snap; (void)snapN; (void)snapStride; (void)seedLo; (void)seedHi;\n"
+      "  (void)step;\n"
+      "  const fl_real t0 = fl_real_from_bits(timeBits);\n";
+  s << "/* ---- generated: the fused act kernel */\n__kernel void fl_act(";
+  for (const auto& l : g.actLanes) s << laneDecl(l) << ", ";
+  s << actArgs << ") {\n"
+    << actPrologue << "  const uint i = get_global_id(0);\n  if (i >= n) return;\n"
+    << one.str() << "}\n";
+  // A small group's whole step in one launch of one work-group: act, count-scan-list, tail.
+  // PoCL pays several microseconds per launch; this is one instead of three.
+  g.small = !g.substepsByDistance && !hair;
+  if (g.small)
+    s << "/* ---- generated: a small group's step */\n"
+         "__kernel void fl_small(FL_LANE_PARAMS, "
+      << actArgs
+      << ",\n    __global uint* tileDead, __global uint* tileOff, __global uint* holes,\n"
+         "    __global uint* tail, uint births, uint capacity, uint tiles,\n"
+         "    __global const uchar* tables, uint offEmitters, uint offTypes, uint offKeys,\n"
+         "    uint offShapes, uint runCount, ulong t1Bits, uint salt) {\n"
+         "  const uint lid = get_local_id(0), lsize = get_local_size(0);\n"
+         "  {\n"
+      << actPrologue << "  for (uint i = lid; i < n; i += lsize) {\n"
+      << one.str()
+      << "  }\n  }\n"
+         "  barrier(CLK_GLOBAL_MEM_FENCE);\n"
+         "  if (lid == 0u) fl_scan_list_body(codes, tileDead, tileOff, holes, tail, state, "
+         "births, capacity, tiles);\n"
+         "  barrier(CLK_GLOBAL_MEM_FENCE);\n"
+         "  fl_tail_body(lid, lsize, FL_LANE_ARGS, holes, tail, state, tables, offEmitters,\n"
+         "               offTypes, offKeys, offShapes, runCount, t1Bits, seedLo, seedHi, salt);\n"
+         "}\n";
   if (hair) {
     if (g.neighbours) notOnDevice("hair mode with actions that read neighbours");
     if (g.substepsByDistance) notOnDevice("hair mode with sub-steps by distance");

@@ -29,6 +29,7 @@ struct GeneratedProgram {
   std::vector<LaneRef> actLanes;    ///< fl_act's lane parameters, in order
   bool neighbours = false;          ///< fl_act reads the snapshot of p, v, rot
   bool substepsByDistance = false;  ///< fl_max_speed runs before fl_act
+  bool small = false;               ///< has fl_small: a small group's whole step in one work-group
 };
 
 /// The program for this list over these stored attributes: the embedded kernels plus one

@@ -293,84 +293,6 @@ void setDouble(std::vector<float>& d, std::size_t at, double x) {
   setWord(d[at + 1], std::uint32_t(b >> 32));
 }
 
-// Domains as the device reads them; meshes and unions put their data into the shape table
-// (domain.cl documents the layout), once per step each.
-struct ShapePacker {
-  std::vector<float>& data;
-  std::map<const void*, std::uint32_t> meshes;
-  std::map<const void*, std::array<std::uint32_t, 3>> unions;  // parts, leaves, leaf count
-
-  std::uint32_t mesh(const MeshData& m) {
-    const auto it = meshes.find(&m);
-    if (it != meshes.end()) return it->second;
-    const auto off = cl::fl_u32(data.size());
-    for (std::size_t k = 0; k < m.triangles.size(); ++k) {
-      const glm::uvec3 t = m.triangles[k];
-      data.resize(data.size() + 2);
-      setDouble(data, data.size() - 2, m.cumulativeArea[k]);
-      for (const Vec3& x : {m.vertices[t.x], m.vertices[t.y], m.vertices[t.z], m.normals[k]})
-        data.insert(data.end(), {x.x, x.y, x.z});
-    }
-    meshes.emplace(&m, off);
-    return off;
-  }
-
-  static void leavesOf(const Domain& d, std::vector<const Domain*>& out) {
-    if (const auto* u = std::get_if<UnionDomain>(&d.shape()))
-      for (const Domain& part : u->parts->parts) leavesOf(part, out);
-    else
-      out.push_back(&d);
-  }
-
-  void put(std::size_t at, const cl::FlDomain& o) {
-    static_assert(sizeof(cl::FlDomain) == 18 * sizeof(float));
-    std::memcpy(data.data() + at, &o, sizeof o);
-  }
-
-  cl::FlDomain pack(const Domain& d) {
-    cl::FlDomain o{};
-    if (const auto* m = std::get_if<MeshDomain>(&d.shape())) {
-      o.kind = FL_DOMAIN_MESH;
-      setWord(o.v[0], mesh(*m->mesh));
-      setWord(o.v[1], cl::fl_u32(m->mesh->triangles.size()));
-      return o;
-    }
-    const auto* u = std::get_if<UnionDomain>(&d.shape());
-    if (!u) return packDomain(d);
-    const UnionData& un = *u->parts;
-    auto it = unions.find(&un);
-    if (it == unions.end()) {
-      // The record first, then its parts' own data after it (the vector may move: indices).
-      const std::size_t off = data.size();
-      data.resize(off + un.parts.size() * 20);
-      for (std::size_t j = 0; j < un.parts.size(); ++j) {
-        const cl::FlDomain part = pack(un.parts[j]);
-        setDouble(data, off + j * 20, un.cumulativeMeasure[j]);
-        put(off + j * 20 + 2, part);
-      }
-      std::vector<const Domain*> leaves;
-      leavesOf(d, leaves);
-      const std::size_t at = data.size();
-      data.resize(at + leaves.size() * 18);
-      for (std::size_t j = 0; j < leaves.size(); ++j) {
-        const cl::FlDomain leaf = pack(*leaves[j]);
-        put(at + j * 18, leaf);
-      }
-      it = unions
-               .emplace(&un, std::array<std::uint32_t, 3>{cl::fl_u32(off), cl::fl_u32(at),
-                                                          cl::fl_u32(leaves.size())})
-               .first;
-    }
-    o.kind = FL_DOMAIN_UNION;
-    setWord(o.v[0], it->second[0]);
-    setWord(o.v[1], cl::fl_u32(un.parts.size()));
-    setWord(o.v[2], cl::fl_u32(drawCount(d)));
-    setWord(o.v[3], it->second[1]);
-    setWord(o.v[4], it->second[2]);
-    return o;
-  }
-};
-
 // One emitter as fl_tail and fl_newborn read it; returns its index in t.emitters.
 std::uint32_t packEmitter(const Emitter& em, std::uint32_t variant, StepTables& t,
                           ShapePacker& shapes) {
@@ -412,6 +334,80 @@ std::uint32_t packEmitter(const Emitter& em, std::uint32_t variant, StepTables& 
 }
 
 }  // namespace
+
+// ---- Domains with data ------------------------------------------------------------------
+
+std::uint32_t ShapePacker::mesh(const MeshData& m) {
+  const auto it = meshes.find(&m);
+  if (it != meshes.end()) return it->second;
+  const auto off = cl::fl_u32(data.size());
+  for (std::size_t k = 0; k < m.triangles.size(); ++k) {
+    const glm::uvec3 t = m.triangles[k];
+    data.resize(data.size() + 2);
+    setDouble(data, data.size() - 2, m.cumulativeArea[k]);
+    for (const Vec3& x : {m.vertices[t.x], m.vertices[t.y], m.vertices[t.z], m.normals[k]})
+      data.insert(data.end(), {x.x, x.y, x.z});
+  }
+  meshes.emplace(&m, off);
+  return off;
+}
+
+void ShapePacker::leavesOf(const Domain& d, std::vector<const Domain*>& out) {
+  if (const auto* u = std::get_if<UnionDomain>(&d.shape()))
+    for (const Domain& part : u->parts->parts) leavesOf(part, out);
+  else
+    out.push_back(&d);
+}
+
+void ShapePacker::put(std::size_t at, const cl::FlDomain& o) {
+  static_assert(sizeof(cl::FlDomain) == 18 * sizeof(float));
+  std::memcpy(data.data() + at, &o, sizeof o);
+}
+
+cl::FlDomain ShapePacker::pack(const Domain& d) {
+  cl::FlDomain o{};
+  if (const auto* m = std::get_if<MeshDomain>(&d.shape())) {
+    o.kind = FL_DOMAIN_MESH;
+    setWord(o.v[0], mesh(*m->mesh));
+    setWord(o.v[1], cl::fl_u32(m->mesh->triangles.size()));
+    putVec(o.v, 2, m->mesh->min);  // the bounds, for containment (fl_inside_mesh)
+    putVec(o.v, 5, m->mesh->max);
+    return o;
+  }
+  const auto* u = std::get_if<UnionDomain>(&d.shape());
+  if (!u) return packDomain(d);
+  const UnionData& un = *u->parts;
+  auto it = unions.find(&un);
+  if (it == unions.end()) {
+    // The record first, then its parts' own data after it (the vector may move: indices).
+    const std::size_t off = data.size();
+    data.resize(off + un.parts.size() * 20);
+    for (std::size_t j = 0; j < un.parts.size(); ++j) {
+      const cl::FlDomain part = pack(un.parts[j]);
+      setDouble(data, off + j * 20, un.cumulativeMeasure[j]);
+      put(off + j * 20 + 2, part);
+    }
+    std::vector<const Domain*> leaves;
+    leavesOf(d, leaves);
+    const std::size_t at = data.size();
+    data.resize(at + leaves.size() * 18);
+    for (std::size_t j = 0; j < leaves.size(); ++j) {
+      const cl::FlDomain leaf = pack(*leaves[j]);
+      put(at + j * 18, leaf);
+    }
+    it = unions
+             .emplace(&un, std::array<std::uint32_t, 3>{cl::fl_u32(off), cl::fl_u32(at),
+                                                        cl::fl_u32(leaves.size())})
+             .first;
+  }
+  o.kind = FL_DOMAIN_UNION;
+  setWord(o.v[0], it->second[0]);
+  setWord(o.v[1], cl::fl_u32(un.parts.size()));
+  setWord(o.v[2], cl::fl_u32(drawCount(d)));
+  setWord(o.v[3], it->second[1]);
+  setWord(o.v[4], it->second[2]);
+  return o;
+}
 
 std::string emitterSignature(const GroupImpl& g) {
   std::string s;

@@ -5,7 +5,9 @@
 // fl_tail.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -24,6 +26,24 @@ struct StepTables {
   /// Mesh and union domains' data (domain.cl: FL_MESH_STRIDE, FL_UNION_STRIDE); integers
   /// and doubles as bit patterns.
   std::vector<float> shapes;
+};
+
+/// Domains as the device reads them: packDomain's, and for meshes and unions an FlDomain
+/// that points into `data`, where their data goes (domain.cl documents the layout), each
+/// once per packer. The offsets are indices into `data`, which the kernels get as the table:
+/// the step's shape table (emitters) or the action list's `extra` (actions' regions and
+/// sampled domains).
+struct ShapePacker {
+  std::vector<float>& data;
+  std::map<const void*, std::uint32_t> meshes;
+  std::map<const void*, std::array<std::uint32_t, 3>> unions;  // parts, leaves, leaf count
+
+  cl::FlDomain pack(const Domain& d);
+
+ private:
+  std::uint32_t mesh(const MeshData& m);
+  static void leavesOf(const Domain& d, std::vector<const Domain*>& out);
+  void put(std::size_t at, const cl::FlDomain& o);
 };
 
 /// Refuses, naming it, what of the group's emission the device does not run.
