@@ -7,23 +7,12 @@
 #include <cmath>
 
 #include "backend.hpp"
+#include "emission_plan.hpp"
 #include "sampling.hpp"
 
 namespace flurry::detail {
 
 namespace {
-
-// One run of births of one emitter: by rate (birth times first/rate apart), a burst, or by
-// distance travelled (births `spacing` apart along the step's path).
-struct BirthRun {
-  enum Kind { Rate, Burst, Distance } kind;
-  bool live;  // the emitter is g.live[index], else g.emitters[index]
-  std::uint32_t index;
-  std::uint64_t first;  // Rate: index of the first birth since the emitter's start
-  double time;          // Burst: its time; Distance: the step's start
-  std::uint64_t count;
-  double s0 = 0, spacing = 0, span = 0, dt = 0;  // Distance: first birth at s0 of span
-};
 
 constexpr std::size_t kNewbornsPerTask = 8192;  // a multiple of kBatch
 
@@ -369,6 +358,8 @@ void countGeneration(GroupImpl& g, std::uint32_t generation, std::uint64_t n) {
   g.stats.emittedByGeneration[generation] += n;
 }
 
+}  // namespace
+
 std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, std::vector<BirthRun>& runs) {
   const double t0 = sp.time, t1 = sp.time + sp.dt;
   std::uint64_t total = 0;
@@ -437,8 +428,6 @@ std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, std::vector<BirthRu
 void retireDead(GroupImpl& g, double t1) {
   std::erase_if(g.live, [&](const LiveEmitter& e) { return e.death <= t1; });
 }
-
-}  // namespace
 
 void emitAndCompact(GroupImpl& g, const StepParams& sp) {
   const double t1 = sp.time + sp.dt;

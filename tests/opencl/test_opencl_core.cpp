@@ -182,3 +182,22 @@ TEST(OpenCLCore, HairStrandsMatchTheCpu) {
   std::printf("[ hair     ] %zu strands, %zu vertices; largest |cpu - opencl| %g\n",
               cpu.strands.size(), cpu.strands.vertexCount(), worst);
 }
+
+TEST(OpenCLCore, ACallbackMayNotReturn) {
+  FLURRY_REQUIRE_OPENCL();
+  ContextOptions o;
+  o.backend = Backend::OpenCL;
+  Context ctx(o);
+  Group& g = ctx.createGroup("cb", 100);
+  g.addEmitter(spray());
+  Callback cb;
+  cb.function = [](Particle&, const CallbackContext&) {};
+  cb.opencl = "if (py > 1.0f) return;";
+  g.setActions({cb, Move{}});
+  try {
+    ctx.step();
+    FAIL() << "a callback with 'return' was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("return"), std::string::npos) << e.what();
+  }
+}

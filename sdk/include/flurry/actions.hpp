@@ -326,7 +326,8 @@ struct CallbackContext {
 /// mass, age, life (lifetime), id (read only), prevx prevy prevz, upx upy upz, rotx roty rotz
 /// (angular velocity), charge, vis (visible, uint), user (user data), pbx pby pbz
 /// (PositionB), vbx vby vbz (VelocityB); and float dt, time (the step's start). For example
-/// `"user += dt; if (py > 2.0f) vx += 0.5f;"`.
+/// `"user += dt; if (py > 2.0f) vx += 0.5f;"`. `break` ends the callback; `return` is not
+/// allowed (it would leave the whole kernel).
 struct Callback {
   std::function<void(Particle&, const CallbackContext&)> function;
   AttributeSet attributes{Attribute::Position, Attribute::Velocity};

@@ -1,6 +1,7 @@
 // The core actions on the device: Move, KillOld, CopyVertexB, Restore, Callback (its OpenCL
 // body). Their functions are in kernels/actions.cl.
 #include <cstring>
+#include <regex>
 #include <string>
 
 #include "codegen.hpp"
@@ -60,13 +61,20 @@ bool generateCoreAction(const Action& act, ActionSource& s) {
       notOnDevice(
           "a Callback without an OpenCL body (Callback::opencl; its C++ function "
           "cannot run on the device)");
-    // The user's statements see the lanes it declared by their kernel names; braces keep its
-    // locals its own.
+    // The user's statements see the lanes it declared by their kernel names; the block keeps
+    // its locals its own.
     s.reads.insert(c->attributes);
     for (int a = 0; a < int(Attribute::Count); ++a)
       if (c->attributes.has(Attribute(a)) && Attribute(a) != Attribute::Id)
         s.writes.insert(Attribute(a));
-    s.apply = "{\n" + c->opencl + "\n}\n";
+    // A `return` would leave the whole kernel (in fl_small, before its barriers): refused.
+    static const std::regex kReturn("\\breturn\\b");
+    if (std::regex_search(c->opencl, kReturn))
+      throw Error(
+          "OpenCL backend: Callback::opencl must not contain 'return' (it would leave "
+          "the kernel); use 'break' to end the callback early");
+    // do-while: a `break` or `continue` in it ends the callback, not the kernel's loop.
+    s.apply = "do {\n" + c->opencl + "\n} while (0);\n";
     return true;
   }
   return false;

@@ -16,6 +16,7 @@
 #include <set>
 #include <sstream>
 
+#include "../emission_plan.hpp"
 #include "../sampling.hpp"
 #include "flurry/error.hpp"
 #include "flurry/random.hpp"
@@ -28,183 +29,6 @@ std::uint64_t doubleBits(double d) {
   std::uint64_t b;
   std::memcpy(&b, &d, sizeof b);
   return b;
-}
-
-// ---- Planning: sdk/src/emission.cpp, verbatim in effect ------------------------------------
-
-struct BirthRun {
-  enum Kind { Rate, Burst, Distance } kind;
-  bool live;  // the emitter is g.live[index], else g.emitters[index]
-  std::uint32_t index;
-  std::uint64_t first;  // Rate: index of the first birth since the emitter's start
-  double time;          // Burst: its time; Distance: the step's start
-  std::uint64_t count;
-  double s0 = 0, spacing = 0, span = 0, dt = 0;  // Distance: first birth at s0 of span
-};
-
-std::uint64_t producedBy(const Emitter& e, double t) {
-  const double elapsed = std::min(t, e.stop) - e.start;
-  if (elapsed <= 0) return 0;
-  const double x = e.rate * elapsed;
-  return std::uint64_t(std::floor(x + 1e-9 * std::max(1.0, x)));
-}
-
-double birthTime(const BirthRun& run, const Emitter& em, std::uint64_t q) {
-  switch (run.kind) {
-    case BirthRun::Rate:
-      return em.start + double(run.first + q + 1) / em.rate;
-    case BirthRun::Burst:
-      return run.time;
-    default:
-      return run.time + run.dt * (run.s0 + double(q) * run.spacing) / run.span;
-  }
-}
-
-std::uint64_t planEmitter(const Emitter& em, EmitterState& state, bool live, std::uint32_t index,
-                          double t0, double t1, std::vector<BirthRun>& runs) {
-  std::uint64_t total = 0;
-  if (em.rate > 0) {
-    const std::uint64_t target = producedBy(em, t1);
-    if (target > state.emittedByRate) {
-      runs.push_back(
-          {BirthRun::Rate, live, index, state.emittedByRate, 0.0, target - state.emittedByRate});
-      total += target - state.emittedByRate;
-      state.emittedByRate = target;
-    }
-  }
-  for (const Burst& b : em.bursts) {
-    for (std::uint32_t r = 0; r < b.repeat; ++r) {
-      const double tb = b.time + r * b.interval;
-      if (tb >= t0 && tb < t1 && tb >= em.start && tb <= em.stop && b.count > 0) {
-        runs.push_back({BirthRun::Burst, live, index, 0, tb, b.count});
-        total += b.count;
-      }
-    }
-  }
-  if (em.spacing > 0) {
-    const double a = std::max(t0, em.start), b = std::min(t1, em.stop);
-    if (b > a) {
-      const double span = glm::length(em.positionAt(b) - em.positionAt(a));
-      const double s0 = em.spacing - state.travelled;
-      if (span >= s0) {
-        const auto count = std::uint64_t(std::floor((span - s0) / em.spacing)) + 1;
-        BirthRun run{BirthRun::Distance, live, index, 0, a, count};
-        run.s0 = s0;
-        run.spacing = em.spacing;
-        run.span = span;
-        run.dt = b - a;
-        runs.push_back(run);
-        total += count;
-        state.travelled = span - (s0 + double(count - 1) * em.spacing);
-      } else {
-        state.travelled += span;
-      }
-    }
-  }
-  return total;
-}
-
-void fly(const EmitterSpec& spec, Vec3 p0, Vec3 v0, double t, Vec3& p, Vec3& v) {
-  const float k = spec.drag, tf = float(t);
-  const Vec3 a = spec.acceleration;
-  if (k > 0.0f) {
-    const float e = std::exp(-k * tf);
-    const Vec3 terminal = a / k;
-    v = terminal + (v0 - terminal) * e;
-    p = p0 + terminal * tf + (v0 - terminal) * ((1.0f - e) / k);
-  } else {
-    v = v0 + a * tf;
-    p = p0 + v0 * tf + a * (0.5f * tf * tf);
-  }
-}
-
-void spawn(GroupImpl& g, const StepParams& sp, std::shared_ptr<const EmitterSpec> spec,
-           double birth, Vec3 place, Vec3 parentVelocity, std::uint32_t generation,
-           const Domain* shape) {
-  const std::uint32_t id = g.nextEmitterId++;
-  Random rng(sp.seed, id, g.index, stream::kEmitterEvent);
-  LiveEmitter e;
-  e.id = id;
-  e.position = place + (shape ? shape->sample(rng) : Vec3(0.0f));
-  e.velocity = spec->velocity.sample(rng) + parentVelocity * spec->inheritVelocity;
-  const double life = std::max(1e-6f, spec->lifetime.sample(rng));
-  e.birth = birth;
-  e.death = birth + life;
-  e.generation = generation;
-  e.emitter = spec->emitter;
-  e.emitter.start = birth;
-  e.emitter.stop = std::min(e.death, birth + (spec->emitter.stop - spec->emitter.start));
-  for (Burst& b : e.emitter.bursts) b.time += birth;
-  e.spec = spec.get();
-  e.keepAlive = std::move(spec);
-  g.live.push_back(std::move(e));
-  ++g.stats.emittersSpawned;
-}
-
-void countGeneration(GroupImpl& g, std::uint32_t generation, std::uint64_t n) {
-  if (g.stats.emittedByGeneration.size() <= generation)
-    g.stats.emittedByGeneration.resize(generation + 1, 0);
-  g.stats.emittedByGeneration[generation] += n;
-}
-
-std::uint64_t planAll(GroupImpl& g, const StepParams& sp, std::vector<BirthRun>& runs) {
-  const double t0 = sp.time, t1 = sp.time + sp.dt;
-  std::uint64_t total = 0;
-  for (std::uint32_t e = 0; e < g.emitters.size(); ++e) {
-    const std::uint64_t n = planEmitter(g.emitters[e], g.emitterState[e], false, e, t0, t1, runs);
-    countGeneration(g, 0, n);
-    total += n;
-  }
-  if (g.primeSpecs.size() != g.primes.size()) {
-    g.primeSpecs.clear();
-    for (const PrimeEmitter& p : g.primes)
-      g.primeSpecs.push_back(std::make_shared<EmitterSpec>(p.child));
-  }
-  for (std::size_t k = 0; k < g.primes.size(); ++k) {
-    const PrimeEmitter& prime = g.primes[k];
-    Emitter counter;
-    counter.rate = prime.rate;
-    counter.bursts = prime.bursts;
-    counter.start = prime.start;
-    counter.stop = prime.stop;
-    std::vector<BirthRun> spawns;
-    planEmitter(counter, g.primeState[k], false, 0, t0, t1, spawns);
-    for (const BirthRun& run : spawns)
-      for (std::uint64_t q = 0; q < run.count; ++q) {
-        const double tb = birthTime(run, counter, q);
-        spawn(g, sp, g.primeSpecs[k], tb, prime.positionAt(tb), prime.velocity, 1, &prime.shape);
-      }
-  }
-  for (std::size_t k = 0; k < g.live.size(); ++k) {
-    LiveEmitter& e = g.live[k];
-    const double a = std::max(t0, e.birth), b = std::min(t1, e.death);
-    if (b < a) continue;
-    const double stateTime = std::max(t0, e.birth);
-    Vec3 pb, vb, pm, vm;
-    fly(*e.spec, e.position, e.velocity, b - stateTime, pb, vb);
-    fly(*e.spec, e.position, e.velocity, 0.5 * (b - stateTime), pm, vm);
-    e.emitter.path = {{a, e.position}, {0.5 * (a + b), pm}, {b, pb}};
-    if (!(b > a)) e.emitter.path.resize(1);
-    const std::uint64_t n =
-        planEmitter(e.emitter, e.state, true, std::uint32_t(k), a, b + 1e-12, runs);
-    countGeneration(g, e.generation, n);
-    total += n;
-    e.position = pb;
-    e.velocity = vb;
-    if (e.death <= t1) {
-      const EmitterSpec& spec = *e.spec;
-      if (spec.deathBurst > 0) {
-        runs.push_back({BirthRun::Burst, true, std::uint32_t(k), 0, e.death, spec.deathBurst});
-        countGeneration(g, e.generation, spec.deathBurst);
-        total += spec.deathBurst;
-      }
-      const double death = e.death;
-      const std::uint32_t generation = e.generation + 1;
-      for (std::uint32_t c = 0; c < spec.deathChildren; ++c)
-        spawn(g, sp, spec.next, death, pb, vb, generation, nullptr);
-    }
-  }
-  return total;
 }
 
 // ---- The generated code: one fl_emit case per distinct emitter code ------------------------
@@ -443,7 +267,7 @@ std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, StepTables& t) {
   thread_local std::vector<BirthRun> runsStore;
   auto& runs = runsStore;
   runs.clear();
-  const std::uint64_t total = planAll(g, sp, runs);
+  const std::uint64_t total = detail::planBirths(g, sp, runs);
   g.stats.emitted += total;
   if (total > 0) {
     ShapePacker shapes{t.shapes, {}, {}};
@@ -484,9 +308,8 @@ std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, StepTables& t) {
       start += run.count;
     }
   }
-  // Live emitters that died this step go after their last births are packed (retireDead).
-  const double t1 = sp.time + sp.dt;
-  std::erase_if(g.live, [&](const LiveEmitter& e) { return e.death <= t1; });
+  // Live emitters that died this step go after their last births are packed.
+  retireDead(g, sp.time + sp.dt);
   if (t.keys.empty()) t.keys.push_back({});
   if (t.shapes.empty()) t.shapes.push_back(0.0f);
   return total;

@@ -1,0 +1,34 @@
+// Planning a step's births: which emitter gives birth, how many and when, prime emitters'
+// spawning, the live emitters' flight and deaths. Shared by the CPU backend (emission.cpp)
+// and the OpenCL backend (opencl/emission.cpp), so both plan the same births in the same
+// order (ids and random streams follow from it).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "backend.hpp"
+
+namespace flurry::detail {
+
+/// One run of births of one emitter: by rate (birth times first/rate apart), a burst, or by
+/// distance travelled (births `spacing` apart along the step's path).
+struct BirthRun {
+  enum Kind { Rate, Burst, Distance } kind;
+  bool live;  ///< the emitter is g.live[index], else g.emitters[index]
+  std::uint32_t index;
+  std::uint64_t first;  ///< Rate: index of the first birth since the emitter's start
+  double time;          ///< Burst: its time; Distance: the step's start
+  std::uint64_t count;
+  double s0 = 0, spacing = 0, span = 0, dt = 0;  ///< Distance: first birth at s0 of span
+};
+
+/// This step's runs, in birth order (emitters, then live emitters with their death bursts);
+/// advances the emitters' state, spawns and moves live emitters, counts generations.
+/// Returns the births planned.
+std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, std::vector<BirthRun>& runs);
+
+/// Drops the live emitters that died by t1 (after their last births are written).
+void retireDead(GroupImpl& g, double t1);
+
+}  // namespace flurry::detail
