@@ -76,6 +76,48 @@ inline void checkParity(const Build& build, int steps = kSteps, std::uint64_t se
   ::testing::Test::RecordProperty("max_abs_difference", std::to_string(maxDiff));
 }
 
+// The list without actions[k], with the same integrator and sub-steps.
+inline ActionList withoutAction(const ActionList& list, std::size_t k) {
+  ActionList out;
+  for (std::size_t j = 0; j < list.size(); ++j)
+    if (j != k) out.add(list.actions()[j]);
+  out.setIntegrator(list.integrator());
+  out.setSubsteps(list.substeps());
+  return out;
+}
+
+// Whether two runs differ in some particle by more than `scale` times the parity tolerance
+// (0: any difference), or in their counts. Parity alone would also pass if an action did
+// nothing on either backend: its tests check on the CPU that dropping it changes the run.
+inline bool differs(const RunResult& x, const RunResult& y, float scale) {
+  if (x.size != y.size || x.stats.absorbed != y.stats.absorbed) return true;
+  auto far = [scale](float a, float b) {
+    return !(std::abs(a - b) <= scale * (kAbs + kRel * std::abs(a)));
+  };
+  for (const auto& [id, p] : x.byId) {
+    auto it = y.byId.find(id);
+    if (it == y.byId.end()) return true;
+    const Particle& q = it->second;
+    if (p.visible != q.visible || far(p.size, q.size)) return true;
+    for (int c = 0; c < 3; ++c)
+      if (far(p.position[c], q.position[c]) || far(p.velocity[c], q.velocity[c]) ||
+          far(p.rotVelocity[c], q.rotVelocity[c]))
+        return true;
+    for (int c = 0; c < 4; ++c)
+      if (far(p.color[c], q.color[c])) return true;
+  }
+  return false;
+}
+
+// Parity of `build`, printing the largest |cpu - opencl| of this run alone.
+inline void checkParityReporting(const Build& build) {
+  const float before = maxDiff;
+  maxDiff = 0;
+  checkParity(build);
+  std::printf("[ parity   ] largest |cpu - opencl|: %g\n", maxDiff);
+  maxDiff = std::max(before, maxDiff);
+}
+
 // A jet of particles from a small sphere, sprayed into a box of obstacles.
 inline Emitter spray(Vec3 at = Vec3(0.0f, 1.0f, 0.0f), double rate = 1500) {
   Emitter e;

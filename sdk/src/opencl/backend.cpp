@@ -50,12 +50,6 @@ std::size_t roundUp(std::size_t x, std::size_t m) {
   return (x + m - 1) / m * m;
 }
 
-std::uint64_t doubleBits(double d) {
-  std::uint64_t b;
-  std::memcpy(&b, &d, sizeof b);
-  return b;
-}
-
 template <class T>
 void setArg(cl_kernel k, cl_uint i, const T& v) {
   check(clSetKernelArg(k, i, sizeof(T), &v), "clSetKernelArg");

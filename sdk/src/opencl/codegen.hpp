@@ -3,6 +3,7 @@
 // (gravity, a restitution) does not recompile.
 #pragma once
 
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -102,6 +103,13 @@ void packActions(const ActionList& actions, float dt, std::vector<cl::FlActionPa
 
 /// Sub-steps of a step of dt seconds by Substeps::maxStep (fused_pass.cpp makePlan).
 std::uint32_t stepSubsteps(const ActionList& actions, double dt);
+
+/// A double as the kernels receive it (params.h: doubles travel as their bit patterns).
+inline std::uint64_t doubleBits(double d) {
+  std::uint64_t b;
+  std::memcpy(&b, &d, sizeof b);
+  return b;
+}
 
 inline void putVec(float* v, int at, Vec3 x) {
   v[at] = x.x;

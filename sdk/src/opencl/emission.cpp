@@ -25,12 +25,6 @@ namespace flurry::detail::ocl {
 
 namespace {
 
-std::uint64_t doubleBits(double d) {
-  std::uint64_t b;
-  std::memcpy(&b, &d, sizeof b);
-  return b;
-}
-
 // ---- The generated code: one fl_emit case per distinct emitter code ------------------------
 
 cl::FlFuzzy packFuzzy(const Fuzzy& f) {
