@@ -13,6 +13,8 @@ DEB_PACKAGES=(
   libopenvdb-dev libtbb-dev libblosc-dev libboost-iostreams-dev libopenvdb-tools python3-openvdb
   # Rendering: GLFW + OpenGL, headless under Xvfb with Mesa's software GL
   libglfw3-dev libgl-dev libgl1-mesa-dri libegl-mesa0 xvfb xauth
+  # Emulated CPUs without AVX / AVX-512 for the instruction-set tests
+  qemu-user
 )
 PY_PACKAGES=(numpy matplotlib pytest nanobind scikit-build-core)
 

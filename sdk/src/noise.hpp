@@ -6,8 +6,10 @@
 #include <cstdint>
 
 #include "flurry/math.hpp"
+#include "isa_namespace.hpp"
 
 namespace flurry::detail {
+inline namespace FLURRY_ISA_NAMESPACE {  // see isa_namespace.hpp
 
 // A hash of integer lattice coordinates (and a seed) to a gradient among the 12 edge
 // directions of a cube: no table, so the same function runs in an OpenCL kernel.
@@ -88,4 +90,5 @@ inline Vec3 curlNoise(Vec3 p, int octaves = 1) {
   return curl;
 }
 
+}  // namespace FLURRY_ISA_NAMESPACE
 }  // namespace flurry::detail

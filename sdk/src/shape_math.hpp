@@ -3,8 +3,10 @@
 #pragma once
 
 #include "flurry/domain.hpp"
+#include "isa_namespace.hpp"
 
 namespace flurry::detail {
+inline namespace FLURRY_ISA_NAMESPACE {  // see isa_namespace.hpp
 
 inline bool inside(const PointDomain&, Vec3) { return false; }
 inline bool inside(const LineDomain&, Vec3) { return false; }
@@ -54,7 +56,10 @@ inline bool inside(const BlobDomain& d, Vec3 p) {
   return glm::dot(r, r) <= d.stddev * d.stddev;
 }
 
-// Not vectorised: a mesh tests ray-crossing parity against its triangles, a union its parts.
+}  // namespace FLURRY_ISA_NAMESPACE
+
+// Not vectorised, defined once in domain.cpp (baseline): a mesh tests ray-crossing parity
+// against its triangles, a union its parts.
 bool inside(const MeshDomain& d, Vec3 p);
 bool inside(const UnionDomain& d, Vec3 p);
 

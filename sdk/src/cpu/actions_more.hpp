@@ -6,9 +6,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "../field_math.hpp"
 #include "kernels.hpp"
+#include "../isa_namespace.hpp"
 
 namespace flurry::detail::cpu {
+inline namespace FLURRY_ISA_NAMESPACE {  // see isa_namespace.hpp
 
 namespace {
 inline Vec3 at(const float* const* a, std::size_t i) { return Vec3(a[0][i], a[1][i], a[2][i]); }
@@ -287,7 +290,7 @@ inline void apply(const SampledField& a, const Lanes& L, std::size_t n, const Bl
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3 p = at(L.p, i);
     const float w = falloffWeight(a.falloff, p);
-    const Vec3 u = f.sample(p) * a.strength;
+    const Vec3 u = sampleTrilinear(f, p) * a.strength;
     const Vec3 v = at(L.v, i);
     put(L.v, i, a.mode == SampledField::Mode::Acceleration ? v + u * (c.dt * w) : v + (u - v) * (k * w));
   }
@@ -454,4 +457,5 @@ inline void apply(const Callback& a, const Lanes& L, std::size_t n, const BlockC
   }
 }
 
+}  // namespace FLURRY_ISA_NAMESPACE
 }  // namespace flurry::detail::cpu

@@ -6,8 +6,10 @@
 #include <vector>
 
 #include "actions_more.hpp"
+#include "../isa_namespace.hpp"
 
 namespace flurry::detail::cpu {
+inline namespace FLURRY_ISA_NAMESPACE {  // see isa_namespace.hpp
 
 /// Arrays an acceleration is evaluated on: positions and velocities of a block (or of an
 /// integrator's intermediate stage), and where it accumulates.
@@ -96,7 +98,7 @@ inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std
           } else if constexpr (std::is_same_v<A, MagneticField>) {
             acc = glm::cross(v, a.field) * chargePerMass(L, i) * falloffWeight(a.falloff, p);
           } else if constexpr (std::is_same_v<A, SampledField>) {
-            const Vec3 u = a.field->sample(p) * a.strength;
+            const Vec3 u = sampleTrilinear(*a.field, p) * a.strength;
             acc = (a.mode == SampledField::Mode::Acceleration ? u : (u - v) * a.responsiveness) *
                   falloffWeight(a.falloff, p);
           } else if constexpr (std::is_same_v<A, TargetVelocity>) {
@@ -248,4 +250,5 @@ inline void integrate(Integrator integrator, const std::vector<Action>& acts,
   if (L.age) ageLoop(L.age, n, dt);
 }
 
+}  // namespace FLURRY_ISA_NAMESPACE
 }  // namespace flurry::detail::cpu

@@ -13,8 +13,10 @@
 #include "../shape_math.hpp"
 #include "flurry/actions.hpp"
 #include "flurry/random.hpp"
+#include "../isa_namespace.hpp"
 
 namespace flurry::detail::cpu {
+inline namespace FLURRY_ISA_NAMESPACE {  // see isa_namespace.hpp
 
 /// Positions and velocities at the start of the step, for actions that read other particles.
 struct Snapshot {
@@ -474,4 +476,5 @@ inline void apply(const Bounce& a, const Lanes& L, std::size_t n, const BlockCon
   }
 }
 
+}  // namespace FLURRY_ISA_NAMESPACE
 }  // namespace flurry::detail::cpu

@@ -1,0 +1,17 @@
+// The fused pass is compiled once per instruction set (sdk/CMakeLists.txt). An inline
+// function it shares with other translation units would be emitted once per build, and the
+// linker keeps one copy for all of them: the SSE2 path would then run AVX2 code. Internal
+// headers therefore put their functions in an inline namespace named after the instruction
+// set the translation unit is compiled for, so each build keeps its own copies by
+// construction. Names in source stay unqualified; only the mangled names differ.
+#pragma once
+
+#if defined(__AVX512F__)
+#define FLURRY_ISA_NAMESPACE isa_avx512
+#elif defined(__AVX2__)
+#define FLURRY_ISA_NAMESPACE isa_avx2
+#elif defined(__AVX__)
+#define FLURRY_ISA_NAMESPACE isa_avx
+#else
+#define FLURRY_ISA_NAMESPACE isa_baseline
+#endif
