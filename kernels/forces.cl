@@ -33,11 +33,12 @@ FL_INLINE float fl_force_approach(float rate, float dt, float packedDt, float pa
   return 1.0f - fl_force_decay(rate, dt, packedDt, packed);
 }
 
-/* actions_more.hpp softPull: magnitude * d / (|d|^2 + eps)^(3/2), zero beyond maxR. */
+/* actions_more.hpp softPull: magnitude * d / (|d|^2 + eps)^(3/2), zero beyond maxR and at
+ * the centre (where s sqrt(s) underflows to 0 for a tiny eps: 0 inf would be NaN). */
 FL_INLINE void fl_force_soft_pull(float dx, float dy, float dz, float magnitude, float eps,
                                   float maxR, float* ox, float* oy, float* oz) {
   const float r2 = dx * dx + dy * dy + dz * dz;
-  if (!(r2 <= maxR * maxR)) {
+  if (!(r2 <= maxR * maxR) || !(r2 > 0.0f)) {
     *ox = 0.0f;
     *oy = 0.0f;
     *oz = 0.0f;

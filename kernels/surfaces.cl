@@ -10,10 +10,6 @@
  * domain.cpp operation by operation. A mesh's or union's data is in `shapes`, the act
  * kernel's `extra` (actions_surfaces.cpp packs it there). */
 
-FL_INLINE float3 fl_surf_normalize(float3 a) {
-  return a * (1.0f / sqrt(fl_dotv(a, a)));
-}
-
 FL_INLINE int fl_surf_planar(uint kind) {
   return kind == FL_DOMAIN_PLANE || kind == FL_DOMAIN_RECTANGLE || kind == FL_DOMAIN_DISC ||
          kind == FL_DOMAIN_TRIANGLE;
@@ -88,9 +84,19 @@ FL_INLINE void fl_bounce_planar(__global const FlActionParams* a, int piece, flo
   const float vn = vx * Nx + vy * Ny + vz * Nz;
   const float d1 = d0 + vn * dt;
   const float side = d0 >= 0.0f ? 1.0f : -1.0f;
-  const float tau = d0 / (d0 - d1) * dt;
+  /* Ending within a few ulps of the plane counts as arriving on it (kernels.hpp
+   * bouncePlanarLoop). */
+  const float reach =
+      1.2e-7f * (fabs(Nx) * (fabs(x) + fabs(Px) + 2.0f * fabs(vx * dt)) +
+                 fabs(Ny) * (fabs(y) + fabs(Py) + 2.0f * fabs(vy * dt)) +
+                 fabs(Nz) * (fabs(z) + fabs(Pz) + 2.0f * fabs(vz * dt))) +
+      1e-30f;
+  const float tau = fl_minf(d0 / (d0 - d1), 1.0f) * dt;
   const float hx = x + vx * tau, hy = y + vy * tau, hz = z + vz * tau;
-  const int hit = (side * d1 < 0.0f) & fl_on_piece(a, piece, hx, hy, hz);
+  /* A crossing or an arrival, approaching; one born or placed exactly on the plane (d0 = 0)
+   * belongs to neither side. */
+  const int hit = (side * d1 <= reach) & (side * vn < 0.0f) & (d0 != 0.0f) &
+                  fl_on_piece(a, piece, hx, hy, hz);
   if (!hit) return;
   float nx = x, ny = y, nz = z, nvx = vx, nvy = vy, nvz = vz;
   fl_reflect(a, &nx, &ny, &nz, &nvx, &nvy, &nvz, hx, hy, hz, Nx, Ny, Nz, tau);
@@ -141,31 +147,37 @@ FL_INLINE void fl_bounce_sphere(__global const FlActionParams* a, int inside, fl
                                   fabs(nvy * dt) + fabs(nvz * dt)) +
                          1e-30f;
     const float push = fl_maxf(2.0f * margin - qd, 0.0f) * (inside ? -1.0f : 1.0f);
-    *px = nx + push * nnx;
-    *py = ny + push * nny;
-    *pz = nz + push * nnz;
-    *vxs = nvx;
-    *vys = nvy;
-    *vzs = nvz;
+    /* Inside, a reflected path that reaches the wall again, or ends too close to it, is
+     * left for the exact loop below (kernels.hpp bounceSphereLoop). */
+    if (!(inside && qd < 2.0f * margin)) {
+      *px = nx + push * nnx;
+      *py = ny + push * nny;
+      *pz = nz + push * nnz;
+      *vxs = nvx;
+      *vys = nvy;
+      *vzs = nvz;
+    }
   }
   if (!inside) return;
-  /* A particle that crosses the sphere more than once in a step bounces again for what is
-   * left of the step; if it still would leave, it ends inside. */
+  /* A particle that crosses the sphere more than once in a step bounces at every exit for
+   * what is left of the step, from where it began; past 16 bounces it ends inside. */
   const float3 C = (float3)(Cx, Cy, Cz);
   const float3 p = (float3)(*px, *py, *pz);
   float3 v = (float3)(*vxs, *vys, *vzs);
   const float slack = 4e-7f * (R + fl_lengthv(v) * dt);
-  if (!(fl_lengthv(p + v * dt - C) > R - slack)) return;
+  if (!(fl_lengthv(p + v * dt - C) > R - slack) || fl_lengthv(p - C) > R + slack) return;
   float left = dt;
   float3 cur = p;
-  for (int bounce = 0; bounce < 16 && fl_lengthv(cur + v * left - C) > R - slack; ++bounce) {
+  for (int bounce = 0; bounce < 16; ++bounce) {
     const float3 r = cur - C;
-    const float bb2 = fl_dotv(r, v), aa2 = fl_dotv(v, v);
-    const float c22 = fl_dotv(r, r) - R2;
-    const float t = fl_clamp((-bb2 + sqrt(fl_maxf(bb2 * bb2 - aa2 * c22, 0.0f))) / aa2, 0.0f, left);
+    const float bb2 = fl_dotv(r, v), aa2 = fl_dotv(v, v), c22 = fl_dotv(r, r) - R2;
+    const float root2 = sqrt(fl_maxf(bb2 * bb2 - aa2 * c22, 0.0f));
+    /* The exit root, in the form without cancellation for either sign of bb. */
+    const float t = fl_maxf(bb2 > 0.0f ? -c22 / (bb2 + root2) : (root2 - bb2) / aa2, 0.0f);
+    if (!(t < left)) break;
     cur += v * t;
     left -= t;
-    const float3 nrm = fl_surf_normalize(cur - C);
+    const float3 nrm = (cur - C) * invR; /* on the sphere: never the centre */
     float qx = cur.x, qy = cur.y, qz = cur.z, nvx = v.x, nvy = v.y, nvz = v.z;
     fl_reflect(a, &qx, &qy, &qz, &nvx, &nvy, &nvz, cur.x, cur.y, cur.z, nrm.x, nrm.y, nrm.z, 0.0f);
     v = (float3)(nvx, nvy, nvz);
@@ -173,8 +185,8 @@ FL_INLINE void fl_bounce_sphere(__global const FlActionParams* a, int inside, fl
   float3 pos = cur + v * left;
   /* Inside by more than Move's rounding of p + v dt. */
   const float margin = 4e-6f * R + 1e-6f * fl_lengthv(v) * dt;
-  if (fl_lengthv(pos - C) > R - margin)
-    pos = C + (pos - C) * (fl_maxf(R - margin, 0.5f * R) / fl_lengthv(pos - C));
+  const float dist = fl_lengthv(pos - C);
+  if (dist > R - margin) pos = C + (pos - C) * (fl_maxf(R - margin, 0.5f * R) / dist);
   const float3 q = pos - v * dt;
   *px = q.x;
   *py = q.y;
@@ -426,11 +438,12 @@ FL_INLINE void fl_constrain2d(__global const FlActionParams* a, float* px, float
 
 /* ---- Neighbours: the particles as they were at the start of the step (FL_SNAP) ----------- */
 
-/* actions_more.hpp softPull: magnitude d / (|d|^2 + eps)^(3/2), zero beyond maxR. f[0]
+/* actions_more.hpp softPull: magnitude d / (|d|^2 + eps)^(3/2), zero beyond maxR and at the
+ * centre. f[0]
  * magnitude, f[1] epsilon, f[2] maxR^2. Adds to acc (adding zero changes nothing). */
 FL_INLINE void fl_soft_pull(__global const FlActionParams* a, float3 d, float3* acc) {
   const float r2 = fl_dotv(d, d);
-  if (!(r2 <= a->f[2])) return;
+  if (!(r2 <= a->f[2]) || !(r2 > 0.0f)) return;
   const float s = r2 + a->f[1];
   *acc += d * (a->f[0] / (s * sqrt(s)));
 }

@@ -28,10 +28,12 @@ inline float falloffWeight(const Falloff& f, Vec3 p) {
 }
 // The fraction of the way an exponential approach covers in dt: never more than 1.
 inline float approach(float rate, float dt) { return 1.0f - std::exp(-rate * dt); }
-// Softened inverse-square pull towards d: magnitude·d / (|d|² + eps)^(3/2), zero beyond maxR.
+// Softened inverse-square pull towards d: magnitude·d / (|d|² + eps)^(3/2), zero beyond maxR
+// and at the centre: there s·√s underflows to 0 for eps below ~1e-26, and 0·inf would be NaN.
+// Elsewhere a pull that overflows stays infinite, and the NaN guard kills the particle.
 inline Vec3 softPull(Vec3 d, float magnitude, float eps, float maxR) {
   const float r2 = glm::dot(d, d);
-  if (!(r2 <= maxR * maxR)) return Vec3(0.0f);
+  if (!(r2 <= maxR * maxR) || !(r2 > 0.0f)) return Vec3(0.0f);
   const float s = r2 + eps;
   return d * (magnitude / (s * std::sqrt(s)));
 }

@@ -182,11 +182,22 @@ inline void bouncePlanarLoop(float* __restrict px, float* __restrict py, float* 
     const float vn = vx * N.x + vy * N.y + vz * N.z;
     const float d1 = d0 + vn * dt;
     const float side = d0 >= 0.0f ? 1.0f : -1.0f;
+    // Ending within a few ulps of the plane counts as arriving on it (Move's p + v·dt may
+    // round onto the plane where d1 does not): bounced at the end of the step and pushed
+    // out, so that no particle comes to rest on a piece by moving.
+    const float reach =
+        1.2e-7f * (std::abs(N.x) * (std::abs(x) + std::abs(P.x) + 2.0f * std::abs(vx * dt)) +
+                   std::abs(N.y) * (std::abs(y) + std::abs(P.y) + 2.0f * std::abs(vy * dt)) +
+                   std::abs(N.z) * (std::abs(z) + std::abs(P.z) + 2.0f * std::abs(vz * dt))) +
+        1e-30f;
     // Computed for every particle and kept only on a hit (one if-block: GCC 12 vectorises
     // that, but not several selects on the same condition). Lanes that miss may hold inf.
-    const float tau = d0 / (d0 - d1) * dt;
+    const float tau = std::min(d0 / (d0 - d1), 1.0f) * dt;
     const float hx = x + vx * tau, hy = y + vy * tau, hz = z + vz * tau;
-    const bool hit = (side * d1 < 0.0f) & onPiece(hx, hy, hz);
+    // A crossing or an arrival, approaching the plane. A particle born or placed exactly on
+    // the plane (d0 = 0) belongs to neither side and leaves it freely, whichever way the
+    // piece's normal points: an emitter on a floor emits through it.
+    const bool hit = (side * d1 <= reach) & (side * vn < 0.0f) & (d0 != 0.0f) & onPiece(hx, hy, hz);
     float nx = x, ny = y, nz = z, nvx = vx, nvy = vy, nvz = vz;
     reflect(nx, ny, nz, nvx, nvy, nvz, hx, hy, hz, N.x, N.y, N.z, tau);
     // Where Move will put it; push it out if rounding left it on or behind the plane.
@@ -254,8 +265,12 @@ inline void bounceSphereLoop(float* __restrict px, float* __restrict py, float* 
                                   std::abs(nvx * dt) + std::abs(nvy * dt) + std::abs(nvz * dt)) +
                          1e-30f;
     const float push = std::max(2.0f * margin - qd, 0.0f) * (Inside ? -1.0f : 1.0f);
+    // Inside, a reflected path that reaches the wall again (|v|·dt longer than the chord),
+    // or ends too close to it, is left as it was for the exact loop below: its end is near
+    // another point of the wall, where this hit's normal does not point inwards.
+    const bool again = Inside && qd < 2.0f * margin;
     float ox = x, oy = y, oz = z, ovx = vx, ovy = vy, ovz = vz;
-    if (hit) {
+    if (hit & !again) {
       ox = nx + push * nnx;
       oy = ny + push * nny;
       oz = nz + push * nnz;
@@ -271,37 +286,39 @@ inline void bounceSphereLoop(float* __restrict px, float* __restrict py, float* 
     vzs[i] = ovz;
   }
   if constexpr (Inside) {
-    // A particle that crosses the sphere more than once in a step (|v|·dt > the diameter)
-    // bounces again for what is left of the step; if it still would leave, it ends inside.
+    // A particle that crosses the sphere more than once in a step bounces at every exit for
+    // what is left of the step, from where it began; past 16 bounces it ends inside.
     for (std::size_t i = 0; i < n; ++i) {
-      Vec3 p(px[i], py[i], pz[i]), v(vxs[i], vys[i], vzs[i]);
+      const Vec3 p(px[i], py[i], pz[i]);
+      Vec3 v(vxs[i], vys[i], vzs[i]);
       const float slack = 4e-7f * (R + glm::length(v) * dt);
-      auto out = [&](Vec3 q) { return glm::length(q - C) > R - slack; };
-      if (!out(p + v * dt)) continue;
-      Vec3 pos = p + v * dt;  // recover where the reflected path starts: at the last hit
-      float left = dt;
+      // Bounced above (its end is inside), or outside to begin with: not ours.
+      if (!(glm::length(p + v * dt - C) > R - slack) || glm::length(p - C) > R + slack) continue;
       Vec3 cur = p;
-      for (int bounce = 0; bounce < 16 && out(cur + v * left); ++bounce) {
+      float left = dt;
+      for (int bounce = 0; bounce < 16; ++bounce) {
         const Vec3 r = cur - C;
-        const float bb = glm::dot(r, v), aa = glm::dot(v, v);
-        const float c2 = glm::dot(r, r) - R2;
-        const float t = std::clamp((-bb + std::sqrt(std::max(bb * bb - aa * c2, 0.0f))) / aa, 0.0f, left);
+        const float bb = glm::dot(r, v), aa = glm::dot(v, v), c2 = glm::dot(r, r) - R2;
+        const float root = std::sqrt(std::max(bb * bb - aa * c2, 0.0f));
+        // The exit root, in the form without cancellation for either sign of bb.
+        const float t = std::max(bb > 0.0f ? -c2 / (bb + root) : (root - bb) / aa, 0.0f);
+        if (!(t < left)) break;  // stays inside for the rest of the step
         cur += v * t;
         left -= t;
-        const Vec3 nrm = glm::normalize(cur - C);
+        const Vec3 nrm = (cur - C) * invR;  // on the sphere: never the centre
         float qx = cur.x, qy = cur.y, qz = cur.z, nvx = v.x, nvy = v.y, nvz = v.z;
         reflect(qx, qy, qz, nvx, nvy, nvz, cur.x, cur.y, cur.z, nrm.x, nrm.y, nrm.z, 0.0f);
         v = Vec3(nvx, nvy, nvz);
       }
-      pos = cur + v * left;
+      Vec3 pos = cur + v * left;
       // Inside by more than Move's rounding of p + v·dt, which grows with |v|·dt.
       const float margin = 4e-6f * R + 1e-6f * glm::length(v) * dt;
-      if (glm::length(pos - C) > R - margin)
-        pos = C + (pos - C) * (std::max(R - margin, 0.5f * R) / glm::length(pos - C));
-      p = pos - v * dt;
-      px[i] = p.x;
-      py[i] = p.y;
-      pz[i] = p.z;
+      const float dist = glm::length(pos - C);
+      if (dist > R - margin) pos = C + (pos - C) * (std::max(R - margin, 0.5f * R) / dist);
+      const Vec3 start = pos - v * dt;
+      px[i] = start.x;
+      py[i] = start.y;
+      pz[i] = start.z;
       vxs[i] = v.x;
       vys[i] = v.y;
       vzs[i] = v.z;
