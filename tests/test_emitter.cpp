@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
+#include <cstdint>
 
 #include "flurry/flurry.hpp"
 
@@ -164,4 +166,99 @@ TEST(Emitter, InvalidParametersNameTheField) {
   Emitter f;
   f.path = {{1.0, Vec3(0)}, {0.5, Vec3(1)}};
   expectParam(f, "emitters[0].path[1].time");
+}
+
+TEST(Emitter, BurstRepeatedForeverCostsTheSameEveryStep) {
+  // A burst repeated ~2^32 times ("forever"): a step finds its occurrences arithmetically.
+  // Walking every repeat took about 5 s a step.
+  ContextOptions o;
+  o.dt = 0.1;
+  o.threads = 1;
+  Context ctx(o);
+  Group& g = ctx.createGroup("g", 1000);
+  Emitter e;
+  e.bursts = {{0.05, 3, 0.1, 4'000'000'000u}};
+  g.addEmitter(e);
+  const auto start = std::chrono::steady_clock::now();
+  ctx.run(3);
+  const std::chrono::duration<double> took = std::chrono::steady_clock::now() - start;
+  EXPECT_EQ(g.size(), 9u);
+  EXPECT_LT(took.count(), 1.0);
+}
+
+TEST(Emitter, BurstOccurrencesFallInTheStepOfTheirTime) {
+  // Per step, what the bursts fire is exactly the occurrences whose times fall in the step's
+  // [t0, t1) and the emitter's [start, stop], also when a time lands on a step's boundary.
+  const double dt = 0.1;
+  Emitter e;
+  e.start = 0.3;
+  e.stop = 2.0;
+  e.bursts = {{0.0, 1, 0.1, 40},
+              {0.05, 2, 0.3, 7},
+              {0.3, 4, 0.025, 100},
+              {1.2, 8, 0.0, 1},
+              {0.7, 16, 1e-4, 3000}};
+  ContextOptions o;
+  o.dt = dt;
+  o.threads = 1;
+  Context ctx(o);
+  Group& g = ctx.createGroup("g", 1 << 20);
+  g.addEmitter(e);
+  for (int step = 0; step < 30; ++step) {
+    const double t0 = double(step) * dt, t1 = t0 + dt;
+    std::uint64_t expected = 0;
+    for (const Burst& b : e.bursts)
+      for (std::uint32_t r = 0; r < b.repeat; ++r) {
+        const double tb = b.time + r * b.interval;
+        if (tb >= t0 && tb < t1 && tb >= e.start && tb <= e.stop) expected += b.count;
+      }
+    const std::uint64_t before = g.stats().emitted;
+    ctx.step();
+    EXPECT_EQ(g.stats().emitted - before, expected) << "step " << step;
+  }
+}
+
+namespace {
+// A group of 1000 fed by `e` for three steps: full, and the rest counted as dropped.
+void expectFillsTheGroup(const Emitter& e) {
+  ContextOptions o;
+  o.dt = 0.1;
+  o.threads = 1;
+  Context ctx(o);
+  Group& g = ctx.createGroup("g", 1000);
+  g.addEmitter(e);
+  ctx.run(3);
+  const GroupStats& s = g.stats();
+  EXPECT_EQ(g.size(), 1000u);
+  EXPECT_GT(s.droppedAtCapacity, 0u);
+  EXPECT_EQ(s.emitted, g.size() + s.droppedAtCapacity);
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const Vec3 p = g.particle(i).position;
+    ASSERT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
+  }
+}
+}  // namespace
+
+TEST(Emitter, RatePast2To64FillsTheGroup) {
+  // 1e25/s is 1e24 births a step: converted to an integer it emitted nothing.
+  Emitter e;
+  e.rate = 1e25;
+  expectFillsTheGroup(e);
+}
+
+TEST(Emitter, SpacingAsksPast2To64FillsTheGroup) {
+  // 0.1 units a step at 1e-30 apart: converted to an integer it emitted one a step.
+  Emitter e;
+  e.velocity = Vec3(1, 0, 0);
+  e.spacing = 1e-30f;
+  expectFillsTheGroup(e);
+}
+
+TEST(Emitter, BurstsAskingPast2To64FillTheGroup) {
+  // Two bursts of 2^32 - 1 particles each fired 2^32 - 1 times in the first step: more
+  // than 2^64 births together.
+  Emitter e;
+  const std::uint32_t most = 0xFFFFFFFFu;
+  e.bursts = {{0.0, most, 1e-12, most}, {0.0, most, 1e-12, most}};
+  expectFillsTheGroup(e);
 }

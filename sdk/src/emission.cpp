@@ -267,27 +267,107 @@ void emitOneByOne(const NewbornContext& nc, const BirthRun& run, const Emitter& 
 
 // ---- Planning: who is born this step, by which emitter, when -----------------------------
 
-// The births of one emitter (static or live) over (t0, t1]: its rate, its bursts in
-// [t0, t1), and one birth per `spacing` of the path it travels.
-std::uint64_t planEmitter(const Emitter& em, EmitterState& state, bool live, std::uint32_t index,
-                          double t0, double t1, std::vector<BirthRun>& runs) {
+// The most births one step of a group counts, all its emitters together. No group holds
+// more than 2^32 particles, so nothing that could be created is lost; what an absurd rate,
+// spacing or burst asks for beyond it (rate 1e25 is 1.7e23 births a step) is neither
+// created nor counted, and the 64-bit statistics cannot overflow.
+constexpr std::uint64_t kMaxStepBirths = std::uint64_t(1) << 40;
+
+// Below 2^53 a count since the emitter's start is an exact double: rates count exactly.
+constexpr double kExactCount = 9007199254740992.0;
+
+// A double count (floored) as an integer, at most `limit`: converting a double past 2^64
+// (or NaN) to an integer is undefined behaviour.
+std::uint64_t clampCount(double x, std::uint64_t limit) {
+  if (!(x >= 1.0)) return 0;
+  if (x >= double(limit)) return limit;
+  return std::min(limit, std::uint64_t(x));
+}
+
+// The runs of one step (or of one prime emitter's spawns) and their births so far. Once
+// `written` births are planned the rest can never be created (the group holds no more), so
+// later runs are merged into the last one: the runs stay at most `written` long however
+// many bursts fire, and the counts stay right.
+struct Plan {
+  std::vector<BirthRun>& runs;
+  std::uint64_t written;
   std::uint64_t total = 0;
+
+  std::uint64_t room() const { return kMaxStepBirths - total; }
+  // `run.count` is at most room().
+  void add(const BirthRun& run) {
+    if (run.count == 0) return;
+    if (total >= written && !runs.empty())
+      runs.back().count += run.count;
+    else
+      runs.push_back(run);
+    total += run.count;
+  }
+};
+
+// The first r in [0, n) with pred(r), or n: pred is false then true as r grows.
+template <class Pred>
+std::uint64_t firstWhere(std::uint64_t n, Pred pred) {
+  std::uint64_t lo = 0, hi = n;
+  while (lo < hi) {
+    const std::uint64_t mid = lo + (hi - lo) / 2;
+    if (pred(mid))
+      hi = mid;
+    else
+      lo = mid + 1;
+  }
+  return lo;
+}
+
+// The births of one emitter (static or live) over (t0, t1]: its rate, its bursts in
+// [t0, t1), and one birth per `spacing` of the path it travels. Returns the births counted.
+std::uint64_t planEmitter(const Emitter& em, EmitterState& state, bool live, std::uint32_t index,
+                          double t0, double t1, Plan& plan) {
+  const std::uint64_t before = plan.total;
   if (em.rate > 0) {
-    const std::uint64_t target = producedBy(em, t1);
-    if (target > state.emittedByRate) {
-      runs.push_back(
-          {BirthRun::Rate, live, index, state.emittedByRate, 0.0, target - state.emittedByRate});
-      total += target - state.emittedByRate;
-      state.emittedByRate = target;
+    const double elapsed = std::min(t1, em.stop) - em.start;
+    if (elapsed <= 0 || em.rate * elapsed < kExactCount) {
+      const std::uint64_t target = producedBy(em, t1);
+      if (target > state.emittedByRate) {
+        const std::uint64_t n = std::min(target - state.emittedByRate, plan.room());
+        plan.add({BirthRun::Rate, live, index, state.emittedByRate, 0.0, n});
+        state.emittedByRate = target;
+      }
+    } else {
+      // Past 2^53 births since the start no integer count is exact: this step's births are
+      // the rate times its time, evenly spaced 1/rate apart from its start (as a run of
+      // evenly spaced times, which a Distance run is).
+      const double x1 = em.rate * elapsed;
+      const double x0 = em.rate * std::max(0.0, std::min(t0, em.stop) - em.start);
+      const std::uint64_t n =
+          clampCount(std::floor(x1 - std::max(x0, double(state.emittedByRate))), plan.room());
+      if (n > 0) {
+        BirthRun run{BirthRun::Distance, live, index, 0, std::max(t0, em.start), n};
+        run.s0 = run.spacing = 1.0 / em.rate;
+        run.span = run.dt = 1.0;
+        plan.add(run);
+      }
+      state.emittedByRate = clampCount(x1, ~std::uint64_t(0));
     }
   }
+  const double lo = std::max(t0, em.start);
   for (const Burst& b : em.bursts) {
-    for (std::uint32_t r = 0; r < b.repeat; ++r) {
-      const double tb = b.time + r * b.interval;
-      if (tb >= t0 && tb < t1 && tb >= em.start && tb <= em.stop && b.count > 0) {
-        runs.push_back({BirthRun::Burst, live, index, 0, tb, b.count});
-        total += b.count;
+    if (b.count == 0) continue;
+    // Occurrence r fires at b.time + r·interval, which never decreases with r: the ones in
+    // [lo, t1) and not after the stop are one range, found by bisection whatever `repeat`.
+    const auto at = [&](std::uint64_t r) { return b.time + double(r) * b.interval; };
+    const std::uint64_t r0 = firstWhere(b.repeat, [&](std::uint64_t r) { return at(r) >= lo; });
+    const std::uint64_t r1 =
+        firstWhere(b.repeat, [&](std::uint64_t r) { return at(r) >= t1 || at(r) > em.stop; });
+    for (std::uint64_t r = r0; r < r1 && plan.room() > 0; ++r) {
+      std::uint64_t n = std::min<std::uint64_t>(b.count, plan.room());
+      if (plan.total >= plan.written) {
+        // None of the rest can be created: count them at once, in the last run.
+        const std::uint64_t left = r1 - r;
+        n = left > plan.room() / b.count ? plan.room() : left * b.count;
+        r = r1 - 1;
       }
+      plan.add({BirthRun::Burst, live, index, 0, at(r), n});
     }
   }
   if (em.spacing > 0) {
@@ -297,21 +377,28 @@ std::uint64_t planEmitter(const Emitter& em, EmitterState& state, bool live, std
       // Births at distances spacing - travelled, + spacing, ... along this step's path.
       const double s0 = em.spacing - state.travelled;
       if (span >= s0) {
-        const auto count = std::uint64_t(std::floor((span - s0) / em.spacing)) + 1;
-        BirthRun run{BirthRun::Distance, live, index, 0, a, count};
-        run.s0 = s0;
-        run.spacing = em.spacing;
-        run.span = span;
-        run.dt = b - a;
-        runs.push_back(run);
-        total += count;
-        state.travelled = span - (s0 + double(count - 1) * em.spacing);
+        const double gaps = std::floor((span - s0) / em.spacing);  // births after the first
+        if (plan.room() > 0) {
+          const std::uint64_t count = clampCount(gaps, plan.room() - 1) + 1;
+          BirthRun run{BirthRun::Distance, live, index, 0, a, count};
+          run.s0 = s0;
+          run.spacing = em.spacing;
+          run.span = span;
+          run.dt = b - a;
+          plan.add(run);
+        }
+        state.travelled = span - (s0 + gaps * em.spacing);
+        // Past 2^53 gaps the product is rounded: keep what is left of a gap a part of one.
+        if (!(gaps < kExactCount))
+          state.travelled = std::isfinite(state.travelled)
+                                ? std::clamp(state.travelled, 0.0, double(em.spacing))
+                                : 0.0;
       } else {
         state.travelled += span;
       }
     }
   }
-  return total;
+  return plan.total - before;
 }
 
 // Exact motion under constant acceleration and linear drag over time t.
@@ -329,27 +416,50 @@ void fly(const EmitterSpec& spec, Vec3 p0, Vec3 v0, double t, Vec3& p, Vec3& v) 
   }
 }
 
-void spawn(GroupImpl& g, const StepParams& sp, std::shared_ptr<const EmitterSpec> spec,
-           double birth, Vec3 place, Vec3 parentVelocity, std::uint32_t generation,
-           const Domain* shape) {
-  const std::uint32_t id = g.nextEmitterId++;
-  Random rng(sp.seed, id, g.index, stream::kEmitterEvent);
-  LiveEmitter e;
-  e.id = id;
-  e.position = place + (shape ? shape->sample(rng) : Vec3(0.0f));
-  e.velocity = spec->velocity.sample(rng) + parentVelocity * spec->inheritVelocity;
-  const double life = std::max(1e-6f, spec->lifetime.sample(rng));
-  e.birth = birth;
-  e.death = birth + life;
-  e.generation = generation;
-  e.emitter = spec->emitter;
-  e.emitter.start = birth;
-  e.emitter.stop = std::min(e.death, birth + (spec->emitter.stop - spec->emitter.start));
-  for (Burst& b : e.emitter.bursts) b.time += birth;  // a spec's bursts are timed from birth
-  e.spec = spec.get();
-  e.keepAlive = std::move(spec);
-  g.live.push_back(std::move(e));
-  ++g.stats.emittersSpawned;
+// Room for one more live emitter of prime emitter `prime`: its own limit, and the group's
+// storage grown (geometrically, never past the sum of the limits) so that spawning never
+// allocates without bound.
+bool reserveLive(GroupImpl& g, std::uint32_t prime) {
+  if (g.primeLive[prime] >= g.primes[prime].maxEmitters) return false;
+  if (g.live.size() == g.live.capacity()) {
+    std::size_t limit = 0;
+    for (const PrimeEmitter& p : g.primes) limit += p.maxEmitters;
+    g.live.reserve(std::min(limit, std::max<std::size_t>(16, 2 * g.live.capacity())));
+  }
+  return true;
+}
+
+// Spawns up to `count` emitters of prime emitter `prime` at `birth` (as many as its limit
+// leaves room for); the rest are counted dropped. Returns how many were spawned.
+std::uint64_t spawn(GroupImpl& g, const StepParams& sp, std::uint32_t prime,
+                    const std::shared_ptr<const EmitterSpec>& spec, std::uint64_t count,
+                    double birth, Vec3 place, Vec3 parentVelocity, std::uint32_t generation,
+                    const Domain* shape) {
+  std::uint64_t made = 0;
+  for (; made < count && reserveLive(g, prime); ++made) {
+    const std::uint32_t id = g.nextEmitterId++;
+    Random rng(sp.seed, id, g.index, stream::kEmitterEvent);
+    LiveEmitter e;
+    e.id = id;
+    e.prime = prime;
+    e.position = place + (shape ? shape->sample(rng) : Vec3(0.0f));
+    e.velocity = spec->velocity.sample(rng) + parentVelocity * spec->inheritVelocity;
+    const double life = std::max(1e-6f, spec->lifetime.sample(rng));
+    e.birth = birth;
+    e.death = birth + life;
+    e.generation = generation;
+    e.emitter = spec->emitter;
+    e.emitter.start = birth;
+    e.emitter.stop = std::min(e.death, birth + (spec->emitter.stop - spec->emitter.start));
+    for (Burst& b : e.emitter.bursts) b.time += birth;  // a spec's bursts are timed from birth
+    e.spec = spec.get();
+    e.keepAlive = spec;
+    g.live.push_back(std::move(e));
+    ++g.primeLive[prime];
+  }
+  g.stats.emittersSpawned += made;
+  g.stats.emittersDropped += count - made;
+  return made;
 }
 
 void countGeneration(GroupImpl& g, std::uint32_t generation, std::uint64_t n) {
@@ -362,11 +472,10 @@ void countGeneration(GroupImpl& g, std::uint32_t generation, std::uint64_t n) {
 
 std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, std::vector<BirthRun>& runs) {
   const double t0 = sp.time, t1 = sp.time + sp.dt;
-  std::uint64_t total = 0;
+  Plan plan{runs, g.capacity};
   for (std::uint32_t e = 0; e < g.emitters.size(); ++e) {
-    const std::uint64_t n = planEmitter(g.emitters[e], g.emitterState[e], false, e, t0, t1, runs);
+    const std::uint64_t n = planEmitter(g.emitters[e], g.emitterState[e], false, e, t0, t1, plan);
     countGeneration(g, 0, n);
-    total += n;
   }
   // Prime emitters spawn emitters at their birth times, where the prime was then.
   if (g.primeSpecs.size() != g.primes.size()) {
@@ -374,20 +483,29 @@ std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, std::vector<BirthRu
     for (const PrimeEmitter& p : g.primes)
       g.primeSpecs.push_back(std::make_shared<EmitterSpec>(p.child));
   }
-  for (std::size_t k = 0; k < g.primes.size(); ++k) {
+  // Scratch kept between steps: a prime emitter's runs stop growing at its free room.
+  thread_local Emitter counter;  // a prime emitter counts like an emitter
+  thread_local std::vector<BirthRun> spawnStore;
+  for (std::uint32_t k = 0; k < g.primes.size(); ++k) {
     const PrimeEmitter& prime = g.primes[k];
-    Emitter counter;  // counts like an emitter
     counter.rate = prime.rate;
     counter.bursts = prime.bursts;
     counter.start = prime.start;
     counter.stop = prime.stop;
-    std::vector<BirthRun> spawns;
+    spawnStore.clear();
+    const std::uint64_t room =
+        prime.maxEmitters > g.primeLive[k] ? prime.maxEmitters - g.primeLive[k] : 0;
+    Plan spawns{spawnStore, room};
     planEmitter(counter, g.primeState[k], false, 0, t0, t1, spawns);
-    for (const BirthRun& run : spawns)
-      for (std::uint64_t q = 0; q < run.count; ++q) {
+    for (const BirthRun& run : spawnStore) {
+      std::uint64_t q = 0;
+      for (; q < run.count && g.primeLive[k] < prime.maxEmitters; ++q) {
         const double tb = birthTime(run, counter, q);
-        spawn(g, sp, g.primeSpecs[k], tb, prime.positionAt(tb), prime.velocity, 1, &prime.shape);
+        spawn(g, sp, k, g.primeSpecs[k], 1, tb, prime.positionAt(tb), prime.velocity, 1,
+              &prime.shape);
       }
+      g.stats.emittersDropped += run.count - q;  // no room left: counted, not spawned
+    }
   }
   // Live emitters (those spawned just now too, and their death children): move, emit, die.
   for (std::size_t k = 0; k < g.live.size(); ++k) {
@@ -401,32 +519,34 @@ std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, std::vector<BirthRu
     // This step's curved flight as three keys: births inside the step sit on it.
     e.emitter.path = {{a, e.position}, {0.5 * (a + b), pm}, {b, pb}};
     if (!(b > a)) e.emitter.path.resize(1);
-    const std::uint64_t n =
-        planEmitter(e.emitter, e.state, true, std::uint32_t(k), a, b + 1e-12, runs);
-    countGeneration(g, e.generation, n);
-    total += n;
+    std::uint64_t n = planEmitter(e.emitter, e.state, true, std::uint32_t(k), a, b + 1e-12, plan);
     e.position = pb;
     e.velocity = vb;
     if (e.death <= t1) {
       const EmitterSpec& spec = *e.spec;
-      if (spec.deathBurst > 0) {
-        runs.push_back({BirthRun::Burst, true, std::uint32_t(k), 0, e.death, spec.deathBurst});
-        countGeneration(g, e.generation, spec.deathBurst);
-        total += spec.deathBurst;
-      }
-      // spawn() grows g.live, which moves `e`: take what the children need first.
+      const std::uint64_t burst = std::min<std::uint64_t>(spec.deathBurst, plan.room());
+      plan.add({BirthRun::Burst, true, std::uint32_t(k), 0, e.death, burst});
+      n += burst;
+      // spawn() grows g.live, which may move `e`: take what the children need first. A
+      // dying emitter holds its place until the step ends, so live emitters never outnumber
+      // the limit.
       const double death = e.death;
-      const std::uint32_t generation = e.generation + 1;
-      for (std::uint32_t c = 0; c < spec.deathChildren; ++c)
-        spawn(g, sp, spec.next, death, pb, vb, generation, nullptr);
+      const std::uint32_t generation = e.generation + 1, prime = e.prime;
+      if (spec.deathChildren > 0)
+        spawn(g, sp, prime, spec.next, spec.deathChildren, death, pb, vb, generation, nullptr);
     }
+    countGeneration(g, g.live[k].generation, n);
   }
-  return total;
+  return plan.total;
 }
 
 // Live emitters that died this step go after their last births are written.
 void retireDead(GroupImpl& g, double t1) {
-  std::erase_if(g.live, [&](const LiveEmitter& e) { return e.death <= t1; });
+  std::erase_if(g.live, [&](const LiveEmitter& e) {
+    if (e.death > t1) return false;
+    --g.primeLive[e.prime];
+    return true;
+  });
 }
 
 void emitAndCompact(GroupImpl& g, const StepParams& sp) {

@@ -12,7 +12,9 @@
 namespace flurry::detail {
 
 /// One run of births of one emitter: by rate (birth times first/rate apart), a burst, or by
-/// distance travelled (births `spacing` apart along the step's path).
+/// distance travelled (births `spacing` apart along the step's path; also a rate past 2^53
+/// births, as evenly spaced times). Runs past the group's capacity are merged into the last:
+/// their births are never written, only counted.
 struct BirthRun {
   enum Kind { Rate, Burst, Distance } kind;
   bool live;  ///< the emitter is g.live[index], else g.emitters[index]
@@ -24,8 +26,10 @@ struct BirthRun {
 };
 
 /// This step's runs, in birth order (emitters, then live emitters with their death bursts);
-/// advances the emitters' state, spawns and moves live emitters, counts generations.
-/// Returns the births planned.
+/// advances the emitters' state, spawns (up to each prime's maxEmitters) and moves live
+/// emitters, counts generations. Returns the births planned: at most 2^40, and the runs
+/// hold at most `capacity` of them one by one, so a step costs the same whatever the
+/// bursts' `repeat`, rates and spacings.
 std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, std::vector<BirthRun>& runs);
 
 /// Drops the live emitters that died by t1 (after their last births are written).

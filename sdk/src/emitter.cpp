@@ -7,7 +7,9 @@
 namespace flurry {
 
 namespace {
-bool finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite(Vec3 v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 }  // namespace
 
 Vec3 Emitter::positionAt(double t) const {
@@ -41,7 +43,8 @@ void Emitter::validate(const std::string& where) const {
   for (std::size_t i = 0; i < path.size(); ++i) {
     const std::string f = "path[" + std::to_string(i) + "]";
     if (!std::isfinite(path[i].time) || !finite(path[i].position)) fail(f, "not finite");
-    if (i > 0 && path[i].time <= path[i - 1].time) fail(f + ".time", "keyframe times must increase");
+    if (i > 0 && path[i].time <= path[i - 1].time)
+      fail(f + ".time", "keyframe times must increase");
   }
   if (types.empty()) fail("types", "an emitter needs at least one particle type");
   double total = 0;
@@ -50,7 +53,8 @@ void Emitter::validate(const std::string& where) const {
     const std::string f = "types[" + std::to_string(i) + "]";
     if (!std::isfinite(t.weight) || t.weight < 0) fail(f + ".weight", "must be finite and >= 0");
     total += t.weight;
-    const std::string fs[] = {f + ".alpha", f + ".size", f + ".mass", f + ".lifetime", f + ".charge"};
+    const std::string fs[] = {f + ".alpha", f + ".size", f + ".mass", f + ".lifetime",
+                              f + ".charge"};
     const Fuzzy* vals[] = {&t.alpha, &t.size, &t.mass, &t.lifetime, &t.charge};
     for (int k = 0; k < 5; ++k) vals[k]->validate((where + "." + fs[k]).c_str());
     if (t.lifetime.center <= 0) fail(f + ".lifetime", "must be > 0");
@@ -96,6 +100,7 @@ void PrimeEmitter::validate(const std::string& where) const {
   e.start = start;
   e.stop = stop;
   e.validate(where);
+  if (maxEmitters < 1) throw InvalidArgument(where + ".maxEmitters", "must be >= 1");
   child.validate(where + ".child");
 }
 

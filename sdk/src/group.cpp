@@ -235,6 +235,7 @@ PrimeEmitter& Group::addPrimeEmitter(PrimeEmitter prime) {
   prime.validate("primeEmitters[" + std::to_string(impl_->primes.size()) + "]");
   impl_->primes.push_back(std::move(prime));
   impl_->primeState.emplace_back();
+  impl_->primeLive.push_back(0);
   return impl_->primes.back();
 }
 

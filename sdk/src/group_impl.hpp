@@ -79,7 +79,8 @@ struct LiveEmitter {
   Vec3 position{0.0f}, velocity{0.0f};           ///< at the start of the current step
   double birth = 0.0, death = 0.0;
   std::uint32_t generation = 1;
-  std::uint32_t id = 0;  ///< keys its random numbers
+  std::uint32_t id = 0;     ///< keys its random numbers
+  std::uint32_t prime = 0;  ///< the prime emitter whose limit it counts against
 };
 
 struct GroupImpl;
@@ -110,7 +111,8 @@ struct GroupImpl {
   std::vector<PrimeEmitter> primes;
   std::vector<EmitterState> primeState;
   std::vector<std::shared_ptr<const EmitterSpec>> primeSpecs;  ///< primes[k].child, shared
-  std::vector<LiveEmitter> live;
+  std::vector<LiveEmitter> live;         ///< grown only up to the primes' maxEmitters together
+  std::vector<std::uint32_t> primeLive;  ///< live emitters of each prime emitter
   std::uint32_t nextEmitterId = 0;
   HairOptions hair;
   Strands strands;

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "flurry/effect.hpp"
 #include "flurry/flurry.hpp"
 
 using namespace flurry;
@@ -86,6 +87,71 @@ TEST(PrimeEmitter, SpawnedEmittersFlyBallistically) {
   EXPECT_NEAR(p.y, 0.0f, 1e-3f);
 }
 
+TEST(PrimeEmitter, LiveEmittersAreBoundedByDefault) {
+  // 1e6 spawns a second with nothing to end them grew without bound (1e7: bad_alloc).
+  ContextOptions o;
+  o.dt = 1.0 / 30.0;
+  o.threads = 1;
+  Context ctx(o);
+  Group& g = ctx.createGroup("g", 1000);
+  PrimeEmitter prime;
+  prime.rate = 1e6;
+  prime.child.lifetime = 100.0f;
+  g.addPrimeEmitter(prime);
+  ctx.run(3);
+  EXPECT_EQ(g.liveEmitterCount(), 4096u);
+  EXPECT_EQ(g.stats().emittersSpawned, 4096u);
+}
+
+TEST(PrimeEmitter, MaxEmittersDropsAndCountsSpawnsPastIt) {
+  ContextOptions o;
+  o.dt = 0.1;
+  o.threads = 1;
+  Context ctx(o);
+  Group& g = ctx.createGroup("g", 1000);
+  auto next = std::make_shared<EmitterSpec>();
+  next->lifetime = 10.0f;
+  PrimeEmitter prime;
+  prime.maxEmitters = 8;
+  prime.bursts = {{0.0, 3, 0.0, 1}};
+  prime.child.lifetime = 0.25f;  // all three die in the third step
+  prime.child.deathChildren = 2;
+  prime.child.next = next;
+  g.addPrimeEmitter(prime);
+  ctx.step();
+  EXPECT_EQ(g.liveEmitterCount(), 3u);
+  ctx.run(2);
+  // The dying three hold their places until the step ends: room for 5 of their 6 children.
+  EXPECT_EQ(g.liveEmitterCount(), 5u);
+  EXPECT_EQ(g.stats().emittersSpawned, 8u);
+  EXPECT_EQ(g.stats().emittersDropped, 1u);
+  // A rate of 1e7 a second adds nothing past the limit, and counts what it drops.
+  // A second prime emitter has its own limit.
+  PrimeEmitter fast;
+  fast.maxEmitters = 100;
+  fast.rate = 1e7;
+  fast.start = 0.3;
+  fast.child.lifetime = 100.0f;
+  g.addPrimeEmitter(fast);
+  ctx.run(3);
+  EXPECT_EQ(g.liveEmitterCount(), 105u);
+  EXPECT_EQ(g.stats().emittersSpawned, 108u);
+  EXPECT_EQ(g.stats().emittersDropped, 1u + 3u * 1'000'000u - 100u);
+  PrimeEmitter zero;
+  zero.maxEmitters = 0;
+  EXPECT_THROW(g.addPrimeEmitter(zero), InvalidArgument);
+}
+
+TEST(PrimeEmitter, MaxEmittersFromAnEffectFile) {
+  const Effect fx = parseEffect(R"({"version": 1, "groups": [{"capacity": 10,
+      "primeEmitters": [{"rate": 1, "maxEmitters": 12, "child": {}}]}]})");
+  ASSERT_EQ(fx.groups.at(0).primeEmitters.size(), 1u);
+  EXPECT_EQ(fx.groups[0].primeEmitters[0].maxEmitters, 12u);
+  EXPECT_THROW(parseEffect(R"({"version": 1, "groups": [{"capacity": 10,
+      "primeEmitters": [{"rate": 1, "maxEmitters": 0, "child": {}}]}]})"),
+               EffectError);
+}
+
 TEST(Emitter, ByDistanceLeavesAnEvenTrailAtAnySpeed) {
   for (float speed : {1.0f, 100.0f, 1e4f}) {
     ContextOptions o;
@@ -166,7 +232,8 @@ TEST(Hair, StrandsHoldEachParticlesWholeLife) {
 }
 
 TEST(UnionDomain, SamplesAllPartsByMeasure) {
-  const Domain u = Domain::unite({Domain::box(Vec3(0), Vec3(1)), Domain::box(Vec3(10, 0, 0), Vec3(13, 1, 1))});
+  const Domain u =
+      Domain::unite({Domain::box(Vec3(0), Vec3(1)), Domain::box(Vec3(10, 0, 0), Vec3(13, 1, 1))});
   EXPECT_NEAR(u.measure(), 4.0, 1e-6);
   Random rng(5, 0, 0, 0);
   int inSecond = 0;

@@ -16,19 +16,22 @@ namespace flurry {
 /// One kind of particle an emitter creates. Vector attributes are drawn from domains
 /// (a point domain gives a constant), scalars from fuzzy values.
 struct ParticleType {
-  float weight = 1.0f;                         ///< relative share of this type
+  float weight = 1.0f;                          ///< relative share of this type
   Domain velocity = Domain::point(Vec3(0.0f));  ///< initial velocity, units/s
   Domain color = Domain::point(Vec3(1.0f));     ///< rgb
   Fuzzy alpha = 1.0f;
-  Fuzzy size = 0.05f;     ///< radius, scene units
+  Fuzzy size = 0.05f;  ///< radius, scene units
   Fuzzy mass = 1.0f;
-  Fuzzy lifetime = 5.0f;  ///< seconds (the seed's "60 frames ± 25%" is Fuzzy::percent(2, 25) at 30 fps)
+  Fuzzy lifetime =
+      5.0f;  ///< seconds (the seed's "60 frames ± 25%" is Fuzzy::percent(2, 25) at 30 fps)
   Fuzzy charge = 0.0f;
   Domain up = Domain::point(Vec3(0.0f, 1.0f, 0.0f));
   Domain rotVelocity = Domain::point(Vec3(0.0f));
 };
 
-/// `count` particles at `time`, repeated `repeat` times every `interval` seconds.
+/// `count` particles at `time`, repeated `repeat` times every `interval` seconds. A step
+/// finds its occurrences arithmetically: any `repeat` (up to 2^32 - 1, "forever") costs the
+/// same per step.
 struct Burst {
   double time = 0.0;
   std::uint32_t count = 0;
@@ -46,7 +49,9 @@ struct Emitter {
   std::string name;
   /// Where particles are born, relative to the emitter's current position.
   Domain shape = Domain::point(Vec3(0.0f));
-  /// Particles per second. Fractional rates are exact over time: 10.5/s for 10 s gives 105.
+  /// Particles per second. Fractional rates are exact over time: 10.5/s for 10 s gives 105
+  /// (exact up to 2^53 births since `start`). A step asking for more than the group holds
+  /// fills it and counts the rest as GroupStats::droppedAtCapacity, up to 2^40 a step.
   double rate = 0.0;
   std::vector<Burst> bursts;
   /// The emitter's position at time `start`; it then moves at `velocity`, or follows `path`
@@ -61,7 +66,9 @@ struct Emitter {
   std::vector<ParticleType> types{ParticleType{}};
   /// Emission by distance: one particle per `spacing` units the emitter travels, with birth
   /// times and places interpolated inside the step, so a fast emitter leaves an even trail
-  /// with no gaps. 0 turns it off. Adds to `rate` and `bursts`.
+  /// with no gaps. 0 turns it off. Adds to `rate` and `bursts`. A spacing so small that a
+  /// step asks for more births than the group holds fills the group from the start of the
+  /// step's path, and counts the rest as dropped (up to 2^40 a step).
   float spacing = 0.0f;
   /// Adds the shape's outward normal where each particle is born, times this speed, to its
   /// velocity: every face of a polyhedron (Domain::mesh) emits along its normal.
@@ -94,6 +101,12 @@ struct EmitterSpec {
 
 /// An emitter that emits emitters (the seed's "prime" or "super" emitter). It moves and
 /// counts like an Emitter; each birth is an emitter of `child`.
+///
+/// Like a group's particles, its live emitters have a capacity: at most `maxEmitters` of
+/// them (its children and all their descendants, every level together) live at once. A
+/// spawn past it (by rate, burst or `deathChildren`) is dropped and counted in
+/// GroupStats::emittersDropped. A dying emitter keeps its place until the end of the step
+/// it dies in, so its `deathChildren` need room beside it.
 struct PrimeEmitter {
   std::string name;
   Domain shape = Domain::point(Vec3(0.0f));
@@ -105,6 +118,9 @@ struct PrimeEmitter {
   double start = 0.0;
   double stop = std::numeric_limits<double>::infinity();
   EmitterSpec child;
+  /// The most live emitters this prime emitter's showers hold at once (>= 1). Their storage
+  /// grows as they spawn, never past the group's primes' maxEmitters together.
+  std::uint32_t maxEmitters = 4096;
 
   Vec3 positionAt(double t) const;
   void validate(const std::string& where = "primeEmitter") const;

@@ -44,17 +44,22 @@ struct Particle {
 /// group's action list, and kept as a strand; the group itself holds no live particles.
 struct HairOptions {
   bool enabled = false;
-  std::uint32_t every = 1;           ///< a vertex every N steps of the particle's life
-  std::uint32_t maxVertices = 256;   ///< a strand ends here if the particle lives on
+  std::uint32_t every = 1;          ///< a vertex every N steps of the particle's life
+  std::uint32_t maxVertices = 256;  ///< a strand ends here if the particle lives on
 };
 
 /// Where the particles went:
 /// emitted == size() + killedByAge + absorbed + droppedAtCapacity + killedNonFinite.
 struct GroupStats {
-  std::uint64_t emitted = 0;            ///< created by emitters or add(), dropped ones included
-  std::uint64_t killedByAge = 0;        ///< by KillOld
-  std::uint64_t absorbed = 0;           ///< by Sink (and other absorbers)
-  std::uint64_t droppedAtCapacity = 0;  ///< not created: the group was full
+  /// Created by emitters or add(), dropped ones included. A step counts at most 2^40 births
+  /// of a group's emitters together: a rate of 1e25/s or a spacing of 1e-30 asks for more
+  /// than any group holds (at most 2^32), and what is asked beyond 2^40 is neither created
+  /// nor counted.
+  std::uint64_t emitted = 0;
+  std::uint64_t killedByAge = 0;  ///< by KillOld
+  std::uint64_t absorbed = 0;     ///< by Sink (and other absorbers)
+  /// Counted in `emitted` but not created: the group was full (within the 2^40 a step).
+  std::uint64_t droppedAtCapacity = 0;
   /// Killed because a step left their position or velocity NaN or infinite (an extreme
   /// input, a user callback): counted, never propagated.
   std::uint64_t killedNonFinite = 0;
@@ -63,6 +68,8 @@ struct GroupStats {
   /// emitters a prime emitter spawned, 2 from their children, ...
   std::vector<std::uint64_t> emittedByGeneration;
   std::uint64_t emittersSpawned = 0;  ///< by prime emitters and death spawns, all levels
+  /// Not spawned: the prime emitter already had PrimeEmitter::maxEmitters live emitters.
+  std::uint64_t emittersDropped = 0;
 };
 
 struct Bounds {

@@ -606,6 +606,7 @@ PrimeEmitter readPrime(const json& j, const std::string& path, const Loader& L) 
   PrimeEmitter p;
   readCounting(o, p);
   p.child = *readSpec(o.require("child", "the emitters it emits"), o.at("child"), L);
+  o.opt("maxEmitters", p.maxEmitters);
   o.finish();
   try {
     p.validate(path);
