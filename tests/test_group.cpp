@@ -1,5 +1,7 @@
-#include <fstream>
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <fstream>
 
 #include <algorithm>
 #include <cstring>
@@ -117,6 +119,62 @@ TEST(Context, RejectsBadGroupsAndFindsThemByName) {
   EXPECT_THROW(ctx.group("b"), Error);
   EXPECT_THROW(ctx.setTimeStep(-1), InvalidArgument);
   EXPECT_THROW(ctx.setTimeStep(INFINITY), InvalidArgument);
+}
+
+TEST(Io, FrameFileNames) {
+  EXPECT_TRUE(isFrameFileName("a.0001.ply", "a", "ply"));
+  EXPECT_TRUE(isFrameFileName("a.b.12345678.ply", "a.b", "ply"));
+  EXPECT_TRUE(isFrameFileName("a.-001.ply", "a", "ply"));
+  EXPECT_FALSE(isFrameFileName("a.0001.ply", "b", "ply"));
+  EXPECT_FALSE(isFrameFileName("a.0001.png", "a", "ply"));
+  EXPECT_FALSE(isFrameFileName("a..ply", "a", "ply"));
+  EXPECT_FALSE(isFrameFileName("a.-.ply", "a", "ply"));
+  EXPECT_FALSE(isFrameFileName("a.00x1.ply", "a", "ply"));
+  EXPECT_FALSE(isFrameFileName("a0001.ply", "a", "ply"));
+  EXPECT_FALSE(isFrameFileName("ab.0001.ply", "a", "ply"));
+  EXPECT_FALSE(isFrameFileName("a.0001.plyx", "a", "ply"));
+}
+
+// A writer killed between its write and its rename leaves NAME.tmp.PID; the next run removes
+// those of dead processes whose NAME it would write, and nothing else.
+TEST(Io, StaleTemporariesOfDeadProcessesAreRemoved) {
+  namespace fs = std::filesystem;
+  const fs::path dir =
+      fs::temp_directory_path() / ("flurry_test_stale_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const pid_t child = ::fork();  // a process that has exited and been reaped: not running
+  ASSERT_GE(child, 0);
+  if (child == 0) ::_exit(0);
+  ASSERT_EQ(::waitpid(child, nullptr, 0), child);
+  const std::string dead = std::to_string(child), live = std::to_string(::getpid());
+  // Sorted by name; 4194305 is above any pid_max, so never a running process.
+  const std::vector<std::string> stale = {"f.0001.ply.tmp." + dead, "f.0003.ply.tmp.4194305",
+                                          "g.0002.ply.tmp." + dead};
+  const std::vector<std::string> kept = {"f.0001.ply",
+                                         "f.0002.ply.tmp." + live,
+                                         "f.0002.ply.tmp.1",
+                                         "h.0001.ply.tmp." + dead,  // not an output of this run
+                                         "f.0001.ply.tmp." + dead + ".x",
+                                         "f.0001.ply.tmp.0" + dead,
+                                         "f.0001.ply.tmp.-" + dead,
+                                         "f.0001.ply.tmp.",
+                                         ".tmp." + dead,
+                                         "f.0001.ply.tmp.99999999999999999999"};
+  for (const std::string& n : stale) std::ofstream(dir / n) << "partial";
+  for (const std::string& n : kept) std::ofstream(dir / n) << "x";
+  auto isOutput = [](std::string_view f) {
+    return isFrameFileName(f, "f", "ply") || isFrameFileName(f, "g", "ply");
+  };
+  std::vector<std::string> removed;
+  for (const fs::path& p : removeStaleTemporaries(dir, isOutput))
+    removed.push_back(p.filename().string());
+  std::sort(removed.begin(), removed.end());
+  EXPECT_EQ(removed, stale);
+  for (const std::string& n : stale) EXPECT_FALSE(fs::exists(dir / n)) << n;
+  for (const std::string& n : kept) EXPECT_TRUE(fs::exists(dir / n)) << n;
+  EXPECT_TRUE(removeStaleTemporaries(dir / "missing", isOutput).empty());
+  fs::remove_all(dir);
 }
 
 TEST(Io, PlyIsWrittenAtomicallyAndErrorsNameThePath) {

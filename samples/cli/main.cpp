@@ -158,6 +158,17 @@ int run(const RunOptions& o, std::vector<std::unique_ptr<flurry::cli::Plugin>>& 
   opts.device = o.device;
   flurry::Context ctx(opts);
   fx.build(ctx, o.capacity);
+  if (!o.out.empty()) {  // PLY temporaries that a run killed before its rename left behind
+    const std::vector<flurry::Group*> groups = ctx.groups();
+    const auto removed = flurry::removeStaleTemporaries(o.out, [&](std::string_view f) {
+      for (const flurry::Group* g : groups)
+        if (flurry::isFrameFileName(f, g->name(), "ply")) return true;
+      return false;
+    });
+    if (!o.quiet && !removed.empty())
+      std::printf("removed %zu stale temporary files of an earlier run from %s\n", removed.size(),
+                  o.out.c_str());
+  }
 
   flurry::cli::RunInfo info{fx.name, frames, o.quiet};
   info.effectFile = &fx;

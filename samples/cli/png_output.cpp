@@ -7,6 +7,7 @@
 
 #include "builtin.hpp"
 #include "flurry/effect.hpp"
+#include "flurry/io.hpp"
 #include "flurry/render.hpp"
 #include "flurry/render_viewer.hpp"
 #include "outputs.hpp"
@@ -155,6 +156,12 @@ class PngPlugin : public Plugin {
     std::error_code ec;
     fs::create_directories(dir_, ec);
     if (ec) throw IoError(dir_, "cannot create the --png folder: " + ec.message());
+    // PNG temporaries that a run killed before its rename left behind.
+    const auto removed = removeStaleTemporaries(
+        dir_, [&](std::string_view f) { return isFrameFileName(f, info.effect, "png"); });
+    if (!info.quiet && !removed.empty())
+      std::printf("png: removed %zu stale temporary files of an earlier run from %s\n",
+                  removed.size(), dir_.c_str());
     OffscreenOptions oo;
     parseSize(runLook_.size, oo.width, oo.height);
     oo.samples = samples_;

@@ -51,7 +51,10 @@ class VdbPlugin final : public Plugin {
     so.folder = folder_;
     so.name = info.effect;
     so.content = options_;
-    writer_.emplace(so);
+    writer_.emplace(so);  // removes the temporaries of a run killed mid-write
+    if (!info.quiet && !writer_->removedTemporaries().empty())
+      std::printf("vdb: removed %zu stale temporary files of an earlier run from %s\n",
+                  writer_->removedTemporaries().size(), folder_.c_str());
     for (int f = 1; f <= info.frames; ++f)
       if (due(f)) ++toWrite_;
     tty_ = ::isatty(STDERR_FILENO) == 1;

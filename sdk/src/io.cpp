@@ -1,8 +1,10 @@
 #include "flurry/io.hpp"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <charconv>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -34,6 +36,61 @@ void writeFileAtomic(const std::filesystem::path& path, std::span<const char> by
     fs::remove(tmp, ec);
     throw IoError(path.string(), "rename failed: " + ec.message());
   }
+}
+
+namespace {
+
+bool allDigits(std::string_view s) {
+  if (s.empty()) return false;
+  for (char c : s)
+    if (c < '0' || c > '9') return false;
+  return true;
+}
+
+/// Whether process `pid` may still be running here (EPERM: it is, under another user).
+bool processRunning(pid_t pid) {
+  return pid == ::getpid() || ::kill(pid, 0) == 0 || errno != ESRCH;
+}
+
+}  // namespace
+
+bool isFrameFileName(std::string_view name, std::string_view base, std::string_view ext) {
+  // BASE '.' ['-'] digits '.' EXT
+  if (name.size() < base.size() + ext.size() + 3 || !name.starts_with(base) || !name.ends_with(ext))
+    return false;
+  std::string_view mid = name.substr(base.size(), name.size() - base.size() - ext.size());
+  if (mid.front() != '.' || mid.back() != '.') return false;
+  mid = mid.substr(1, mid.size() - 2);
+  if (mid.starts_with('-')) mid.remove_prefix(1);
+  return allDigits(mid);
+}
+
+std::vector<std::filesystem::path> removeStaleTemporaries(
+    const std::filesystem::path& folder, const std::function<bool(std::string_view)>& isOutput) {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> removed;
+  std::error_code ec;
+  fs::directory_iterator it(folder, ec);
+  if (ec) return removed;
+  constexpr std::string_view kTmp = ".tmp.";
+  for (; it != fs::directory_iterator(); it.increment(ec)) {
+    if (ec) break;
+    const std::string name = it->path().filename().string();
+    const std::size_t at = name.rfind(kTmp);
+    if (at == std::string::npos || at == 0) continue;
+    // The PID exactly as std::to_string writes it: digits, no leading zero, in range.
+    const std::string_view digits = std::string_view(name).substr(at + kTmp.size());
+    if (!allDigits(digits) || digits.front() == '0') continue;
+    pid_t pid = 0;
+    const auto [end, err] = std::from_chars(digits.data(), digits.data() + digits.size(), pid);
+    if (err != std::errc() || end != digits.data() + digits.size() || pid <= 0) continue;
+    if (!isOutput(std::string_view(name).substr(0, at)) || processRunning(pid)) continue;
+    std::error_code typeEc;
+    if (it->symlink_status(typeEc).type() != fs::file_type::regular) continue;  // not a link
+    std::error_code rmEc;
+    if (fs::remove(it->path(), rmEc)) removed.push_back(it->path());
+  }
+  return removed;
 }
 
 void writePly(const Group& group, const std::filesystem::path& path) {

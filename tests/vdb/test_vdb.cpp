@@ -645,6 +645,68 @@ TEST(VdbCrash, KilledBetweenWriteAndRename) {
   std::size_t files = 0;
   for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++files;
   EXPECT_EQ(files, 4u);
+
+  // The next sequence in the folder removes the temporaries of dead processes that match its
+  // own name pattern exactly, and nothing else.
+  const std::string dead = std::to_string(pid), live = std::to_string(::getpid());
+  const std::vector<std::string> stale = {
+      "crash.0004.vdb.tmp." + dead, "crash.-001.vdb.tmp." + dead,
+      "crash.17.vdb.tmp.999999999",  // beyond any pid_max: never a running process
+  };
+  const std::vector<std::string> kept = {
+      "crash.0005.vdb.tmp." + live,  // a running process's (this one)
+      "crash.0005.vdb.tmp.1",        // init's: running
+      "other.0004.vdb.tmp." + dead,  // another sequence's
+      "crash.0004.vdb.tmp." + dead + "x",
+      "crash.0004.vdb.tmp.0" + dead,
+      "crash.0004.vdb.tmp.",
+      "crash.x004.vdb.tmp." + dead,
+      "crash.0004.vdbx.tmp." + dead,
+      "crash.0004.png.tmp." + dead,
+      "xcrash.0004.vdb.tmp." + dead,
+      "crash.0004.vdb.tmp.99999999999999999999",  // not a pid_t
+  };
+  for (const std::string& n : stale) std::ofstream(dir / n) << "partial";
+  for (const std::string& n : kept) std::ofstream(dir / n) << "partial";
+  fs::create_directory(dir / ("crash.0006.vdb.tmp." + dead));  // not a file: kept
+  fs::create_symlink(dir / "crash.0001.vdb", dir / ("crash.0007.vdb.tmp." + dead));
+  {
+    vdb::SequenceOptions so;
+    so.folder = dir;
+    so.name = "crash";
+    vdb::SequenceWriter w(so);
+    std::vector<std::string> removed;
+    for (const fs::path& p : w.removedTemporaries()) removed.push_back(p.filename().string());
+    std::sort(removed.begin(), removed.end());
+    std::vector<std::string> expected = stale;
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(removed, expected);
+    // The sequence goes on where the killed run stopped.
+    Context ctx;
+    w.write(makeGroup(ctx, "g", 100, 0.02f, 0.03f, 14), 4, 0.4);
+    w.finish();
+  }
+  for (const std::string& n : stale) EXPECT_FALSE(fs::exists(dir / n)) << n;
+  for (const std::string& n : kept) EXPECT_TRUE(fs::exists(dir / n)) << n;
+  EXPECT_TRUE(fs::is_directory(dir / ("crash.0006.vdb.tmp." + dead)));
+  EXPECT_TRUE(fs::is_symlink(dir / ("crash.0007.vdb.tmp." + dead)));
+  for (int f = 1; f <= 4; ++f) {
+    char name[32];
+    std::snprintf(name, sizeof name, "crash.%04d.vdb", f);
+    EXPECT_EQ(openvdb::points::pointCount(
+                  VdbFile(dir / name).get<openvdb::points::PointDataGrid>("points")->tree()),
+              100u);
+  }
+
+  // Turned off, nothing is removed.
+  std::ofstream(dir / stale[0]) << "partial";
+  vdb::SequenceOptions so;
+  so.folder = dir;
+  so.name = "crash";
+  so.cleanStaleTemporaries = false;
+  vdb::SequenceWriter w(so);
+  EXPECT_TRUE(w.removedTemporaries().empty());
+  EXPECT_TRUE(fs::exists(dir / stale[0]));
 }
 
 // -------------------------------------------------------------------------- vector fields --

@@ -1,7 +1,8 @@
 // OpenVDB export and import (target flurry::vdb): particles as a fog volume (`density`,
 // `vel`, `Cd` grids) and as a point cloud (a PointDataGrid named `points`), hair strands
 // rasterised into the fog volume, one file per frame written atomically on a background
-// thread, and OpenVDB vector grids read back as a VectorField for the sampled-field force.
+// thread (temporaries that a killed run left are cleaned up by the next sequence), and OpenVDB
+// vector grids read back as a VectorField for the sampled-field force.
 //
 // This header does not include OpenVDB: a game that includes it links flurry::vdb, which
 // links OpenVDB privately.
@@ -91,8 +92,12 @@ struct FileStats {
   double writeSeconds = 0.0;     ///< serialising, writing, syncing, renaming
 };
 
-/// Writes one frame to `path` (written to a temporary name in the same folder, flushed to
-/// disk, then renamed: a reader never sees a torn file). Throws IoError naming the path, or
+/// Writes one frame to `path` (written to `path.tmp.PID` in the same folder, PID this
+/// process's id, flushed to disk, then renamed: a reader never sees a torn file, and a failed
+/// write removes the temporary). A process killed before the rename leaves that complete
+/// temporary behind, never a file under `path`; SequenceWriter removes such leftovers of dead
+/// processes when it starts (SequenceOptions::cleanStaleTemporaries), flurry::
+/// removeStaleTemporaries does it for any folder. Throws IoError naming the path, or
 /// InvalidArgument for a bad option.
 FileStats writeFile(const std::filesystem::path& path, const Frame& frame,
                     const ExportOptions& options = {});
@@ -142,6 +147,11 @@ struct SequenceOptions {
   /// Frames captured but not yet written; write() waits while this many are pending, so
   /// memory stays bounded when the disk is slower than the simulation.
   std::size_t maxPending = 2;
+  /// On construction, delete the temporaries an earlier run killed mid-write left in
+  /// `folder`: only files named exactly `name.N.vdb.tmp.PID` (N a frame number) whose
+  /// process PID is no longer running. PIDs are only meaningful on one machine: turn this
+  /// off for a folder that writers on several machines share.
+  bool cleanStaleTemporaries = true;
 };
 
 /// Writes a sequence of frames on a background thread. write() copies the particles on the
@@ -150,7 +160,8 @@ struct SequenceOptions {
 /// IoError naming the file, by the next write() and by finish().
 class SequenceWriter {
  public:
-  /// Creates the folder; throws IoError naming it if that fails.
+  /// Creates the folder (throws IoError naming it if that fails) and removes stale
+  /// temporaries of this sequence from it (see SequenceOptions::cleanStaleTemporaries).
   explicit SequenceWriter(SequenceOptions options);
   /// Waits for pending frames; never throws (call finish() to see errors).
   ~SequenceWriter();
@@ -173,6 +184,8 @@ class SequenceWriter {
   ExportCost cost() const;
   /// The last file written (empty before the first).
   FileStats last() const;
+  /// The stale temporaries the constructor removed.
+  const std::vector<std::filesystem::path>& removedTemporaries() const;
   /// Waits for every pending frame; throws the first error. Returns the totals.
   ExportCost finish();
 

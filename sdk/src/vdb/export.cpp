@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "detail.hpp"
+#include "flurry/io.hpp"
 
 namespace fs = std::filesystem;
 
@@ -228,6 +229,7 @@ struct SequenceWriter::Impl {
   std::exception_ptr error;
   ExportCost cost;
   FileStats last;
+  std::vector<fs::path> removedTemporaries;
   std::thread worker;
 
   void run() {
@@ -288,6 +290,13 @@ SequenceWriter::SequenceWriter(SequenceOptions options) : impl_(std::make_unique
     throw IoError(
         options.folder.string(),
         "cannot create the output folder: " + (ec ? ec.message() : std::string("not a directory")));
+  // A run killed between write and rename left `name.N.vdb.tmp.PID`: only this sequence's
+  // own temporaries of dead processes go (another writer may be at work in the folder).
+  if (options.cleanStaleTemporaries)
+    impl_->removedTemporaries =
+        removeStaleTemporaries(options.folder, [&name = options.name](std::string_view file) {
+          return isFrameFileName(file, name, "vdb");
+        });
   impl_->options = std::move(options);
   impl_->worker = std::thread([impl = impl_.get()] { impl->run(); });
 }
@@ -355,6 +364,10 @@ std::size_t SequenceWriter::written() const {
 std::size_t SequenceWriter::pending() const {
   std::lock_guard lock(impl_->mutex);
   return impl_->queue.size() + (impl_->busy ? 1 : 0);
+}
+
+const std::vector<fs::path>& SequenceWriter::removedTemporaries() const {
+  return impl_->removedTemporaries;
 }
 
 ExportCost SequenceWriter::cost() const {
