@@ -101,6 +101,20 @@ FL_INLINE void fl_newborn(FL_LANE_PARAMS, uint slot, uint id, float age, float3 
 #ifdef FL_HAS_SIZE
   l_size[slot] = fl_fuzzy_nonneg(&type->size, sizeMode, rng);
 #endif
+  /* What the curves over life scale (emission.cpp store). */
+#if defined(FL_HAS_BIRTH_COLOR) && defined(FL_HAS_COLOR)
+  l_birthr[slot] = l_r[slot];
+  l_birthg[slot] = l_g[slot];
+  l_birthb[slot] = l_b[slot];
+  l_birtha[slot] = l_a[slot];
+#elif defined(FL_HAS_BIRTH_COLOR)
+  l_birthr[slot] = l_birthg[slot] = l_birthb[slot] = l_birtha[slot] = 1.0f;
+#endif
+#if defined(FL_HAS_BIRTH_SIZE) && defined(FL_HAS_SIZE)
+  l_birthsize[slot] = l_size[slot];
+#elif defined(FL_HAS_BIRTH_SIZE)
+  l_birthsize[slot] = 0.05f; /* Particle::size */
+#endif
 #ifdef FL_HAS_MASS
   l_mass[slot] = fl_fuzzy(&type->mass, massMode, rng);
 #endif

@@ -651,3 +651,24 @@ FL_INLINE void fl_size_over_life(__global const FlActionParams* a, __global cons
   fl_force_lookup(extra + a->u[0], a->u[1], 2u, fl_force_life_fraction(age, life), s);
   *size = s[0];
 }
+
+/* Multiply mode: the curve scales the birth colour / size. */
+FL_INLINE void fl_color_over_life_scaled(__global const FlActionParams* a,
+                                         __global const float* extra, float age, float life,
+                                         float r0, float g0, float b0, float a0, float* r, float* g,
+                                         float* b, float* al) {
+  float c[4];
+  fl_force_lookup(extra + a->u[0], a->u[1], 5u, fl_force_life_fraction(age, life), c);
+  *r = r0 * c[0];
+  *g = g0 * c[1];
+  *b = b0 * c[2];
+  *al = a0 * c[3];
+}
+
+FL_INLINE void fl_size_over_life_scaled(__global const FlActionParams* a,
+                                        __global const float* extra, float age, float life,
+                                        float size0, float* size) {
+  float s[1];
+  fl_force_lookup(extra + a->u[0], a->u[1], 2u, fl_force_life_fraction(age, life), s);
+  *size = size0 * s[0];
+}

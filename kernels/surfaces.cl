@@ -373,13 +373,14 @@ FL_INLINE void fl_sink_hit(__global const FlActionParams* a, uint kind, float dt
   if (fl_surf_distance(a, kind, h, shapes) <= 1e-5f * (1.0f + fl_lengthv(h))) fl_kill(code, dead);
 }
 
-/* The particles this action just took survive with probability f[0] (actions_more.hpp
- * passThrough). */
+/* The particles this absorber just took survive if they pass it, decided once per particle
+ * and absorber (actions_more.hpp passThrough, kernels.hpp sinkPasses): key is the group's
+ * stream base + the Sink's index; the stream is flurry::stream::kPassThrough. f[0] passThrough. */
 FL_INLINE void fl_sink_pass(__global const FlActionParams* a, uint id, uint code, uint* dead,
-                            uint seedLo, uint seedHi, uint step, uint stream) {
+                            uint seedLo, uint seedHi, uint key) {
   if (*dead != code) return;
-  FlRandom rng = fl_random(seedLo, seedHi, id, step, stream);
-  if (fl_uniform(&rng) < a->f[0]) *dead = 0u;
+  const uint4 w = fl_philox((uint4)(id, key, 0xFFFF0002u, 0u), seedLo, seedHi);
+  if ((float)(w.x >> 8) * (1.0f / 16777216.0f) < a->f[0]) *dead = 0u;
 }
 
 /* Hides the particles inside the region (actions_more.hpp apply(Block)); the list's first

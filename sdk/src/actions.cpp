@@ -173,7 +173,12 @@ struct Validator {
       require(i == 0 || k[i].t >= k[i - 1].t, "keys", "key times must not decrease");
     }
   }
+  void overLifeMode(OverLifeMode m) const {
+    require(m == OverLifeMode::Multiply || m == OverLifeMode::Replace, "mode",
+            "must be Multiply or Replace");
+  }
   void operator()(const ColorOverLife& a) const {
+    overLifeMode(a.mode);
     keys(a.keys);
     for (const auto& k : a.keys)
       require(std::isfinite(k.color.r) && std::isfinite(k.color.g) && std::isfinite(k.color.b) &&
@@ -181,6 +186,7 @@ struct Validator {
               "keys", "a color is not finite");
   }
   void operator()(const SizeOverLife& a) const {
+    overLifeMode(a.mode);
     keys(a.keys);
     for (const auto& k : a.keys) nonNegative(k.size, "keys");
   }
@@ -262,8 +268,17 @@ struct Uses {
   AttributeSet operator()(const TargetColor&) const { return {A::Color}; }
   AttributeSet operator()(const TargetSize&) const { return {A::Size}; }
   AttributeSet operator()(const SpeedClamp&) const { return {A::Velocity}; }
-  AttributeSet operator()(const ColorOverLife&) const { return {A::Color, A::Age, A::Lifetime}; }
-  AttributeSet operator()(const SizeOverLife&) const { return {A::Size, A::Age, A::Lifetime}; }
+  // Multiply reads the birth value: stored only for the lists that multiply.
+  AttributeSet operator()(const ColorOverLife& a) const {
+    AttributeSet s{A::Color, A::Age, A::Lifetime};
+    if (a.mode == OverLifeMode::Multiply) s.insert(A::BirthColor);
+    return s;
+  }
+  AttributeSet operator()(const SizeOverLife& a) const {
+    AttributeSet s{A::Size, A::Age, A::Lifetime};
+    if (a.mode == OverLifeMode::Multiply) s.insert(A::BirthSize);
+    return s;
+  }
   AttributeSet operator()(const Bounce&) const { return {A::Position, A::Velocity}; }
   AttributeSet operator()(const Sink& a) const {
     AttributeSet s{A::Position};

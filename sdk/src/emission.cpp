@@ -78,6 +78,14 @@ struct Newborn {
   Vec3 up, rot;
 };
 
+// What the curves over life scale: the colour and size just stored (Particle's defaults for
+// a lane not stored).
+void storeBirth(const Lanes& L, std::size_t slot) {
+  for (int c = 0; c < 4; ++c)
+    if (L.birthColor[c]) L.birthColor[c][slot] = L.color[c] ? L.color[c][slot] : 1.0f;
+  if (L.birthSize) L.birthSize[slot] = L.size ? L.size[slot] : Particle().size;
+}
+
 void store(const NewbornContext& nc, std::size_t slot, std::uint32_t id, float age,
            const Newborn& b) {
   const Lanes& L = nc.L;
@@ -99,6 +107,7 @@ void store(const NewbornContext& nc, std::size_t slot, std::uint32_t id, float a
     L.color[3][slot] = b.alpha;
   }
   if (L.size) L.size[slot] = std::max(b.size, 0.0f);
+  storeBirth(L, slot);
   if (L.mass) L.mass[slot] = b.mass;
   if (L.charge) L.charge[slot] = b.charge;
   if (L.age) L.age[slot] = age;
@@ -225,6 +234,8 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
   put(L.mass, attr[12]);
   put(L.charge, attr[13]);
   put(L.age, age);
+  if (L.birthColor[0] || L.birthSize)
+    for (std::size_t k = 0; k < m; ++k) storeBirth(L, slot[k]);
   for (std::size_t k = 0; k < m; ++k) L.id[slot[k]] = firstId + std::uint32_t(k);
   if (L.visible)
     for (std::size_t k = 0; k < m; ++k) L.visible[slot[k]] = 1u;

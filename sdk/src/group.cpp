@@ -13,8 +13,9 @@ namespace flurry {
 
 std::string_view attributeName(Attribute a) {
   static constexpr std::string_view names[] = {
-      "position", "velocity", "color",  "size",    "mass",     "age",      "lifetime",
-      "id",       "prevPosition", "up", "rotVelocity", "charge", "visible", "userData", "positionB", "velocityB"};
+      "position", "velocity", "color",        "size",      "mass",        "age",
+      "lifetime", "id",       "prevPosition", "up",        "rotVelocity", "charge",
+      "visible",  "userData", "positionB",    "velocityB", "birthColor",  "birthSize"};
   const auto i = std::size_t(a);
   return i < std::size(names) ? names[i] : "unknown";
 }
@@ -63,6 +64,8 @@ Lanes Lanes::offset(std::size_t b) const {
   for (auto& q : r.rot) shift(q);
   for (auto& q : r.posB) shift(q);
   for (auto& q : r.velB) shift(q);
+  for (auto& q : r.birthColor) shift(q);
+  shift(r.birthSize);
   shift(r.size);
   shift(r.mass);
   shift(r.age);
@@ -86,8 +89,12 @@ Lanes GroupImpl::lanePointers() const {
     l.posB[c] = f(Attribute::PositionB, c);
     l.velB[c] = f(Attribute::VelocityB, c);
   }
-  for (int c = 0; c < 4; ++c) l.color[c] = f(Attribute::Color, c);
+  for (int c = 0; c < 4; ++c) {
+    l.color[c] = f(Attribute::Color, c);
+    l.birthColor[c] = f(Attribute::BirthColor, c);
+  }
   l.size = f(Attribute::Size, 0);
+  l.birthSize = f(Attribute::BirthSize, 0);
   l.mass = f(Attribute::Mass, 0);
   l.age = f(Attribute::Age, 0);
   l.lifetime = f(Attribute::Lifetime, 0);
@@ -182,6 +189,12 @@ void GroupImpl::ensureStorage() {
     for (int c = 0; c < 4; ++c)
       if (!before.has(Attribute::Color) && l.color[c]) l.color[c][i] = defaults.color[c];
     if (!before.has(Attribute::Size) && l.size) l.size[i] = defaults.size;
+    // Particles alive when a curve starts scaling their birth value keep what they have now.
+    for (int c = 0; c < 4; ++c)
+      if (!before.has(Attribute::BirthColor) && l.birthColor[c])
+        l.birthColor[c][i] = l.color[c] ? l.color[c][i] : defaults.color[c];
+    if (!before.has(Attribute::BirthSize) && l.birthSize)
+      l.birthSize[i] = l.size ? l.size[i] : defaults.size;
     if (!before.has(Attribute::Mass) && l.mass) l.mass[i] = defaults.mass;
     if (!before.has(Attribute::Age) && l.age) l.age[i] = 0.0f;
     if (!before.has(Attribute::Lifetime) && l.lifetime) l.lifetime[i] = defaults.lifetime;
@@ -269,7 +282,13 @@ bool Group::add(const Particle& p) {
   }
   Particle q = p;
   q.id = g.nextId++;
-  g.write(g.size++, q);
+  const std::size_t i = g.size++;
+  g.write(i, q);
+  // Its colour and size as added are its birth values (ColorOverLife / SizeOverLife).
+  const detail::Lanes l = g.lanePointers();
+  for (int c = 0; c < 4; ++c)
+    if (l.birthColor[c]) l.birthColor[c][i] = q.color[c];
+  if (l.birthSize) l.birthSize[i] = q.size;
   g.hostChanged();
   return true;
 }

@@ -55,6 +55,8 @@ struct Lanes {
   float* user = nullptr;
   float* posB[3] = {};
   float* velB[3] = {};
+  float* birthColor[4] = {};
+  float* birthSize = nullptr;
 
   Lanes offset(std::size_t b) const;
 };

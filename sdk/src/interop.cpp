@@ -50,6 +50,10 @@ float defaultComponent(Attribute a, int c) {
       return 1.0f;
     case Attribute::UserData:
       return d.userData;
+    case Attribute::BirthColor:
+      return d.color[c];
+    case Attribute::BirthSize:
+      return d.size;
     default:
       return 0.0f;
   }

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "flurry/flurry.hpp"
 
@@ -131,6 +132,49 @@ TEST(Sink, EnterLeaveAndHitModes) {
   Sink outside{box, true, 0.0f, Sink::Mode::Outside};
   EXPECT_EQ(one(outside, Vec3(5, 0, 0), Vec3(0)), 0u);
   EXPECT_EQ(one(outside, Vec3(0, 0, 0), Vec3(0)), 1u);
+}
+
+// passThrough 0.3 lets 30 % of the particles through in every mode: the decision is made once
+// per particle and absorber, not drawn again each step the particle is inside.
+TEST(Sink, PassThroughIsAFractionOfParticlesInEveryMode) {
+  const int n = 10000;
+  const double p = 0.3, sigma = std::sqrt(p * (1 - p) / n);
+  const Domain slab = Domain::box(Vec3(1, -100, -100), Vec3(2, 100, 100));
+  auto passing = [&](std::vector<Action> sinks, Vec3 start, int steps) {
+    Context ctx = makeContext(0.05);  // 1 unit/s: 20 steps inside the slab
+    Group& g = ctx.createGroup("g", n);
+    ActionList list;
+    for (const Action& a : sinks) list.add(a);
+    list.add(Move{});
+    g.setActions(list);
+    for (int i = 0; i < n; ++i) {
+      Particle q;
+      q.position = start + Vec3(0, float(i % 100) * 0.1f, float(i / 100) * 0.1f);
+      q.velocity = Vec3(1, 0, 0);
+      g.add(q);
+    }
+    ctx.run(steps);
+    return double(g.size()) / n;
+  };
+  using M = Sink::Mode;
+  const Vec3 before(0, 0, 0);
+  EXPECT_NEAR(passing({Sink{slab, true, 0.3f, M::Inside}}, before, 60), p, 3 * sigma);
+  EXPECT_NEAR(passing({Sink{slab, true, 0.3f, M::Enter}}, before, 60), p, 3 * sigma);
+  EXPECT_NEAR(passing({Sink{slab, true, 0.3f, M::Leave}}, before, 60), p, 3 * sigma);
+  EXPECT_NEAR(passing({Sink{Domain::plane(Vec3(1.5f, 0, 0), Vec3(1, 0, 0)), true, 0.3f, M::Hit}},
+                      before, 60),
+              p, 3 * sigma);
+  // Outside a region the particles leave and stay out of, for 40 steps.
+  EXPECT_NEAR(
+      passing({Sink{Domain::box(Vec3(-1, -100, -100), Vec3(1, 100, 100)), true, 0.3f, M::Outside}},
+              before, 60),
+      p, 3 * sigma);
+  // Two absorbers decide independently: 0.3 · 0.3 pass both.
+  const Domain slab2 = Domain::box(Vec3(3, -100, -100), Vec3(4, 100, 100));
+  const double p2 = p * p, sigma2 = std::sqrt(p2 * (1 - p2) / n);
+  EXPECT_NEAR(
+      passing({Sink{slab, true, 0.3f, M::Inside}, Sink{slab2, true, 0.3f, M::Inside}}, before, 100),
+      p2, 3 * sigma2);
 }
 
 TEST(Sink, EachAbsorberCountsWhatItTook) {

@@ -192,19 +192,80 @@ TEST(SpeedClamp, KeepsSpeedInRange) {
   EXPECT_NEAR(g.particle(1).velocity.y, 1.0f, 1e-6f);
 }
 
-TEST(OverLife, ColorAndSizeFollowTheirCurves) {
+TEST(OverLife, ColorAndSizeFollowTheirCurvesInReplaceMode) {
   Context ctx = makeContext(0.25);
   Group& g = ctx.createGroup("g", 1);
-  g.setActions({Move{}, ColorOverLife{{{0.0f, Vec4(1, 0, 0, 1)}, {1.0f, Vec4(0, 0, 1, 0)}}},
-                SizeOverLife{{{0.0f, 1.0f}, {0.5f, 3.0f}, {1.0f, 0.0f}}}});
+  g.setActions(
+      {Move{},
+       ColorOverLife{{{0.0f, Vec4(1, 0, 0, 1)}, {1.0f, Vec4(0, 0, 1, 0)}}, OverLifeMode::Replace},
+       SizeOverLife{{{0.0f, 1.0f}, {0.5f, 3.0f}, {1.0f, 0.0f}}, OverLifeMode::Replace}});
+  // Replace needs no birth values.
+  EXPECT_FALSE(g.attributes().has(Attribute::BirthColor));
+  EXPECT_FALSE(g.attributes().has(Attribute::BirthSize));
   Particle p = at(Vec3(0));
   p.lifetime = 1.0f;
+  p.color = Vec4(0.2f, 0.4f, 0.6f, 1.0f);
   g.add(p);
   ctx.run(2);  // age 0.5
   const Particle q = g.particle(0);
   EXPECT_NEAR(q.color.r, 0.5f, 1e-6f);
   EXPECT_NEAR(q.color.b, 0.5f, 1e-6f);
   EXPECT_NEAR(q.size, 3.0f, 1e-6f);
+}
+
+// By default the curves scale what the particle was born with: two particle types of an
+// emitter keep their own colours and sizes under one curve.
+TEST(OverLife, CurvesMultiplyTheBirthColorAndSizeByDefault) {
+  Context ctx = makeContext(0.25);
+  Group& g = ctx.createGroup("g", 100);
+  Emitter e;
+  e.bursts = {{0.0, 100, 0.0, 1}};
+  e.types.resize(2);
+  e.types[0].color = Domain::point(Vec3(1.0f, 0.5f, 0.1f));  // orange
+  e.types[0].size = 0.04f;
+  e.types[1].color = Domain::point(Vec3(0.2f, 0.6f, 1.0f));  // blue
+  e.types[1].size = 0.08f;
+  for (auto& t : e.types) t.lifetime = 1.0f;
+  g.addEmitter(e);
+  g.setActions({Move{}, ColorOverLife{{{0.0f, Vec4(1.0f)}, {1.0f, Vec4(0.5f, 0.5f, 0.5f, 0.0f)}}},
+                SizeOverLife{{{0.0f, 1.0f}, {1.0f, 3.0f}}}, KillOld{}});
+  EXPECT_TRUE(g.attributes().has(Attribute::BirthColor));
+  EXPECT_TRUE(g.attributes().has(Attribute::BirthSize));
+  ctx.run(2);
+  ASSERT_EQ(g.size(), 100u);
+  int blue = 0;
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const Particle q = g.particle(i);
+    const bool isBlue = q.color.b > q.color.r;
+    blue += isBlue;
+    const Vec3 birth = isBlue ? Vec3(0.2f, 0.6f, 1.0f) : Vec3(1.0f, 0.5f, 0.1f);
+    const float t = q.age / q.lifetime;  // the curves ran after Move, at this age
+    ASSERT_GT(t, 0.2f);
+    ASSERT_LT(t, 0.8f);
+    const float f = 1.0f - 0.5f * t;
+    EXPECT_NEAR(q.color.r, birth.r * f, 1e-5f);
+    EXPECT_NEAR(q.color.g, birth.g * f, 1e-5f);
+    EXPECT_NEAR(q.color.b, birth.b * f, 1e-5f);
+    EXPECT_NEAR(q.color.a, 1.0f - t, 1e-5f);
+    EXPECT_NEAR(q.size, (isBlue ? 0.08f : 0.04f) * (1.0f + 2.0f * t), 1e-5f);
+  }
+  EXPECT_GT(blue, 20);
+  EXPECT_LT(blue, 80);
+
+  // A particle added by hand: its colour and size as added are its birth values.
+  Particle p = at(Vec3(0));
+  p.lifetime = 1.0f;
+  p.color = Vec4(0.0f, 1.0f, 0.0f, 1.0f);
+  p.size = 2.0f;
+  Context ctx2 = makeContext(0.25);
+  Group& h = ctx2.createGroup("h", 1);
+  h.setActions({Move{}, ColorOverLife{{{0.0f, Vec4(1.0f)}, {1.0f, Vec4(0.0f)}}},
+                SizeOverLife{{{0.0f, 1.0f}, {1.0f, 0.0f}}}});
+  h.add(p);
+  ctx2.run(2);  // age 0.5
+  EXPECT_NEAR(h.particle(0).color.g, 0.5f, 1e-6f);
+  EXPECT_NEAR(h.particle(0).color.r, 0.0f, 1e-6f);
+  EXPECT_NEAR(h.particle(0).size, 1.0f, 1e-6f);
 }
 
 TEST(RandomActions, DrawFromTheirDomainsReproducibly) {

@@ -258,7 +258,7 @@ TEST(EffectLoader, ActionsByName) {
     {"type": "MagneticField", "field": [0, 0, 2]},
     {"type": "SpeedClamp", "maxSpeed": 10},
     {"type": "ColorOverLife", "keys": [{"t": 0, "color": [1, 0, 0]}, {"t": 1, "color": [0, 0, 1, 0]}]},
-    {"type": "SizeOverLife", "keys": [{"t": 0, "size": 1}, {"t": 1, "size": 2}]},
+    {"type": "SizeOverLife", "keys": [{"t": 0, "size": 1}, {"t": 1, "size": 2}], "mode": "replace"},
     {"type": "Bounce", "surface": {"type": "plane", "normal": [0, 1, 0]}, "restitution": 0.5, "friction": 0.25},
     {"type": "Sink", "region": {"type": "sphere", "outerRadius": 9}, "mode": "outside", "passThrough": 0.5},
     {"type": "Block", "region": {"type": "box", "min": [0, 0, 0], "max": [1, 1, 1]}},
@@ -280,6 +280,8 @@ TEST(EffectLoader, ActionsByName) {
   EXPECT_EQ(col.keys[0].color.w, 1.0f);  // [r, g, b] is opaque
   EXPECT_EQ(col.keys[1].color.w, 0.0f);
   EXPECT_EQ(std::get<SizeOverLife>(as[8]).keys[1].size, 2.0f);
+  EXPECT_EQ(col.mode, OverLifeMode::Multiply);  // the default
+  EXPECT_EQ(std::get<SizeOverLife>(as[8]).mode, OverLifeMode::Replace);
   EXPECT_EQ(std::get<Bounce>(as[9]).friction, 0.25f);
   EXPECT_EQ(std::get<Sink>(as[10]).mode, Sink::Mode::Outside);
   EXPECT_EQ(std::get<Sink>(as[10]).passThrough, 0.5f);

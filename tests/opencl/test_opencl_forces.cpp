@@ -253,13 +253,33 @@ TEST(OpenCLForces, ColorOverLife) {
             {0.4f, Vec4(0.2f, 0.9f, 0.3f, 0.8f)},
             {0.4f, Vec4(0.0f, 0.0f, 1.0f, 0.6f)},
             {0.85f, Vec4(0.7f, 0.1f, 0.4f, 0.0f)}};
+  check({Gravity{kDown}, Move{}, c, KillOld{}}, 2, decorated(), kDecorated);  // Multiply
+  c.mode = ColorOverLife::Mode::Replace;
   check({Gravity{kDown}, Move{}, c, KillOld{}}, 2, decorated(), kDecorated);
 }
 
 TEST(OpenCLForces, SizeOverLife) {
   SizeOverLife s;
   s.keys = {{0.0f, 0.1f}, {0.3f, 0.8f}, {1.0f, 0.05f}};
+  check({Gravity{kDown}, Move{}, s, KillOld{}}, 2, decorated(), kDecorated);  // Multiply
+  s.mode = SizeOverLife::Mode::Replace;
   check({Gravity{kDown}, Move{}, s, KillOld{}}, 2, decorated(), kDecorated);
+}
+
+// Multiply with curves before Move, and with the colour and size lanes only the curves ask
+// for (the newborns' birth values written by the device's emission).
+TEST(OpenCLForces, OverLifeMultiplyTwoTypes) {
+  Emitter e = decorated();
+  e.types.push_back(e.types[0]);
+  e.types[1].color = Domain::point(Vec3(0.2f, 0.5f, 1.0f));
+  e.types[1].size = 0.5f;
+  ColorOverLife c;
+  c.keys = {{0.0f, Vec4(1.5f, 1.5f, 1.5f, 1.0f)},
+            {0.6f, Vec4(1.0f)},
+            {1.0f, Vec4(0.3f, 0.2f, 0.2f, 0.0f)}};
+  SizeOverLife s;
+  s.keys = {{0.0f, 0.5f}, {1.0f, 2.0f}};
+  check({Gravity{kDown}, c, s, Move{}, KillOld{}}, {1, 2}, e);
 }
 
 // ---- Under the other integrators (the forces' accelerations at the stages' states) ---------

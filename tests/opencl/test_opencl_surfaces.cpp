@@ -115,6 +115,19 @@ TEST(OpenCLSurfaces, SinkLeaveWithPassThrough) {
   checkAction({Gravity{kDown}, k, Move{}, KillOld{}}, 1);
 }
 
+// Inside a region the spray crosses for many steps: the once-per-particle decision (the same
+// hash of seed, id, group and index on both backends), also across sub-steps.
+TEST(OpenCLSurfaces, SinkInsideWithPassThrough) {
+  ActionList list{Gravity{kDown},
+                  Sink{Domain::box(Vec3(-3.0f, 0.8f, -3.0f), Vec3(3.0f, 1.4f, 3.0f)), true, 0.3f,
+                       Sink::Mode::Inside},
+                  Sink{Domain::sphere(Vec3(0.0f, 0.5f, 0.0f), 0.8f), true, 0.6f, Sink::Mode::Enter},
+                  Move{}, KillOld{}};
+  checkAction(list, 1);
+  list.setSubsteps(Substeps{1.0 / 90.0});
+  checkAction(list, 1);
+}
+
 TEST(OpenCLSurfaces, SinkHitEveryPiece) {
   const Domain pieces[] = {
       Domain::plane(Vec3(0.0f, 0.5f, 0.0f), Vec3(0.1f, 1.0f, 0.0f)),

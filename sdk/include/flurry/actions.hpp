@@ -224,21 +224,32 @@ struct SpeedClamp {
   float maxSpeed = kInfinity;
 };
 
+/// How a curve over life sets its attribute: Multiply (the default) scales the value the
+/// particle was born with (the emitter's type chose it), so one curve fades particles of every
+/// colour or size alike; Replace sets the curve's value itself, as an absolute colour or size.
+/// Multiply stores the birth value (Attribute::BirthColor, BirthSize) for the lists that use it.
+enum class OverLifeMode { Multiply, Replace };
+
 /// Color and size over life: the particle's age / lifetime in [0, 1] looks up a piecewise
-/// linear gradient or curve (keys sorted by t).
+/// linear gradient or curve (keys sorted by t), which scales the birth value (Multiply) or
+/// replaces it (Replace), per channel (r, g, b, a).
 struct ColorOverLife {
+  using Mode = OverLifeMode;
   struct Key {
     float t;
     Vec4 color;
   };
   std::vector<Key> keys{{0.0f, Vec4(1.0f)}, {1.0f, Vec4(1.0f, 1.0f, 1.0f, 0.0f)}};
+  Mode mode = Mode::Multiply;
 };
 struct SizeOverLife {
+  using Mode = OverLifeMode;
   struct Key {
     float t;
     float size;
   };
   std::vector<Key> keys{{0.0f, 1.0f}, {1.0f, 0.0f}};
+  Mode mode = Mode::Multiply;
 };
 
 // ---- Deflectors, absorbers, blockers --------------------------------------------------------
@@ -261,7 +272,11 @@ struct Bounce {
 
 /// An absorber: kills particles inside (or outside) a region, entering or leaving it in the
 /// coming Move, or hitting a plane piece. A fraction `passThrough` in [0, 1] of the particles
-/// it would kill survive; GroupStats::killedByAction counts what each absorber took.
+/// pass it, in every mode: whether a particle passes is decided once per particle and absorber
+/// (a uniform number in [0, 1) hashed from the seed, the particle's id, the group and the
+/// absorber's index in the list; it passes iff that is < passThrough), not drawn anew each
+/// step, so a particle that passes stays unharmed by this absorber for its whole life.
+/// GroupStats::killedByAction counts what each absorber took.
 struct Sink {
   enum class Mode { Inside, Outside, Enter, Leave, Hit };
   Domain region;
@@ -325,7 +340,8 @@ struct CallbackContext {
 /// `attributes` as variables: position px py pz, velocity vx vy vz, color r g b a, size,
 /// mass, age, life (lifetime), id (read only), prevx prevy prevz, upx upy upz, rotx roty rotz
 /// (angular velocity), charge, vis (visible, uint), user (user data), pbx pby pbz
-/// (PositionB), vbx vby vbz (VelocityB); and float dt, time (the step's start). For example
+/// (PositionB), vbx vby vbz (VelocityB), birthr birthg birthb birtha (BirthColor), birthsize
+/// (BirthSize); and float dt, time (the step's start). For example
 /// `"user += dt; if (py > 2.0f) vx += 0.5f;"`. `break` ends the callback; `return` is not
 /// allowed (it would leave the whole kernel).
 struct Callback {

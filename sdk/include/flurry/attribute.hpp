@@ -26,6 +26,8 @@ enum class Attribute : std::uint8_t {
   UserData,      ///< one free float for callbacks
   PositionB,     ///< a second, rest position (CopyVertexB, Restore)
   VelocityB,     ///< a second velocity (CopyVertexB)
+  BirthColor,    ///< r, g, b, a at birth (ColorOverLife in Multiply mode scales it)
+  BirthSize,     ///< radius at birth (SizeOverLife in Multiply mode scales it)
   Count
 };
 
@@ -41,6 +43,7 @@ constexpr int componentCount(Attribute a) {
     case Attribute::VelocityB:
       return 3;
     case Attribute::Color:
+    case Attribute::BirthColor:
       return 4;
     default:
       return 1;

@@ -77,6 +77,7 @@ class Random {
 namespace stream {
 inline constexpr std::uint32_t kEmission = 0xFFFF0000u;  ///< a newborn's attributes
 inline constexpr std::uint32_t kEmitterEvent = 0xFFFF0001u;
+inline constexpr std::uint32_t kPassThrough = 0xFFFF0002u;  ///< a Sink's once-per-particle pass
 }  // namespace stream
 
 }  // namespace flurry

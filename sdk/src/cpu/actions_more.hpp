@@ -40,15 +40,16 @@ inline Vec3 softPull(Vec3 d, float magnitude, float eps, float maxR) {
 inline void kill(const BlockContext& c, std::size_t i) {
   if (c.dead[i] == 0u) c.dead[i] = c.action + 1;
 }
-// The particles this action would kill survive with probability passThrough.
+// The particles this absorber would kill survive if they pass it: decided once per particle
+// and absorber (sinkPasses), so a fraction passThrough of them passes in every mode.
 inline void passThrough(const BlockContext& c, const Lanes& L, std::size_t n, float fraction) {
   if (fraction <= 0.0f) return;
   const std::uint32_t code = c.action + 1;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (c.dead[i] != code) continue;
-    Random rng(c.seed, L.id[i], c.step, c.streamBase + c.action);
-    if (rng.uniform() < fraction) c.dead[i] = 0u;
-  }
+  // The group's part of the stream base, without the sub-step's (fused_pass.cpp: s << 8).
+  const std::uint32_t group = c.streamBase & 0xFFFF0000u;
+  for (std::size_t i = 0; i < n; ++i)
+    if (c.dead[i] == code && sinkPasses(c.seed, L.id[i], group + c.action, fraction))
+      c.dead[i] = 0u;
 }
 inline Random actionRandom(const BlockContext& c, const Lanes& L, std::size_t i) {
   return Random(c.seed, L.id[i], c.step, c.streamBase + c.action);
@@ -407,17 +408,22 @@ inline float lifeFraction(const Lanes& L, std::size_t i) {
   const float life = L.lifetime[i];
   return life > 0.0f ? std::clamp(L.age[i] / life, 0.0f, 1.0f) : 1.0f;
 }
+// Multiply scales the birth value (stored by emission), Replace sets the curve's value.
 inline void apply(const ColorOverLife& a, const Lanes& L, std::size_t n, const BlockContext&) {
+  const bool multiply = a.mode == OverLifeMode::Multiply;
   for (std::size_t i = 0; i < n; ++i) {
     const Vec4 col = lookup<std::vector<ColorOverLife::Key>, Vec4>(
         a.keys, lifeFraction(L, i), [](const ColorOverLife::Key& k) { return k.color; });
-    for (int d = 0; d < 4; ++d) L.color[d][i] = col[d];
+    for (int d = 0; d < 4; ++d) L.color[d][i] = multiply ? L.birthColor[d][i] * col[d] : col[d];
   }
 }
 inline void apply(const SizeOverLife& a, const Lanes& L, std::size_t n, const BlockContext&) {
-  for (std::size_t i = 0; i < n; ++i)
-    L.size[i] = lookup<std::vector<SizeOverLife::Key>, float>(
+  const bool multiply = a.mode == OverLifeMode::Multiply;
+  for (std::size_t i = 0; i < n; ++i) {
+    const float s = lookup<std::vector<SizeOverLife::Key>, float>(
         a.keys, lifeFraction(L, i), [](const SizeOverLife::Key& k) { return k.size; });
+    L.size[i] = multiply ? L.birthSize[i] * s : s;
+  }
 }
 
 // ---- Bookkeeping -------------------------------------------------------------------------

@@ -911,6 +911,8 @@ Action readActionBody(Obj& o, const std::string& type) {
   }
   if (type == "ColorOverLife") {
     ColorOverLife a;
+    readEnum(o, "mode", a.mode,
+             {{"multiply", OverLifeMode::Multiply}, {"replace", OverLifeMode::Replace}});
     if (const json* k = o.get("keys"))
       readArray(*k, o.at("keys"), L, a.keys,
                 [&](const json& e, const std::string& p, ColorOverLife::Key& key) {
@@ -923,6 +925,8 @@ Action readActionBody(Obj& o, const std::string& type) {
   }
   if (type == "SizeOverLife") {
     SizeOverLife a;
+    readEnum(o, "mode", a.mode,
+             {{"multiply", OverLifeMode::Multiply}, {"replace", OverLifeMode::Replace}});
     if (const json* k = o.get("keys"))
       readArray(*k, o.at("keys"), L, a.keys,
                 [&](const json& e, const std::string& p, SizeOverLife::Key& key) {

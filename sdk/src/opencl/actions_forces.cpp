@@ -206,16 +206,28 @@ bool generateForceAction(const Action& act, ActionSource& s) {
     s.apply = call("fl_speed_clamp", ap + ", " + kPV);
     return true;
   }
-  if (std::holds_alternative<ColorOverLife>(act)) {
+  // Multiply scales the birth value, Replace sets the curve's (actions_more.hpp).
+  if (const auto* c = std::get_if<ColorOverLife>(&act)) {
     s.reads.insert({A::Age, A::Lifetime});
     s.writes.insert(A::Color);
-    s.apply = call("fl_color_over_life", ap + ", extra, age, life, &r, &g, &b, &a");
+    if (c->mode == OverLifeMode::Multiply) {
+      s.reads.insert(A::BirthColor);
+      s.apply = call("fl_color_over_life_scaled",
+                     ap + ", extra, age, life, birthr, birthg, birthb, birtha, &r, &g, &b, &a");
+    } else {
+      s.apply = call("fl_color_over_life", ap + ", extra, age, life, &r, &g, &b, &a");
+    }
     return true;
   }
-  if (std::holds_alternative<SizeOverLife>(act)) {
+  if (const auto* c = std::get_if<SizeOverLife>(&act)) {
     s.reads.insert({A::Age, A::Lifetime});
     s.writes.insert(A::Size);
-    s.apply = call("fl_size_over_life", ap + ", extra, age, life, &size");
+    if (c->mode == OverLifeMode::Multiply) {
+      s.reads.insert(A::BirthSize);
+      s.apply = call("fl_size_over_life_scaled", ap + ", extra, age, life, birthsize, &size");
+    } else {
+      s.apply = call("fl_size_over_life", ap + ", extra, age, life, &size");
+    }
     return true;
   }
   return false;

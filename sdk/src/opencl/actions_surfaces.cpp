@@ -135,8 +135,9 @@ bool generateSurfaceAction(const Action& act, ActionSource& s) {
     }
     if (k->passThrough > 0.0f) {
       s.reads.insert(Attribute::Id);
-      s.apply += "fl_sink_pass(" + ap + ", id, " + s.in.code + ", &dead, seedLo, seedHi, step, " +
-                 s.in.stream + ");\n";
+      // Keyed by the group's streamBase (without the sub-step) and the index: once per particle.
+      s.apply += "fl_sink_pass(" + ap + ", id, " + s.in.code +
+                 ", &dead, seedLo, seedHi, (streamBase + " + std::to_string(s.in.index) + "u));\n";
     }
     return true;
   }

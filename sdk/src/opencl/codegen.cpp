@@ -53,6 +53,8 @@ constexpr AttrInfo kAttrs[] = {
     {Attribute::UserData, "USER_DATA", {"user"}, false},
     {Attribute::PositionB, "POSITION_B", {"pbx", "pby", "pbz"}, false},
     {Attribute::VelocityB, "VELOCITY_B", {"vbx", "vby", "vbz"}, false},
+    {Attribute::BirthColor, "BIRTH_COLOR", {"birthr", "birthg", "birthb", "birtha"}, false},
+    {Attribute::BirthSize, "BIRTH_SIZE", {"birthsize"}, false},
 };
 
 const AttrInfo& info(Attribute a) {

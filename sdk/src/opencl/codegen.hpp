@@ -49,6 +49,7 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
 ///   float dt              the (sub-)step's length
 ///   fl_real time          the (sub-)step's start time (double where the device has fp64)
 ///   uint seedLo, seedHi, step   the Philox key and counter parts, as on the CPU
+///   uint streamBase       the group's stream base, without the sub-step (in.stream has it)
 ///   uint i, n             the particle's index and the live count at the start of the step
 ///   uint dead             0, or the first kill code of this step (set it only when 0)
 ///   __global const FlActionParams* ap   the list's constants (ap[k] is this action's)
