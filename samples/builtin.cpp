@@ -54,6 +54,8 @@ Effect loadEffectOrSample(const std::string& nameOrPath, const EffectLoadOptions
     // Parsed again so that the caller's options (a field resolver) apply.
     return parseEffect(s->json, s->file, options);
   }
+  // A folder that is not a built-in's name: say so rather than "no such file".
+  if (fs::is_directory(nameOrPath, ec)) throw EffectError(nameOrPath, "", "is a directory");
   std::string names, near;
   std::size_t best = std::string::npos;
   for (const Sample& s : builtinSamples()) {

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <new>
 #include <optional>
 
 #include "builtin.hpp"
@@ -15,6 +16,9 @@
 #include "outputs.hpp"
 #ifdef FLURRY_CLI_VDB
 #include "flurry/vdb.hpp"
+#endif
+#ifdef FLURRY_CLI_PNG
+#include "flurry/render.hpp"
 #endif
 
 namespace fs = std::filesystem;
@@ -51,15 +55,71 @@ std::vector<std::unique_ptr<flurry::cli::Plugin>> makePlugins() {
   return plugins;
 }
 
-flurry::EffectLoadOptions loadOptions() {
-  flurry::EffectLoadOptions o;
+/// "emitted N = alive A + killed by age K + ...": where every particle went (GroupStats).
+std::string accounting(unsigned long long emitted, unsigned long long alive,
+                       unsigned long long byAge, unsigned long long absorbed,
+                       unsigned long long nonFinite, unsigned long long dropped) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf,
+                "emitted %llu = alive %llu + killed by age %llu + absorbed %llu + non-finite "
+                "%llu + dropped at capacity %llu",
+                emitted, alive, byAge, absorbed, nonFinite, dropped);
+  return buf;
+}
+
+/// The loader's warnings, one line each on stderr; they do not stop anything.
+void printWarnings(const flurry::Effect& fx, const std::string& label) {
+  const std::string where = fx.file.empty() ? label : fx.file.string();
+  for (const flurry::EffectWarning& w : fx.warnings)
+    std::cerr << "flurry: warning: " << where << ": " << w.message() << "\n";
+}
+
+/// One line for any failure: the tool never ends in std::terminate.
+void printError(const std::string& prefix) {
+  try {
+    throw;
+  } catch (const flurry::Error& e) {
+    std::cerr << "flurry: " << prefix << e.what() << "\n";
+  } catch (const std::bad_alloc&) {
+    std::cerr << "flurry: " << prefix << "out of memory\n";
+  } catch (const std::exception& e) {
+    std::cerr << "flurry: " << prefix << e.what() << "\n";
+  } catch (...) {
+    std::cerr << "flurry: " << prefix << "unknown error\n";
+  }
+}
+
+}  // namespace
+
+namespace flurry::cli {
+
+EffectLoadOptions effectLoadOptions() {
+  EffectLoadOptions o;
 #ifdef FLURRY_CLI_VDB
   // The core does not link OpenVDB; the tool lends the loader its reader.
   o.fieldResolver = [](const fs::path& file, const std::string& grid) {
-    return flurry::vdb::readVectorField(file, grid);
+    return vdb::readVectorField(file, grid);
+  };
+#endif
+#ifdef FLURRY_CLI_PNG
+  // The core does not read `render`; the renderer's parser checks it at load, so that
+  // `validate` catches what `run --png` would refuse, and the error names the file.
+  o.renderChecker = [](std::string_view render, const fs::path& baseDir) {
+    const RenderSettings s = parseRenderSettings(render, baseDir);
+    std::error_code ec;
+    if (s.sprite == Sprite::Image && !fs::is_regular_file(s.spriteImage, ec))
+      throw InvalidArgument("render.sprite", "no such file: " + s.spriteImage);
   };
 #endif
   return o;
+}
+
+}  // namespace flurry::cli
+
+namespace {
+
+flurry::EffectLoadOptions loadOptions() {
+  return flurry::cli::effectLoadOptions();
 }
 
 std::string frameName(const std::string& base, int frame, const char* ext) {
@@ -139,6 +199,7 @@ void printStats(const flurry::Group& g, int frame, double time) {
 
 int run(const RunOptions& o, std::vector<std::unique_ptr<flurry::cli::Plugin>>& plugins) {
   const flurry::Effect fx = flurry::samples::loadEffectOrSample(o.effect, loadOptions());
+  printWarnings(fx, o.effect);
   const int frames = o.frames.value_or(fx.frames);
   if (!o.out.empty()) {
     std::error_code ec;
@@ -208,27 +269,23 @@ int run(const RunOptions& o, std::vector<std::unique_ptr<flurry::cli::Plugin>>& 
   const double secs = std::chrono::duration<double>(Clock::now() - start).count();
   if (o.quiet) {
     // One line for scripts.
-    unsigned long long emitted = 0, alive = 0, killed = 0, absorbed = 0, dropped = 0;
+    unsigned long long emitted = 0, alive = 0, killed = 0, absorbed = 0, nonFinite = 0, dropped = 0;
     for (flurry::Group* g : ctx.groups()) {
       const auto& s = g->stats();
       emitted += s.emitted, alive += g->size(), killed += s.killedByAge, absorbed += s.absorbed,
-          dropped += s.droppedAtCapacity;
+          nonFinite += s.killedNonFinite, dropped += s.droppedAtCapacity;
     }
-    std::printf(
-        "%s: %d steps in %.3f s; emitted %llu, alive %llu, killed by age %llu, absorbed "
-        "%llu, dropped at capacity %llu\n",
-        fx.name.c_str(), frames, secs, emitted, alive, killed, absorbed, dropped);
+    std::printf("%s: %d steps in %.3f s; %s\n", fx.name.c_str(), frames, secs,
+                accounting(emitted, alive, killed, absorbed, nonFinite, dropped).c_str());
     return 0;
   }
   for (flurry::Group* g : ctx.groups()) {
     if (!perFrame) printStats(*g, frames, ctx.time());
     const auto& s = g->stats();
-    std::printf(
-        "%s: %d steps in %.3f s; emitted %llu, alive %zu, killed by age %llu, absorbed "
-        "%llu, dropped at capacity %llu",
-        g->name().c_str(), frames, secs, (unsigned long long)s.emitted, g->size(),
-        (unsigned long long)s.killedByAge, (unsigned long long)s.absorbed,
-        (unsigned long long)s.droppedAtCapacity);
+    std::printf("%s: %d steps in %.3f s; %s", g->name().c_str(), frames, secs,
+                accounting(s.emitted, g->size(), s.killedByAge, s.absorbed, s.killedNonFinite,
+                           s.droppedAtCapacity)
+                    .c_str());
     if (s.emittersSpawned > 0)
       std::printf(", emitters spawned %llu", (unsigned long long)s.emittersSpawned);
     std::printf("\n");
@@ -247,9 +304,17 @@ int validate(const std::vector<std::string>& files) {
       co.threads = 1;
       flurry::Context ctx(co);
       fx.build(ctx, 64);  // a small capacity: the checks do not depend on it
-      std::printf("%s: ok\n", f.c_str());
+      printWarnings(fx, f);
+      if (fx.warnings.empty())
+        std::printf("%s: ok\n", f.c_str());
+      else
+        std::printf("%s: ok, %zu warning%s\n", f.c_str(), fx.warnings.size(),
+                    fx.warnings.size() == 1 ? "" : "s");
     } catch (const flurry::Error& e) {
       std::cerr << "flurry: " << e.what() << "\n";
+      ++bad;
+    } catch (...) {
+      printError(f + ": ");  // out of memory, ...: name the file, go on with the next
       ++bad;
     }
   }
@@ -277,14 +342,14 @@ int main(int argc, char** argv) {
   runCmd->add_option("--threads", o.threads, "worker threads (0: all cores)");
   runCmd->add_option("--capacity", o.capacity, "cap every group's capacity (0: the effect's)")
       ->check(CLI::Range(std::size_t(0), std::size_t(1) << 31));
-  runCmd->add_flag("--quiet", o.quiet, "print only errors and a one-line summary");
+  runCmd->add_flag("--quiet", o.quiet, "print only errors, warnings and a one-line summary");
   runCmd->add_option("--backend", o.backend, "cpu, opencl or auto")
       ->check(CLI::IsMember({"cpu", "opencl", "auto"}));
   runCmd->add_option("--device", o.device, "OpenCL platform or device name (a substring)");
   app.add_subcommand("list", "list the built-in effects");
   std::vector<std::string> toValidate;
-  CLI::App* validateCmd =
-      app.add_subcommand("validate", "check effect files: print \"ok\" or the first error");
+  CLI::App* validateCmd = app.add_subcommand(
+      "validate", "check effect files: print \"ok\" (and any warnings) or the first error");
   validateCmd->add_option("effect", toValidate, "effect files (or built-in names)")->required();
   auto plugins = makePlugins();
   for (auto& p : plugins) p->addOptions(app, *runCmd);
@@ -306,8 +371,8 @@ int main(int argc, char** argv) {
     }
     if (validateCmd->parsed()) return validate(toValidate);
     return run(o, plugins);
-  } catch (const flurry::Error& e) {
-    std::cerr << "flurry: " << e.what() << "\n";
+  } catch (...) {
+    printError("");
     return 1;
   }
 }

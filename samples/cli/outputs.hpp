@@ -43,6 +43,10 @@ class Plugin {
   virtual void end(Context& /*ctx*/) {}
 };
 
+/// The options every command loads effects with: the VDB field reader and the render
+/// settings' checker where the tool has those parts (main.cpp).
+EffectLoadOptions effectLoadOptions();
+
 // Each factory is defined by its part's source file, compiled in when that part is built.
 std::unique_ptr<Plugin> makePngPlugin();     // png_output.cpp   (FLURRY_VIEWER)
 std::unique_ptr<Plugin> makeVdbPlugin();     // vdb_output.cpp   (FLURRY_VDB)

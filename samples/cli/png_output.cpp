@@ -60,8 +60,15 @@ void addLookOptions(CLI::App& cmd, Look& look) {
 // The effect's `render` object, then the command line's overrides.
 RenderSettings settingsFrom(const std::string& render, const fs::path& effectFile,
                             const Look& look) {
-  RenderSettings s =
-      parseRenderSettings(render, effectFile.empty() ? fs::path() : effectFile.parent_path());
+  RenderSettings s;
+  try {
+    s = parseRenderSettings(render, effectFile.empty() ? fs::path() : effectFile.parent_path());
+  } catch (const InvalidArgument& e) {
+    // The loader's checker refuses a bad `render` first; name the file here too.
+    std::string why = e.what();
+    if (why.rfind(e.parameter() + ": ", 0) == 0) why = why.substr(e.parameter().size() + 2);
+    throw EffectError(effectFile.string(), e.parameter(), why);
+  }
   if (look.sprite == "point")
     s.sprite = Sprite::Point;
   else if (look.sprite == "disc")
@@ -119,7 +126,10 @@ class PngPlugin : public Plugin {
 
   bool runCommand(CLI::App& /*app*/, int& exitCode) override {
     if (!view_->parsed()) return false;
-    const Effect fx = samples::loadEffectOrSample(viewEffect_);
+    const Effect fx = samples::loadEffectOrSample(viewEffect_, effectLoadOptions());
+    for (const EffectWarning& w : fx.warnings)
+      std::fprintf(stderr, "flurry: warning: %s: %s\n",
+                   (fx.file.empty() ? viewEffect_ : fx.file.string()).c_str(), w.message().c_str());
     ViewerOptions vo;
     parseSize(viewLook_.size, vo.width, vo.height);
     vo.title = "flurry " + fx.name;

@@ -1,13 +1,30 @@
 #include "thread_pool.hpp"
 
+#include <string>
+
+#include "flurry/error.hpp"
+
 namespace flurry::detail {
 
 ThreadPool::ThreadPool(unsigned threads) {
   if (threads == 0) threads = 1;
-  for (unsigned i = 1; i < threads; ++i) workers_.emplace_back([this] { workerLoop(); });
+  try {
+    for (unsigned i = 1; i < threads; ++i) workers_.emplace_back([this] { workerLoop(); });
+  } catch (const std::exception& e) {
+    // The system refused a thread (std::system_error) or memory: the workers already started
+    // must be joined, or destroying them terminates the program.
+    stopWorkers();
+    throw Error("cannot start " + std::to_string(threads) + " threads (" +
+                std::to_string(workers_.size() + 1) + " started): " + e.what() +
+                "; ask for fewer threads");
+  }
 }
 
 ThreadPool::~ThreadPool() {
+  stopWorkers();
+}
+
+void ThreadPool::stopWorkers() {
   {
     std::lock_guard lock(mutex_);
     stop_ = true;

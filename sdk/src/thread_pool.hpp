@@ -15,7 +15,8 @@ namespace flurry::detail {
 
 class ThreadPool {
  public:
-  /// `threads` counts the calling thread: 1 runs everything inline.
+  /// `threads` counts the calling thread: 1 runs everything inline. Throws flurry::Error if
+  /// the system cannot start them (no thread is left running).
   explicit ThreadPool(unsigned threads);
   ~ThreadPool();
   ThreadPool(const ThreadPool&) = delete;
@@ -29,6 +30,7 @@ class ThreadPool {
 
  private:
   void workerLoop();
+  void stopWorkers();
   void runTasks();
 
   std::vector<std::thread> workers_;

@@ -1,13 +1,21 @@
 # Runs the `flurry` tool and checks its exit code and output.
 #   MODE=validate: good files print "ok" (exit 0); bad ones name the file, the JSON path and
-#                  why (exit 1).
-#   MODE=run:      --quiet prints one summary line; --out writes PLY files; a file path runs.
+#                  why (exit 1); warnings go to stderr; folders and endless files are refused.
+#   MODE=run:      --quiet prints one summary line accounting for every particle; --out writes
+#                  PLY files; a file path runs; what the system refuses (memory, threads) is
+#                  one line and exit 1, never an abort.
 #   MODE=list:     every built-in effect with a description.
+# SANITIZE: the sanitizer build (no address-space limits); RENDER: the tool has --png.
 cmake_minimum_required(VERSION 3.25)
 
 function(flurry_expect)
-  cmake_parse_arguments(E "" "RC;OUT;ERR" "ARGS" ${ARGN})
-  execute_process(COMMAND ${CMAKE_COMMAND} -E env FLURRY_PROGRESS=0 ${FLURRY} ${E_ARGS}
+  # LIMIT_KB: run under `ulimit -v` (an address-space limit, KiB).
+  cmake_parse_arguments(E "" "RC;OUT;ERR;LIMIT_KB" "ARGS" ${ARGN})
+  set(limit)
+  if(E_LIMIT_KB)
+    set(limit sh -c "ulimit -v ${E_LIMIT_KB} && exec \"$@\"" sh)
+  endif()
+  execute_process(COMMAND ${CMAKE_COMMAND} -E env FLURRY_PROGRESS=0 ${limit} ${FLURRY} ${E_ARGS}
                   RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT rc EQUAL E_RC)
     message(FATAL_ERROR "flurry ${E_ARGS}: exit ${rc}, expected ${E_RC}\n${out}\n${err}")
@@ -34,9 +42,33 @@ if(MODE STREQUAL "validate")
   # One bad file among good ones fails the whole call, and the good ones still say ok.
   flurry_expect(RC 1 OUT "fountain.json: ok" ERR "typo.json"
     ARGS validate ${SRC}/samples/effects/fountain.json ${SRC}/tests/effect/data/typo.json)
+  # A folder says so; a file that never ends is read up to the size bound.
+  flurry_expect(RC 1 ERR "flurry: [^\n]*/tests/effect/data: is a directory\n"
+    ARGS validate ${SRC}/tests/effect/data)
+  if(EXISTS /dev/zero)
+    flurry_expect(RC 1 ERR "^flurry: /dev/zero: larger than 64 MiB, the limit for an effect file\n$"
+      ARGS validate /dev/zero)
+  endif()
+  # Warnings: the file is still ok (exit 0); each warning is a line on stderr with its path.
+  flurry_expect(RC 0 OUT "no_move.json: ok, 2 warnings"
+    ERR "flurry: warning: [^\n]*no_move.json: groups\\[0\\]\\.actions: has no Move: particles never move or age\n[^\n]*groups\\[0\\]\\.actions\\[1\\]: never kills"
+    ARGS validate ${SRC}/tests/effect/data/no_move.json)
+  # A valid file whose parsed form does not fit in memory: one line naming it, not an abort.
+  if(NOT SANITIZE)
+    string(REPEAT "[]," 6000000 many)
+    file(WRITE ${DIR}/big.json "{\"groups\": [{\"capacity\": 1}], \"$comment\": [${many}[]]}")
+    flurry_expect(RC 1 ERR "^flurry: [^\n]*big.json: out of memory[^\n]*\n$" LIMIT_KB 400000
+      ARGS validate ${DIR}/big.json)
+    file(REMOVE ${DIR}/big.json)
+  endif()
+  # The render object is checked as `run --png` reads it, with the file's name.
+  if(RENDER)
+    flurry_expect(RC 1 ERR "bad_render.json: render\\.camera\\.ptich: unknown field"
+      ARGS validate ${SRC}/tests/effect/data/bad_render.json)
+  endif()
 elseif(MODE STREQUAL "run")
   file(REMOVE_RECURSE ${DIR})
-  flurry_expect(RC 0 OUT "^fountain: 5 steps in [0-9.]+ s; emitted [0-9]+, alive [0-9]+" ARGS run fountain --frames 5 --quiet)
+  flurry_expect(RC 0 OUT "^fountain: 5 steps in [0-9.]+ s; emitted [0-9]+ = alive [0-9]+ \\+ killed by age [0-9]+ \\+ absorbed [0-9]+ \\+ non-finite [0-9]+ \\+ dropped at capacity [0-9]+\n$" ARGS run fountain --frames 5 --quiet)
   string(REGEX MATCHALL "\n" lines "${last_out}")
   list(LENGTH lines n)
   if(NOT n EQUAL 1)
@@ -51,6 +83,24 @@ elseif(MODE STREQUAL "run")
   flurry_expect(RC 1 ERR "bad_rate.json: groups\\[0\\]" ARGS run ${SRC}/tests/effect/data/bad_rate.json)
   # The run's defaults come from the file; the flags override them.
   flurry_expect(RC 0 OUT "hair: 30 steps" ARGS run hair --quiet)
+  # Particles killed as non-finite are in the summary (every one of them, here).
+  flurry_expect(RC 0
+    OUT "nonfinite: 10 steps in [0-9.]+ s; emitted 300 = alive 0 \\+ killed by age 0 \\+ absorbed 0 \\+ non-finite 300 \\+ dropped at capacity 0"
+    ARGS run ${SRC}/tests/effect/data/nonfinite.json --frames 10 --quiet)
+  flurry_expect(RC 0 OUT "blowup: 10 steps.*non-finite 300"
+    ARGS run ${SRC}/tests/effect/data/nonfinite.json --frames 10)
+  # A warning does not stop a run.
+  flurry_expect(RC 0 OUT "no_move: 3 steps" ERR "flurry: warning: [^\n]*no_move.json: groups\\[0\\]\\.actions: has no Move"
+    ARGS run ${SRC}/tests/effect/data/no_move.json --frames 3 --quiet)
+  if(RENDER)
+    flurry_expect(RC 1 ERR "bad_render.json: render\\.camera\\.ptich: unknown field"
+      ARGS run ${SRC}/tests/effect/data/bad_render.json --frames 1)
+  endif()
+  # What the system refuses is one line and exit 1, not an abort (std::terminate).
+  if(NOT SANITIZE)
+    flurry_expect(RC 1 ERR "^flurry: cannot start 1000 threads [^\n]*\n$" LIMIT_KB 1500000
+      ARGS run fountain --threads 1000 --frames 2 --quiet)
+  endif()
 elseif(MODE STREQUAL "list")
   flurry_expect(RC 0 OUT "fountain +a water fountain" ARGS list)
   foreach(name fireworks snow hair tornado pinball2d magnetic)

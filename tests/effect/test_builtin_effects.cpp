@@ -71,6 +71,50 @@ TEST_P(EachBuiltin, LoadsRuns100StepsAndStaysFinite) {
   EXPECT_GT(emitted, 0u) << "an effect that shows nothing";
 }
 
+/// GroupStats' identity: every particle emitted is alive, or was killed (by age, by an
+/// absorber, as non-finite), or was dropped at capacity.
+void expectAccounted(const Group& g, const std::string& when) {
+  const GroupStats& s = g.stats();
+  EXPECT_EQ(s.emitted,
+            g.size() + s.killedByAge + s.absorbed + s.killedNonFinite + s.droppedAtCapacity)
+      << g.name() << " " << when << ": emitted " << s.emitted << ", alive " << g.size()
+      << ", killed by age " << s.killedByAge << ", absorbed " << s.absorbed << ", non-finite "
+      << s.killedNonFinite << ", dropped " << s.droppedAtCapacity;
+}
+
+TEST_P(EachBuiltin, AccountsForEveryParticle) {
+  const samples::Sample* s = samples::findSample(GetParam());
+  ASSERT_NE(s, nullptr);
+  ASSERT_TRUE(s->effect) << s->description;
+  EXPECT_TRUE(s->effect->warnings.empty())
+      << GetParam() << ": " << s->effect->warnings.front().message();
+  ContextOptions co = s->effect->contextOptions();
+  co.backend = Backend::Cpu;
+  co.threads = 2;
+  Context ctx(co);
+  // A small capacity, so that dropping at capacity is part of what is checked.
+  s->build(ctx, 2000);
+  for (int i = 1; i <= 150; ++i) {
+    ctx.step();
+    if (i % 30 == 0)
+      for (const Group* g : ctx.groups()) expectAccounted(*g, "step " + std::to_string(i));
+  }
+}
+
+TEST(BuiltinEffects, NonFiniteParticlesAreAccounted) {
+  // Every particle overflows to infinity within a few steps and is killed as non-finite.
+  const Effect fx = parseEffect(R"({"groups": [{"capacity": 100,
+      "emitters": [{"bursts": [{"count": 50}], "types": [{"velocity": [0, 3e38, 0]}]}],
+      "actions": [{"type": "Gravity", "acceleration": [0, 3e38, 0]}, {"type": "Move"},
+                  {"type": "KillOld"}]}]})");
+  Context ctx({.threads = 1, .backend = Backend::Cpu});
+  Group& g = *fx.build(ctx).at(0);
+  ctx.run(10);
+  EXPECT_EQ(g.stats().emitted, 50u);
+  EXPECT_EQ(g.stats().killedNonFinite, 50u);
+  expectAccounted(g, "after 10 steps");
+}
+
 std::vector<std::string> builtinNames() {
   std::vector<std::string> names;
   for (const auto& s : samples::builtinSamples()) names.push_back(s.name);

@@ -1,10 +1,12 @@
 // The effect-file loader: what it accepts, and that every kind of bad input is refused with
 // the file, the JSON path of the bad field and why.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "flurry/effect.hpp"
 #include "flurry/flurry.hpp"
@@ -510,4 +512,127 @@ TEST(EffectLoader, BuildCreatesTheGroups) {
   } catch (const EffectError& e) {
     EXPECT_EQ(e.path(), "groups[0]");
   }
+}
+
+namespace {
+/// A scratch folder of this process (tests of several worktrees run side by side).
+std::filesystem::path scratchDir(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("flurry_" + name + "_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+EffectError loadErrorOf(const std::filesystem::path& file, const EffectLoadOptions& opts = {}) {
+  try {
+    loadEffect(file, opts);
+  } catch (const EffectError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "no error for " << file;
+  return EffectError("", "", "");
+}
+
+std::vector<std::string> warningsOf(const std::string& json) {
+  std::vector<std::string> out;
+  for (const EffectWarning& w : parseEffect(json, "w.json").warnings) out.push_back(w.message());
+  return out;
+}
+}  // namespace
+
+TEST(EffectLoader, AFolderIsNamedAsOne) {
+  const auto dir = scratchDir("folder");
+  const EffectError e = loadErrorOf(dir);
+  EXPECT_EQ(std::string(e.what()), dir.string() + ": is a directory");
+  std::filesystem::remove_all(dir);
+}
+
+TEST(EffectLoader, FilesAreReadUpToASizeBound) {
+  const auto dir = scratchDir("size");
+  const auto file = dir / "big.json";
+  const std::string text = withGroup("");
+  { std::ofstream(file) << text; }
+  EffectLoadOptions small;
+  small.maxFileBytes = text.size();
+  EXPECT_EQ(loadEffect(file, small).name, "t");  // exactly at the bound: read
+  small.maxFileBytes = text.size() - 1;
+  EXPECT_EQ(loadErrorOf(file, small).why(), "larger than " + std::to_string(text.size() - 1) +
+                                                " bytes, the limit for an effect file");
+  std::filesystem::remove_all(dir);
+  // A device has no size to check first: it is read up to the bound (64 MiB), not for ever.
+  if (std::filesystem::exists("/dev/zero")) {
+    const EffectError e = loadErrorOf("/dev/zero");
+    EXPECT_EQ(std::string(e.what()), "/dev/zero: larger than 64 MiB, the limit for an effect file");
+  }
+}
+
+TEST(EffectLoader, RenderCheckerErrorsNameTheFile) {
+  EffectLoadOptions opts;
+  std::string seen;
+  opts.baseDir = "effects";
+  opts.renderChecker = [&](std::string_view render, const std::filesystem::path& base) {
+    seen = std::string(render) + " in " + base.string();
+    if (render.find("ptich") != std::string_view::npos)
+      throw InvalidArgument("render.camera.ptich", "unknown field");
+    if (render.find("sprite") != std::string_view::npos) throw Error("cannot read the sprite");
+  };
+  const Effect ok = parseEffect(R"({"groups": [{"capacity": 1}], "render": {"blend": "additive"}})",
+                                "ok.json", opts);
+  EXPECT_EQ(seen, R"({"blend":"additive"} in effects)");
+  EXPECT_EQ(ok.render, R"({"blend":"additive"})");
+  const EffectError e =
+      errorOf(R"({"groups": [{"capacity": 1}], "render": {"camera": {"ptich": 10}}})", opts);
+  EXPECT_EQ(std::string(e.what()), "test.json: render.camera.ptich: unknown field");
+  EXPECT_EQ(e.path(), "render.camera.ptich");
+  EXPECT_EQ(
+      std::string(
+          errorOf(R"({"groups": [{"capacity": 1}], "render": {"sprite": "x.png"}})", opts).what()),
+      "test.json: render: cannot read the sprite");
+  // Without a checker the object is kept unchecked (the core does not read it).
+  EXPECT_NO_THROW(
+      parseEffect(R"({"groups": [{"capacity": 1}], "render": {"camera": {"ptich": 10}}})"));
+}
+
+TEST(EffectLoader, WarnsAboutListsThatCannotDoWhatTheyImply) {
+  const std::string emitter = R"("emitters": [{"rate": 100}])";
+  // No Move: nothing moves or ages, so KillOld never kills and gradients stay put.
+  EXPECT_EQ(warningsOf(withGroup(emitter + R"(, "actions": [{"type": "Gravity"},
+              {"type": "KillOld"}, {"type": "ColorOverLife"}])")),
+            (std::vector<std::string>{
+                "groups[0].actions: has no Move: particles never move or age",
+                "groups[0].actions[1]: never kills: without a Move particles never age",
+                "groups[0].actions[2]: stays at its first key: without a Move particles never "
+                "age"}));
+  // Move but nothing that removes particles, with an emitter that never stops.
+  EXPECT_EQ(warningsOf(withGroup(emitter + R"(, "actions": [{"type": "Move"}])")),
+            (std::vector<std::string>{
+                "groups[0].actions: nothing removes particles (no KillOld, Sink or "
+                "SinkVelocity): the group fills to its capacity of 100 and then drops every "
+                "newborn"}));
+  // ... which an emitter that stops, a Sink, or hair mode answers.
+  EXPECT_TRUE(warningsOf(withGroup(R"("emitters": [{"rate": 100, "stop": 1}],
+                                      "actions": [{"type": "Move"}])"))
+                  .empty());
+  EXPECT_TRUE(warningsOf(withGroup(emitter + R"(, "actions": [{"type": "Move"},
+              {"type": "Sink", "region": {"type": "plane", "normal": [0, -1, 0]}}])"))
+                  .empty());
+  EXPECT_TRUE(
+      warningsOf(withGroup(emitter + R"(, "hair": true, "actions": [{"type": "Move"}])")).empty());
+  // A group nothing fills, and emitters that emit nothing.
+  EXPECT_EQ(warningsOf(withGroup("")),
+            (std::vector<std::string>{
+                "groups[0]: has no emitters or prime emitters: the group stays empty"}));
+  EXPECT_EQ(warningsOf(withGroup(R"("emitters": [{"rate": 0}, {"bursts": [{"count": 5}]}],
+                                    "actions": [{"type": "Move"}, {"type": "KillOld"}])")),
+            (std::vector<std::string>{"groups[0].emitters[0]: emits nothing: its rate is 0 and "
+                                      "it has no bursts (nor a spacing while it moves)"}));
+  // A 2-D group: the inserted constraint does not shift the actions' JSON indices.
+  const auto w2d = warningsOf(withGroup(emitter + R"(, "mode2d": true, "actions": [
+      {"type": "Gravity"}, {"type": "KillOld"}])"));
+  ASSERT_EQ(w2d.size(), 2u);
+  EXPECT_EQ(w2d[1], "groups[0].actions[1]: never kills: without a Move particles never age");
+  // A complete list has none.
+  EXPECT_TRUE(
+      warningsOf(withGroup(emitter + R"(, "actions": [{"type": "Move"}, {"type": "KillOld"}])"))
+          .empty());
 }

@@ -36,6 +36,16 @@ class EffectError : public InvalidArgument {
   std::string file_, why_, message_;
 };
 
+/// Something an effect asks for that cannot happen as written, e.g. a KillOld in a group
+/// without a Move (its particles never age). Not an error: the effect loads and runs as
+/// written. The library reports warnings (Effect::warnings), it never prints them.
+struct EffectWarning {
+  std::string path;  ///< the JSON path, e.g. "groups[0].actions[3]"
+  std::string why;
+  /// "path: why".
+  std::string message() const { return path.empty() ? why : path + ": " + why; }
+};
+
 /// One group of an effect, as loaded (validated, not yet built).
 struct EffectGroup {
   std::string name;
@@ -62,6 +72,9 @@ struct Effect {
   std::string render = "{}";
   /// The file it came from (empty for an embedded or in-memory effect).
   std::filesystem::path file;
+  /// What the loader found suspicious (see EffectWarning and docs/effect-format.md), in file
+  /// order. `flurry validate` and `flurry run` print them.
+  std::vector<EffectWarning> warnings;
 
   /// ContextOptions with this effect's seed and dt (the rest default).
   ContextOptions contextOptions() const;
@@ -83,6 +96,15 @@ struct EffectLoadOptions {
   FieldResolver fieldResolver;
   /// Relative paths in the effect resolve against this folder (loadEffect: the file's).
   std::filesystem::path baseDir;
+  /// Checks the `render` object (its JSON text; relative paths resolve against baseDir).
+  /// Throw an InvalidArgument whose parameter() is the JSON path ("render.camera.pitch"):
+  /// the loader reports it as an EffectError naming the file. The core does not read
+  /// `render`; without a checker it is kept unchecked. `flurry` passes one that calls
+  /// flurry::parseRenderSettings when it is built with the renderer.
+  std::function<void(std::string_view render, const std::filesystem::path& baseDir)> renderChecker;
+  /// loadEffect refuses a file larger than this (bytes), reading no further: an effect file
+  /// is a hand-written text, and a special file (/dev/zero) must not be read forever.
+  std::size_t maxFileBytes = std::size_t(64) << 20;
 };
 
 /// Parses and validates an effect from JSON text. `fileName` names it in errors.
@@ -90,8 +112,9 @@ struct EffectLoadOptions {
 Effect parseEffect(std::string_view json, const std::string& fileName = "<effect>",
                    const EffectLoadOptions& options = {});
 
-/// Reads, parses and validates an effect file. Throws EffectError (IoError-like failures are
-/// reported as EffectError with an empty JSON path).
+/// Reads, parses and validates an effect file. Throws EffectError (IoError-like failures, a
+/// folder, a file over EffectLoadOptions::maxFileBytes, are reported as EffectError with an
+/// empty JSON path).
 Effect loadEffect(const std::filesystem::path& file, EffectLoadOptions options = {});
 
 /// The names effect files use for attributes ("color", "size", ...): attributeName(a).

@@ -6,11 +6,12 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <limits>
+#include <new>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <sstream>
 
 namespace flurry {
 
@@ -1016,10 +1017,79 @@ void addAction(ActionList& list, const Action& a, const std::string& path, const
   }
 }
 
+// ---- warnings -------------------------------------------------------------------------------
+
+template <class A>
+bool hasAction(const std::vector<Action>& actions) {
+  return std::any_of(actions.begin(), actions.end(),
+                     [](const Action& a) { return std::holds_alternative<A>(a); });
+}
+
+/// Whether an emitter keeps emitting for ever (so a group it fills must also lose particles).
+bool emitsForever(const Emitter& e) {
+  // A path ends (the emitter then stays put); a velocity moves it for ever.
+  return std::isinf(e.stop) && (e.rate > 0 || (e.spacing > 0 && e.velocity != Vec3(0.0f)));
+}
+
+/// Every warning about a group (see EffectWarning): what its file asks for that cannot happen
+/// as written. `actions` is its action list in file order (before a 2-D constraint is
+/// inserted), so that indices are JSON indices. A new check is one more block here.
+void warnGroup(const EffectGroup& g, const std::vector<Action>& actions, const std::string& path,
+               std::vector<EffectWarning>& out) {
+  const std::string ap = join(path, "actions");
+  auto warn = [&](std::string p, std::string why) {
+    out.push_back({std::move(p), std::move(why)});
+  };
+  // Emitters that emit nothing, and groups nothing fills.
+  for (std::size_t i = 0; i < g.emitters.size(); ++i) {
+    const Emitter& e = g.emitters[i];
+    const bool moves = e.velocity != Vec3(0.0f) || e.path.size() >= 2;
+    if (e.rate == 0 && e.bursts.empty() && !(e.spacing > 0 && moves))
+      warn(index(join(path, "emitters"), i),
+           "emits nothing: its rate is 0 and it has no bursts (nor a spacing while it moves)");
+  }
+  for (std::size_t i = 0; i < g.primeEmitters.size(); ++i) {
+    const PrimeEmitter& e = g.primeEmitters[i];
+    if (e.rate == 0 && e.bursts.empty())
+      warn(index(join(path, "primeEmitters"), i),
+           "spawns no emitters: its rate is 0 and it has no bursts");
+  }
+  const bool filled = !g.emitters.empty() || !g.primeEmitters.empty();
+  if (!filled) {
+    warn(path, "has no emitters or prime emitters: the group stays empty");
+    return;  // the rest is about what happens to particles
+  }
+  // Move integrates positions and advances ages: without it nothing moves or ages.
+  if (!hasAction<Move>(actions)) {
+    warn(ap, "has no Move: particles never move or age");
+    for (std::size_t k = 0; k < actions.size(); ++k) {
+      const Action& a = actions[k];
+      // (Every particle of an effect file has a lifetime: a particle type's default is 5 s.)
+      if (std::holds_alternative<KillOld>(a))
+        warn(index(ap, k), "never kills: without a Move particles never age");
+      else if (std::holds_alternative<ColorOverLife>(a) || std::holds_alternative<SizeOverLife>(a))
+        warn(index(ap, k), "stays at its first key: without a Move particles never age");
+    }
+  }
+  // A continuous emitter and nothing that removes particles: the group fills up, then every
+  // newborn is dropped. (Hair groups end their strands by themselves.)
+  const bool forever =
+      std::any_of(g.emitters.begin(), g.emitters.end(), emitsForever) ||
+      std::any_of(g.primeEmitters.begin(), g.primeEmitters.end(),
+                  [](const PrimeEmitter& e) { return std::isinf(e.stop) && e.rate > 0; });
+  if (!g.hair.enabled && forever && !hasAction<KillOld>(actions) && !hasAction<Sink>(actions) &&
+      !hasAction<SinkVelocity>(actions))
+    warn(ap,
+         "nothing removes particles (no KillOld, Sink or SinkVelocity): the group fills to "
+         "its capacity of " +
+             std::to_string(g.capacity) + " and then drops every newborn");
+}
+
 // ---- groups and the effect ------------------------------------------------------------------
 
 EffectGroup readGroup(const json& j, const std::string& path, const Loader& L,
-                      const std::vector<EffectGroup>& before) {
+                      const std::vector<EffectGroup>& before,
+                      std::vector<EffectWarning>& warnings) {
   Obj o(j, path, L);
   EffectGroup g;
   g.name = "group" + std::to_string(before.size());
@@ -1073,9 +1143,8 @@ EffectGroup readGroup(const json& j, const std::string& path, const Loader& L,
       parsed.push_back(std::move(a));
     }
   }
-  const bool hasConstrain = std::any_of(parsed.begin(), parsed.end(), [](const Action& a) {
-    return std::holds_alternative<Constrain2D>(a);
-  });
+  const std::vector<Action> asWritten = parsed;  // for the warnings' JSON indices
+  const bool hasConstrain = hasAction<Constrain2D>(parsed);
   if (plane && !hasConstrain) {
     // Project after the forces, before deflectors, absorbers and Move read the motion.
     auto it = std::find_if(parsed.begin(), parsed.end(), [](const Action& a) {
@@ -1154,6 +1223,7 @@ EffectGroup readGroup(const json& j, const std::string& path, const Loader& L,
     }
   }
   o.finish();
+  warnGroup(g, asWritten, path, warnings);
   return g;
 }
 
@@ -1179,11 +1249,21 @@ Effect readEffect(const json& j, const Loader& L, const std::string& defaultName
   arrayOf(gs, "groups", L, 0, "an array of groups");
   if (gs.empty()) L.fail("groups", "an effect needs at least one group");
   for (std::size_t i = 0; i < gs.size(); ++i)
-    fx.groups.push_back(readGroup(gs[i], index("groups", i), L, fx.groups));
+    fx.groups.push_back(readGroup(gs[i], index("groups", i), L, fx.groups, fx.warnings));
   if (const json* r = o.get("render")) {
     if (!r->is_object()) L.fail(o.at("render"), "expected an object, got " + kindOf(*r));
     if (depthOf(*r) > 64) L.fail(o.at("render"), "nested more than 64 levels deep");
     fx.render = r->dump();
+    // The renderer's own parser checks it now, so that an error names this file.
+    if (L.options->renderChecker) {
+      try {
+        L.options->renderChecker(fx.render, L.options->baseDir);
+      } catch (const InvalidArgument& e) {
+        L.rethrow(o.at("render"), e);
+      } catch (const Error& e) {
+        L.fail(o.at("render"), e.what());
+      }
+    }
   }
   o.finish();
   return fx;
@@ -1223,8 +1303,77 @@ std::vector<Group*> Effect::build(Context& ctx, std::size_t maxCapacity) const {
   return made;
 }
 
+namespace {
+
+/// Counts what the JSON document would hold, without building it (a SAX pass allocates
+/// nothing but a string at a time), to estimate the memory its DOM needs.
+struct SizeCounter : nlohmann::json_sax<json> {
+  std::size_t values = 0, members = 0, stringBytes = 0, largest = 0;
+  std::vector<std::size_t> open;  // elements of each open container
+
+  bool value() {
+    ++values;
+    if (!open.empty()) largest = std::max(largest, ++open.back());
+    return true;
+  }
+  bool null() override { return value(); }
+  bool boolean(bool) override { return value(); }
+  bool number_integer(number_integer_t) override { return value(); }
+  bool number_unsigned(number_unsigned_t) override { return value(); }
+  bool number_float(number_float_t, const string_t&) override { return value(); }
+  bool string(string_t& s) override {
+    stringBytes += s.size();
+    return value();
+  }
+  bool binary(binary_t&) override { return value(); }
+  bool start_object(std::size_t) override {
+    value();
+    open.push_back(0);
+    return true;
+  }
+  bool key(string_t& k) override {
+    ++members;
+    stringBytes += k.size();
+    return true;
+  }
+  bool end_object() override {
+    open.pop_back();
+    return true;
+  }
+  bool start_array(std::size_t) override { return start_object(0); }
+  bool end_array() override { return end_object(); }
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) override {
+    return false;  // the DOM parse reports it, with its position
+  }
+};
+
+/// Makes sure the memory the document's DOM needs is there before building it: nlohmann's
+/// destructor allocates (a stack as long as the largest array), so running out of memory
+/// in the middle of a parse would end in std::terminate. Throws std::bad_alloc, having built
+/// nothing, when it is not.
+void reserveForDom(std::string_view text) {
+  SizeCounter c;
+  if (!json::sax_parse(text.begin(), text.end(), &c, nlohmann::detail::input_format_t::json, false,
+                       true))
+    return;
+  // A value's slot, a container's storage with growth slack, an object member's map node and
+  // key, the strings, and the destructor's stack (generous: it is a probe, not a budget).
+  const std::size_t bytes = c.values * 64 + c.members * 128 + c.stringBytes * 2 + c.largest * 48;
+  // Through a volatile pointer: the compiler may not elide an allocation it cannot see used.
+  void* volatile probe = std::malloc(bytes);
+  if (!probe) throw std::bad_alloc();
+  std::free(probe);
+}
+
+}  // namespace
+
 Effect parseEffect(std::string_view text, const std::string& fileName,
                    const EffectLoadOptions& options) {
+  try {
+    reserveForDom(text);
+  } catch (const std::bad_alloc&) {
+    throw EffectError(fileName, "", "out of memory: the file is too large to parse here");
+  }
   json j;
   try {
     // Comments (// and /* */) are allowed: effect files are written by hand.
@@ -1252,14 +1401,40 @@ Effect parseEffect(std::string_view text, const std::string& fileName,
   }
 }
 
+namespace {
+std::string byteCount(std::size_t n) {
+  if (n >= (std::size_t(1) << 20) && n % (std::size_t(1) << 20) == 0)
+    return std::to_string(n >> 20) + " MiB";
+  return std::to_string(n) + " bytes";
+}
+}  // namespace
+
 Effect loadEffect(const std::filesystem::path& file, EffectLoadOptions options) {
+  namespace fs = std::filesystem;
+  const std::string name = file.string();
+  std::error_code ec;
+  const fs::file_status st = fs::status(file, ec);
+  if (fs::is_directory(st)) throw EffectError(name, "", "is a directory");
+  const std::size_t limit = options.maxFileBytes;
+  const std::string tooLarge = "larger than " + byteCount(limit) + ", the limit for an effect file";
+  if (fs::is_regular_file(st)) {
+    const std::uintmax_t size = fs::file_size(file, ec);
+    if (!ec && size > limit) throw EffectError(name, "", tooLarge);
+  }
   std::ifstream in(file, std::ios::binary);
-  if (!in) throw EffectError(file.string(), "", "cannot open the file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) throw EffectError(file.string(), "", "cannot read the file");
+  if (!in) throw EffectError(name, "", "cannot open the file");
+  // Read in chunks up to the limit: a pipe or a device (/dev/zero) has no size to check first.
+  std::string text;
+  char chunk[1 << 16];
+  while (in) {
+    in.read(chunk, sizeof chunk);
+    const std::size_t got = std::size_t(in.gcount());
+    if (got > limit - text.size()) throw EffectError(name, "", tooLarge);
+    text.append(chunk, got);
+  }
+  if (in.bad()) throw EffectError(name, "", "cannot read the file");
   if (options.baseDir.empty()) options.baseDir = file.parent_path();
-  Effect fx = parseEffect(ss.str(), file.string(), options);
+  Effect fx = parseEffect(text, name, options);
   fx.file = file;
   return fx;
 }
