@@ -626,6 +626,18 @@ TEST(EffectLoader, WarnsAboutListsThatCannotDoWhatTheyImply) {
                                     "actions": [{"type": "Move"}, {"type": "KillOld"}])")),
             (std::vector<std::string>{"groups[0].emitters[0]: emits nothing: its rate is 0 and "
                                       "it has no bursts (nor a spacing while it moves)"}));
+  // Prime emitters whose showers would outgrow their emitter capacity (maxEmitters).
+  const std::string acts = R"(, "actions": [{"type": "Move"}, {"type": "KillOld"}])";
+  EXPECT_EQ(warningsOf(withGroup(R"("primeEmitters": [{"rate": 1000, "maxEmitters": 100,
+                "child": {"lifetime": 2, "deathChildren": 3, "emitter": {"rate": 10},
+                          "next": {"lifetime": 0.5}}}])" + acts)),
+            (std::vector<std::string>{
+                "groups[0].primeEmitters[0]: keeps about 3500 emitters alive at once (rate and "
+                "largest burst times each level's lifetime and deathChildren), more than its "
+                "maxEmitters of 100: spawns past it are dropped"}));
+  EXPECT_TRUE(warningsOf(withGroup(R"("primeEmitters": [{"rate": 10, "maxEmitters": 100,
+                "child": {"lifetime": 2, "emitter": {"rate": 10}}}])" + acts))
+                  .empty());
   // A 2-D group: the inserted constraint does not shift the actions' JSON indices.
   const auto w2d = warningsOf(withGroup(emitter + R"(, "mode2d": true, "actions": [
       {"type": "Gravity"}, {"type": "KillOld"}])"));

@@ -1031,6 +1031,21 @@ bool emitsForever(const Emitter& e) {
   return std::isinf(e.stop) && (e.rate > 0 || (e.spacing > 0 && e.velocity != Vec3(0.0f)));
 }
 
+/// About how many emitters a prime emitter's showers keep alive at once in steady state:
+/// each level lives its mean lifetime, fed by the rate (and the largest burst at once)
+/// times the deathChildren of the levels above it.
+double liveEmitters(const PrimeEmitter& e) {
+  double feed = e.rate, burst = 0.0, live = 0.0;
+  for (const Burst& b : e.bursts) burst = std::max(burst, double(b.count));
+  int depth = 0;
+  for (const EmitterSpec* s = &e.child; s && depth < 64; s = s->next.get(), ++depth) {
+    live += feed * std::max(0.0f, s->lifetime.center) + burst;
+    feed *= s->deathChildren;
+    burst *= s->deathChildren;
+  }
+  return live;
+}
+
 /// Every warning about a group (see EffectWarning): what its file asks for that cannot happen
 /// as written. `actions` is its action list in file order (before a 2-D constraint is
 /// inserted), so that indices are JSON indices. A new check is one more block here.
@@ -1053,6 +1068,13 @@ void warnGroup(const EffectGroup& g, const std::vector<Action>& actions, const s
     if (e.rate == 0 && e.bursts.empty())
       warn(index(join(path, "primeEmitters"), i),
            "spawns no emitters: its rate is 0 and it has no bursts");
+    const double live = liveEmitters(e);
+    if (live > e.maxEmitters)
+      warn(index(join(path, "primeEmitters"), i),
+           "keeps about " + std::to_string(std::llround(std::min(live, 1e18))) +
+               " emitters alive at once (rate and largest burst times each level's lifetime "
+               "and deathChildren), more than its maxEmitters of " +
+               std::to_string(e.maxEmitters) + ": spawns past it are dropped");
   }
   const bool filled = !g.emitters.empty() || !g.primeEmitters.empty();
   if (!filled) {
