@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "flurry/flurry.hpp"
 #include "noise.hpp"
@@ -22,6 +23,38 @@ Particle at(Vec3 p, Vec3 v = Vec3(0)) {
   return q;
 }
 }  // namespace
+
+// Issue #12 item 3: softened forces with a tiny epsilon leave a particle at the centre untouched
+// (the header's promise), instead of 0·inf = NaN.
+TEST(SoftenedForces, TinyEpsilonIsFiniteAtTheCentre) {
+  for (const float eps : {1e-3f, 1e-26f, 1e-30f, std::numeric_limits<float>::denorm_min()}) {
+    Context ctx = makeContext(1.0 / 30.0);
+    Group& g = ctx.createGroup("centre", 16);
+    OrbitPoint point;
+    point.center = Vec3(1, 2, 3);
+    point.epsilon = eps;
+    OrbitLine line;
+    line.point = Vec3(1, 2, 3);
+    line.epsilon = eps;
+    Explosion blast;
+    blast.center = Vec3(1, 2, 3);
+    blast.epsilon = eps;
+    blast.speed = 0.0f;
+    g.setActions({point, line, blast, Move{}});
+    Particle p;
+    p.position = Vec3(1, 2, 3);
+    g.add(p);
+    Particle on;  // on OrbitLine's axis, off the point: the line pulls with d = 0
+    on.position = Vec3(1, 2.5f, 3);
+    g.add(on);
+    for (int s = 0; s < 3; ++s) ctx.step();
+    ASSERT_EQ(g.stats().killedNonFinite, 0u) << "epsilon " << eps;
+    ASSERT_EQ(g.size(), 2u);
+    const Particle q = g.particle(0);
+    EXPECT_EQ(q.position, Vec3(1, 2, 3)) << "epsilon " << eps;
+    EXPECT_EQ(q.velocity, Vec3(0.0f)) << "epsilon " << eps;
+  }
+}
 
 TEST(OrbitPoint, KeepsACircularOrbitsRadius) {
   Context ctx = makeContext(0.001);
