@@ -226,12 +226,15 @@ Scenario magnetic() {
 
 // A ball dropped from h0 onto the plane y = 0 with restitution e: apex n is at
 // h_n = e^{2n} h0. The apex is read at the step where vy turns from up to down as
-// y + vy²/(2g) (exact on a parabola), for the first three bounces.
+// y + vy²/(2g) (exact on a parabola), for the first three bounces. A step that bounces
+// (vy ends above the free fall's vy − g·dt) may also hold an apex: the previous flight's if
+// it began rising (read from the step's start), the new flight's if it ends falling.
 Scenario bouncingBall() {
   static const double g = 9.81, e = 0.8;
   static const int kApexes = 3;
   struct State {
-    std::vector<float> prevVy;
+    std::vector<float> prevVy, prevY;
+    double prevT = 0.0;
     std::vector<int> apexCount;
     std::vector<double> worst;
   };
@@ -256,13 +259,17 @@ Scenario bouncingBall() {
   };
   s.reset = [st] {
     st->prevVy.clear();
+    st->prevY.clear();
+    st->prevT = 0.0;
     st->apexCount.clear();
     st->worst.clear();
   };
   // Needs the initial heights: the observer sees ids and heights; ids are 0..n-1 in the
   // order added (checked by the driver), so the initial height is recomputed from the id.
   auto h0 = [](std::size_t i) { return 0.5 + u1(i); };
-  s.observe = [st, h0](const Group& grp, double) {
+  s.observe = [st, h0](const Group& grp, double t) {
+    const double dt = t - st->prevT;
+    st->prevT = t;
     const auto ids = grp.ids();
     const auto y = grp.lane(Attribute::Position, 1);
     const auto vy = grp.lane(Attribute::Velocity, 1);
@@ -270,16 +277,23 @@ Scenario bouncingBall() {
       const std::size_t i = ids[j];
       if (i >= st->prevVy.size()) {
         st->prevVy.resize(i + 1, 0.0f);
+        st->prevY.resize(i + 1, float(h0(i)));
         st->apexCount.resize(i + 1, 0);
         st->worst.resize(i + 1, 0.0);
       }
-      if (st->prevVy[i] > 0.0f && vy[j] <= 0.0f && st->apexCount[i] < kApexes) {
+      auto apexAt = [&](double py, double pvy) {
+        if (st->apexCount[i] >= kApexes) return;
         const int n = ++st->apexCount[i];
-        const double apex = double(y[j]) + double(vy[j]) * double(vy[j]) / (2.0 * g);
+        const double apex = py + pvy * pvy / (2.0 * g);
         const double want = std::pow(e, 2 * n) * h0(i);
         st->worst[i] = std::max(st->worst[i], std::abs(apex - want) / h0(i));
-      }
+      };
+      const double v0 = st->prevVy[i], v1 = vy[j];
+      const bool bounced = v1 > v0 - 0.5 * g * dt;
+      if (bounced && v0 > 0.0) apexAt(st->prevY[i], v0);
+      if ((v0 > 0.0 || bounced) && v1 <= 0.0) apexAt(y[j], v1);
       st->prevVy[i] = vy[j];
+      st->prevY[i] = y[j];
     }
   };
   s.errors = [st](const std::vector<std::optional<Particle>>& fin,

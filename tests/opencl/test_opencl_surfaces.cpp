@@ -257,8 +257,12 @@ TEST(OpenCLSurfaces, BounceUnderIntegrators) {
   sphere.inside = true;
   Bounce box{Domain::box(Vec3(-1.2f, 1.6f, -0.9f), Vec3(1.0f, 2.2f, 1.1f)), 0.8f, 0.15f, 0.2f};
   Bounce seg{Domain::line(Vec3(-3.0f, -0.2f, 0.0f), Vec3(3.0f, 0.3f, 0.0f)), 0.7f, 0.1f, 0.0f};
-  const Bounce bounces[] = {kFloor, sphere, box, seg};
-  for (Integrator in : {Integrator::ExplicitEuler, Integrator::VelocityVerlet, Integrator::RK4}) {
+  // Planar pieces bounce on the parabola of the integrator's acceleration (Verlet, RK4, Exact).
+  Bounce disc{Domain::disc(Vec3(0.0f, 0.2f, 0.0f), Vec3(0.1f, 1.0f, 0.0f), 1.5f, 0.3f), 0.7f, 0.2f,
+              0.05f};
+  const Bounce bounces[] = {kFloor, sphere, box, seg, disc};
+  for (Integrator in : {Integrator::ExplicitEuler, Integrator::VelocityVerlet, Integrator::RK4,
+                        Integrator::Exact}) {
     for (const Bounce& b : bounces) {
       SCOPED_TRACE(std::string(integratorName(in)) + " " + b.surface.name());
       ActionList list{Gravity{kDown}, Damping{Vec3(0.3f)}, b, Move{}, KillOld{}};

@@ -30,9 +30,12 @@ constexpr std::size_t kParticlesPerTask = 32768;  // below this a group is stepp
 // How each action of the list runs this step.
 struct Plan {
   Integrator integrator = Integrator::SemiImplicitEuler;
-  std::vector<std::uint8_t> gathered;                  // a force an integrating Move evaluates
-  std::vector<std::vector<std::uint32_t>> forcesOf;    // per Move: its forces
-  std::vector<std::vector<std::uint32_t>> guardsOf;    // per Move: the Bounces before it
+  std::vector<std::uint8_t> gathered;                // a force an integrating Move evaluates
+  std::vector<std::vector<std::uint32_t>> forcesOf;  // per Move: its forces
+  std::vector<std::vector<std::uint32_t>> guardsOf;  // per Move: the Bounces before it
+  // Per planar Bounce before a Move that integrates forces with Exact, Verlet or RK4: 1 +
+  // that Move's index (it bounces on the curve the Move takes); else 0.
+  std::vector<std::uint32_t> curvedBy;
   std::uint32_t substeps = 1;
   const float* start[3] = {};  // positions when the step (or sub-step) began, for the guard
 };
@@ -44,6 +47,11 @@ Plan makePlan(const GroupImpl& g, const StepParams& sp, ThreadPool& pool) {
   plan.gathered.assign(acts.size(), 0);
   plan.forcesOf.resize(acts.size());
   plan.guardsOf.resize(acts.size());
+  plan.curvedBy.assign(acts.size(), 0);
+  // Explicit Euler moves on the straight line p + v·dt: the plain bounce is its own path.
+  const bool curved = plan.integrator == Integrator::Exact ||
+                      plan.integrator == Integrator::VelocityVerlet ||
+                      plan.integrator == Integrator::RK4;
   if (plan.integrator != Integrator::SemiImplicitEuler) {
     std::vector<std::uint32_t> pending, bounces;
     for (std::uint32_t k = 0; k < acts.size(); ++k) {
@@ -51,6 +59,9 @@ Plan makePlan(const GroupImpl& g, const StepParams& sp, ThreadPool& pool) {
       if (std::holds_alternative<Bounce>(acts[k])) bounces.push_back(k);
       if (std::holds_alternative<Move>(acts[k])) {
         for (std::uint32_t f : pending) plan.gathered[f] = 1;
+        for (std::uint32_t b : bounces)
+          if (curved && !pending.empty() && cpu::isPlanarBounce(std::get<Bounce>(acts[b])))
+            plan.curvedBy[b] = k + 1;
         plan.forcesOf[k] = std::move(pending);
         plan.guardsOf[k] = std::move(bounces);
         pending.clear();
@@ -137,6 +148,15 @@ void runActions(const std::vector<Action>& acts, const Plan& plan, std::size_t f
         for (int c = 0; c < 3; ++c) start[c] = plan.start[c] + ctx.base;
         for (std::uint32_t b : plan.guardsOf[k]) guard(std::get<Bounce>(acts[b]), lanes, start, n);
       }
+      continue;
+    }
+    if (plan.curvedBy[k]) {
+      // The acceleration the Move's integrator starts from, taken as constant over the step.
+      cpu::IntegratorScratch& scratch = scratchStore;
+      scratch.reset(n, 3);
+      float* acc[3] = {scratch.take(n), scratch.take(n), scratch.take(n)};
+      cpu::startAcceleration(acts, plan.forcesOf[plan.curvedBy[k] - 1], lanes, n, ctx, acc);
+      cpu::applyAccelerated(std::get<Bounce>(acts[k]), lanes, n, ctx, acc);
       continue;
     }
     std::visit([&](const auto& a) { cpu::apply(a, lanes, n, ctx); }, acts[k]);

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <vector>
 
-#include "actions_more.hpp"
 #include "../isa_namespace.hpp"
+#include "actions_more.hpp"
 
 namespace flurry::detail::cpu {
 inline namespace FLURRY_ISA_NAMESPACE {  // see isa_namespace.hpp
@@ -20,7 +20,9 @@ struct Stage {
 };
 
 namespace {
-inline Vec3 get(const float* const* a, std::size_t i) { return Vec3(a[0][i], a[1][i], a[2][i]); }
+inline Vec3 get(const float* const* a, std::size_t i) {
+  return Vec3(a[0][i], a[1][i], a[2][i]);
+}
 inline void add(float* const* a, std::size_t i, Vec3 d) {
   a[0][i] += d.x;
   a[1][i] += d.y;
@@ -124,6 +126,21 @@ struct IntegratorScratch {
   }
   std::size_t used = 0;
 };
+
+/// The acceleration a Bounce takes as constant over the step before a Move that integrates
+/// `forces` (fused_pass.cpp): the forces evaluated at the block's state at the step's start,
+/// as the integrators' first stage evaluates them, into `a` (three arrays of n).
+inline void startAcceleration(const std::vector<Action>& acts,
+                              const std::vector<std::uint32_t>& forces, const Lanes& L,
+                              std::size_t n, const BlockContext& c, float* const* a) {
+  for (int d = 0; d < 3; ++d) std::fill_n(a[d], n, 0.0f);
+  const Stage s{{L.p[0], L.p[1], L.p[2]}, {L.v[0], L.v[1], L.v[2]}, {a[0], a[1], a[2]}};
+  for (std::uint32_t k : forces) {
+    BlockContext ck = c;
+    ck.action = k;
+    accumulate(acts[k], s, L, n, ck, c.time);
+  }
+}
 
 /// Move with an integrator other than semi-implicit Euler: `forces` are the indices of the
 /// force actions gathered for this Move.

@@ -9,11 +9,11 @@
 #include <cstdint>
 
 #include "../group_impl.hpp"
+#include "../isa_namespace.hpp"
 #include "../noise.hpp"
 #include "../shape_math.hpp"
 #include "flurry/actions.hpp"
 #include "flurry/random.hpp"
-#include "../isa_namespace.hpp"
 
 namespace flurry::detail::cpu {
 inline namespace FLURRY_ISA_NAMESPACE {  // see isa_namespace.hpp
@@ -51,8 +51,8 @@ inline void addLoop(float* __restrict x, float* __restrict y, float* __restrict 
   }
 }
 
-inline void scaleLoop(float* __restrict x, float* __restrict y, float* __restrict z,
-                      std::size_t n, float fx, float fy, float fz) {
+inline void scaleLoop(float* __restrict x, float* __restrict y, float* __restrict z, std::size_t n,
+                      float fx, float fy, float fz) {
   for (std::size_t i = 0; i < n; ++i) {
     x[i] *= fx;
     y[i] *= fy;
@@ -160,9 +160,8 @@ struct Reflect {
   float restitution, keep, cutoff2;
   // In: position p, velocity v, hit point h, unit normal nrm, time of impact tau.
   // Out: the new position and velocity.
-  inline void operator()(float& px, float& py, float& pz, float& vx, float& vy, float& vz,
-                         float hx, float hy, float hz, float nx, float ny, float nz,
-                         float tau) const {
+  inline void operator()(float& px, float& py, float& pz, float& vx, float& vy, float& vz, float hx,
+                         float hy, float hz, float nx, float ny, float nz, float tau) const {
     const float vn = vx * nx + vy * ny + vz * nz;
     const float vnx = vn * nx, vny = vn * ny, vnz = vn * nz;
     const float tx = vx - vnx, ty = vy - vny, tz = vz - vnz;
@@ -237,6 +236,94 @@ inline void bouncePlanarLoop(float* __restrict px, float* __restrict py, float* 
     vxs[i] = ovx;
     vys[i] = ovy;
     vzs[i] = ovz;
+  }
+}
+
+/// The same deflector when the following Move integrates each particle with an acceleration
+/// a (per particle: ax, ay, az) taken as constant over the step (Exact with gravity and
+/// electric fields; Verlet and RK4 with their first stage's): the particle moves on the
+/// parabola p + v·t + ½a·t², so the impact is found on it and the velocity it has at the
+/// impact, v + a·tau, is reflected. The start-of-step state is then set so that the
+/// integrator's p + v·dt + ½a·dt² runs the reflected parabola after the impact. With the
+/// straight path instead, the impact velocity would be off by a·(dt − tau): first order.
+template <class OnPiece>
+inline void bouncePlanarAccelLoop(float* __restrict px, float* __restrict py, float* __restrict pz,
+                                  float* __restrict vxs, float* __restrict vys,
+                                  float* __restrict vzs, const float* __restrict axs,
+                                  const float* __restrict ays, const float* __restrict azs,
+                                  std::size_t n, float dt, Vec3 P, Vec3 N, OnPiece onPiece,
+                                  const Bounce& b) {
+  const Reflect reflect{b.restitution, 1.0f - b.friction, b.cutoff * b.cutoff};
+  const float hdt2 = 0.5f * dt * dt;
+  for (std::size_t i = 0; i < n; ++i) {
+    const float x = px[i], y = py[i], z = pz[i];
+    const float vx = vxs[i], vy = vys[i], vz = vzs[i];
+    const float ax = axs[i], ay = ays[i], az = azs[i];
+    const float d0 = (x - P.x) * N.x + (y - P.y) * N.y + (z - P.z) * N.z;
+    const float vn = vx * N.x + vy * N.y + vz * N.z;
+    const float an = ax * N.x + ay * N.y + az * N.z;
+    const float side = d0 >= 0.0f ? 1.0f : -1.0f;
+    // Towards the side it is on: s(t) = s0 + u·t + ½w·t², s0 > 0 (0 when on the plane).
+    const float s0 = side * d0, u = side * vn, w = side * an;
+    const float s1 = s0 + u * dt + w * hdt2;
+    const float reach =
+        1.2e-7f *
+            (std::abs(N.x) *
+                 (std::abs(x) + std::abs(P.x) + 2.0f * (std::abs(vx * dt) + std::abs(ax * hdt2))) +
+             std::abs(N.y) *
+                 (std::abs(y) + std::abs(P.y) + 2.0f * (std::abs(vy * dt) + std::abs(ay * hdt2))) +
+             std::abs(N.z) *
+                 (std::abs(z) + std::abs(P.z) + 2.0f * (std::abs(vz * dt) + std::abs(az * hdt2)))) +
+        1e-30f;
+    // The first root of s(t) = 0, in the forms without cancellation: approaching (u < 0)
+    // 2·s0 / (√D − u); receding but pulled back (u ≥ 0, w < 0) (u + √D) / −w. D < 0: the
+    // path turns before it reaches the plane.
+    const float D = u * u - 2.0f * w * s0;
+    const float sq = std::sqrt(std::max(D, 0.0f));
+    const float root = u < 0.0f ? 2.0f * s0 / (sq - u) : (u + sq) / -w;
+    const bool crossing = (D >= 0.0f) & (root >= 0.0f) & (root <= dt);
+    // Or ending within a few ulps of the plane: an arrival at the end of the step.
+    const float tau = crossing ? root : dt;
+    const float hx = x + (vx + 0.5f * ax * tau) * tau, hy = y + (vy + 0.5f * ay * tau) * tau,
+                hz = z + (vz + 0.5f * az * tau) * tau;
+    // Approaching at the impact; one born or placed exactly on the plane leaves it freely.
+    const bool hit =
+        (crossing | (s1 <= reach)) & (u + w * tau < 0.0f) & (d0 != 0.0f) & onPiece(hx, hy, hz);
+    if (!hit) continue;
+    // The velocity at the impact, reflected; then the start of a parabola through h at tau
+    // with that velocity: v_start = v' − a·tau, p_start = h − v'·tau + ½a·tau².
+    float nx = x, ny = y, nz = z;
+    float nvx = vx + ax * tau, nvy = vy + ay * tau, nvz = vz + az * tau;
+    reflect(nx, ny, nz, nvx, nvy, nvz, hx, hy, hz, N.x, N.y, N.z, tau);
+    const float htau2 = 0.5f * tau * tau;
+    nx += ax * htau2;
+    ny += ay * htau2;
+    nz += az * htau2;
+    nvx -= ax * tau;
+    nvy -= ay * tau;
+    nvz -= az * tau;
+    // Where the integrator will put it (as Exact computes it); pushed out if rounding left
+    // it on or behind the plane. The reflected parabola may also come back through the
+    // plane within the step (a slow bounce): then it ends just in front of it.
+    const float sx = nvx * dt + 0.5f * ax * dt * dt, sy = nvy * dt + 0.5f * ay * dt * dt,
+                sz = nvz * dt + 0.5f * az * dt * dt;
+    const float qx = nx + sx, qy = ny + sy, qz = nz + sz;
+    const float qd = side * ((qx - P.x) * N.x + (qy - P.y) * N.y + (qz - P.z) * N.z);
+    const float margin =
+        1.2e-7f * (std::abs(N.x) *
+                       (std::abs(qx) + std::abs(P.x) + std::abs(nvx * dt) + std::abs(ax * hdt2)) +
+                   std::abs(N.y) *
+                       (std::abs(qy) + std::abs(P.y) + std::abs(nvy * dt) + std::abs(ay * hdt2)) +
+                   std::abs(N.z) *
+                       (std::abs(qz) + std::abs(P.z) + std::abs(nvz * dt) + std::abs(az * hdt2))) +
+        1e-30f;
+    const float push = std::max(margin - qd, 0.0f) * side;
+    px[i] = nx + push * N.x;
+    py[i] = ny + push * N.y;
+    pz[i] = nz + push * N.z;
+    vxs[i] = nvx;
+    vys[i] = nvy;
+    vzs[i] = nvz;
   }
 }
 
@@ -370,8 +457,8 @@ inline void bounceBoxInside(float* __restrict px, float* __restrict py, float* _
     for (int k = 0; k < 3; ++k) {
       if (hit[k]) {
         const float margin = 4e-7f * (std::abs(wall[k]) + std::abs(nv[k] * dt)) + 1e-30f;
-        const float end = std::clamp(wall[k] + nv[k] * (dt - tau[k]), box.min[k] + margin,
-                                     box.max[k] - margin);
+        const float end =
+            std::clamp(wall[k] + nv[k] * (dt - tau[k]), box.min[k] + margin, box.max[k] - margin);
         p[k][i] = end - nv[k] * dt;
       }
       // A slower velocity on an axis that did not hit stays between here and the old end.
@@ -428,56 +515,70 @@ inline void bounceBoxOutside(float* __restrict px, float* __restrict py, float* 
   }
 }
 
-template <class OnPiece>
-inline void bouncePlanar(Vec3 P, Vec3 N, OnPiece onPiece, const Bounce& b, const Lanes& L,
-                         std::size_t n, float dt) {
-  bouncePlanarLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, dt, P, N, onPiece, b);
-}
-
-inline void apply(const Bounce& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+// Calls f(P, N, onPiece) for a planar Bounce surface (plane, rectangle, triangle, disc, and
+// the 2-D segment, a wall standing on the group's plane); false for the others.
+template <class F>
+inline bool withPlanarPiece(const Bounce& a, F&& f) {
   const auto& shape = a.surface.shape();
   if (const auto* pl = std::get_if<PlaneDomain>(&shape)) {
-    bouncePlanar(pl->point, pl->normal, [](float, float, float) { return true; }, a, L, n, c.dt);
+    f(pl->point, pl->normal, [](float, float, float) { return true; });
   } else if (const auto* r = std::get_if<RectangleDomain>(&shape)) {
     // Dual vectors give the (s, t) coordinates of a point of the plane, also for a rhombus.
     const Vec3 cu = glm::cross(r->v, r->normal), cv = glm::cross(r->normal, r->u);
     const Vec3 du = cu / glm::dot(r->u, cu), dv = cv / glm::dot(r->v, cv);
     const Vec3 o = r->origin;
-    bouncePlanar(
-        o, r->normal,
-        [=](float x, float y, float z) {
-          const float wx = x - o.x, wy = y - o.y, wz = z - o.z;
-          const float s = wx * du.x + wy * du.y + wz * du.z;
-          const float t = wx * dv.x + wy * dv.y + wz * dv.z;
-          return (s >= 0.0f) & (s <= 1.0f) & (t >= 0.0f) & (t <= 1.0f);
-        },
-        a, L, n, c.dt);
+    f(o, r->normal, [=](float x, float y, float z) {
+      const float wx = x - o.x, wy = y - o.y, wz = z - o.z;
+      const float s = wx * du.x + wy * du.y + wz * du.z;
+      const float t = wx * dv.x + wy * dv.y + wz * dv.z;
+      return (s >= 0.0f) & (s <= 1.0f) & (t >= 0.0f) & (t <= 1.0f);
+    });
   } else if (const auto* t = std::get_if<TriangleDomain>(&shape)) {
     const Vec3 e1 = t->p1 - t->p0, e2 = t->p2 - t->p0;
     const Vec3 c1 = glm::cross(e2, t->normal), c2 = glm::cross(t->normal, e1);
     const Vec3 d1 = c1 / glm::dot(e1, c1), d2 = c2 / glm::dot(e2, c2);
     const Vec3 o = t->p0;
-    bouncePlanar(
-        o, t->normal,
-        [=](float x, float y, float z) {
-          const float wx = x - o.x, wy = y - o.y, wz = z - o.z;
-          const float s = wx * d1.x + wy * d1.y + wz * d1.z;
-          const float u = wx * d2.x + wy * d2.y + wz * d2.z;
-          return (s >= 0.0f) & (u >= 0.0f) & (s + u <= 1.0f);
-        },
-        a, L, n, c.dt);
+    f(o, t->normal, [=](float x, float y, float z) {
+      const float wx = x - o.x, wy = y - o.y, wz = z - o.z;
+      const float s = wx * d1.x + wy * d1.y + wz * d1.z;
+      const float u = wx * d2.x + wy * d2.y + wz * d2.z;
+      return (s >= 0.0f) & (u >= 0.0f) & (s + u <= 1.0f);
+    });
   } else if (const auto* d = std::get_if<DiscDomain>(&shape)) {
     const Vec3 o = d->center;
     const float ro2 = d->outerRadius * d->outerRadius, ri2 = d->innerRadius * d->innerRadius;
-    bouncePlanar(
-        o, d->normal,
-        [=](float x, float y, float z) {
-          const float wx = x - o.x, wy = y - o.y, wz = z - o.z;
-          const float r2 = wx * wx + wy * wy + wz * wz;
-          return (r2 <= ro2) & (r2 >= ri2);
-        },
-        a, L, n, c.dt);
-  } else if (const auto* s = std::get_if<SphereDomain>(&shape)) {
+    f(o, d->normal, [=](float x, float y, float z) {
+      const float wx = x - o.x, wy = y - o.y, wz = z - o.z;
+      const float r2 = wx * wx + wy * wy + wz * wz;
+      return (r2 <= ro2) & (r2 >= ri2);
+    });
+  } else if (const auto* ln = std::get_if<LineDomain>(&shape)) {
+    // 2-D: the segment is a wall standing on the group's plane; its normal lies in the plane.
+    const Vec3 dir = ln->p1 - ln->p0;
+    const float len2 = glm::dot(dir, dir);
+    const Vec3 nrm = glm::normalize(glm::cross(dir, a.planeNormal));
+    const Vec3 o = ln->p0;
+    f(o, nrm, [=](float x, float y, float z) {
+      const float t = ((x - o.x) * dir.x + (y - o.y) * dir.y + (z - o.z) * dir.z) / len2;
+      return (t >= 0.0f) & (t <= 1.0f);
+    });
+  } else {
+    return false;
+  }
+  return true;
+}
+
+inline bool isPlanarBounce(const Bounce& a) {
+  return withPlanarPiece(a, [](Vec3, Vec3, auto) {});
+}
+
+inline void apply(const Bounce& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const bool planar = withPlanarPiece(a, [&](Vec3 P, Vec3 N, auto onPiece) {
+    bouncePlanarLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, c.dt, P, N, onPiece, a);
+  });
+  if (planar) return;
+  const auto& shape = a.surface.shape();
+  if (const auto* s = std::get_if<SphereDomain>(&shape)) {
     if (a.inside)
       bounceSphereLoop<true>(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, c.dt, *s, a);
     else
@@ -487,20 +588,20 @@ inline void apply(const Bounce& a, const Lanes& L, std::size_t n, const BlockCon
       bounceBoxInside(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, c.dt, *bx, a);
     else
       bounceBoxOutside(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, c.dt, *bx, a);
-  } else if (const auto* ln = std::get_if<LineDomain>(&shape)) {
-    // 2-D: the segment is a wall standing on the group's plane; its normal lies in the plane.
-    const Vec3 dir = ln->p1 - ln->p0;
-    const float len2 = glm::dot(dir, dir);
-    const Vec3 nrm = glm::normalize(glm::cross(dir, a.planeNormal));
-    const Vec3 o = ln->p0;
-    bouncePlanar(
-        o, nrm,
-        [=](float x, float y, float z) {
-          const float t = ((x - o.x) * dir.x + (y - o.y) * dir.y + (z - o.z) * dir.z) / len2;
-          return (t >= 0.0f) & (t <= 1.0f);
-        },
-        a, L, n, c.dt);
   }
+}
+
+/// A Bounce before a Move whose integrator moves each particle with the acceleration `acc`
+/// (three arrays, per particle) over the step: planar pieces bounce on that parabola.
+/// Spheres and boxes still bounce on the straight path (first order at the impact), and the
+/// guard after the Move keeps them on their side.
+inline void applyAccelerated(const Bounce& a, const Lanes& L, std::size_t n, const BlockContext& c,
+                             const float* const* acc) {
+  const bool planar = withPlanarPiece(a, [&](Vec3 P, Vec3 N, auto onPiece) {
+    bouncePlanarAccelLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], acc[0], acc[1], acc[2], n,
+                          c.dt, P, N, onPiece, a);
+  });
+  if (!planar) apply(a, L, n, c);
 }
 
 }  // namespace FLURRY_ISA_NAMESPACE

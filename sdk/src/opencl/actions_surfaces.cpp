@@ -96,6 +96,13 @@ const char* kSnapArgs = "snap, snapStride, snapN, i";
 
 }  // namespace
 
+std::string bounceOnCurve(const Bounce& b, const std::string& params, const std::string& acc) {
+  const int piece = pieceOf(b.surface);
+  if (piece < 0) return "";
+  return "fl_bounce_planar_accel(" + params + ", " + std::to_string(piece) + ", dt, " + acc +
+         "x, " + acc + "y, " + acc + "z, &px, &py, &pz, &vx, &vy, &vz);\n";
+}
+
 bool generateSurfaceAction(const Action& act, ActionSource& s) {
   const std::string& ap = s.in.params;
   const std::string pv = "&px, &py, &pz, &vx, &vy, &vz);\n";

@@ -404,9 +404,10 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   std::vector<std::size_t> pendingBounces;
   bool guarded = false;  // some Bounce is guarded: keep where each particle began the step
   const auto& acts = actions.actions();
+  std::vector<ActionSource> sources(acts.size());
   for (std::size_t k = 0; k < acts.size(); ++k) {
     const Action& act = acts[k];
-    ActionSource src;
+    ActionSource& src = sources[k];
     src.in.index = k;
     src.in.stored = stored;
     src.in.params = "(ap + " + std::to_string(k) + ")";
@@ -415,6 +416,28 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
     if (!generateCoreAction(act, src) && !generateForceAction(act, src) &&
         !generateSurfaceAction(act, src))
       notOnDevice("action '" + actionName(act) + "' (actions[" + std::to_string(k) + "])");
+  }
+  // A planar Bounce before a Move that integrates with Exact, Verlet or RK4 bounces on the
+  // parabola of the acceleration that Move's integrator starts from (fused_pass.cpp
+  // curvedBy): all forces since the previous Move, evaluated at the Bounce's state.
+  std::vector<std::vector<std::string>> curveForces(acts.size());
+  if (integrator == Integrator::Exact || integrator == Integrator::VelocityVerlet ||
+      integrator == Integrator::RK4) {
+    std::vector<std::string> forces;
+    std::vector<std::size_t> bounces;
+    for (std::size_t k = 0; k < acts.size(); ++k) {
+      if (isForce(acts[k]) && !sources[k].accel.empty()) forces.push_back(sources[k].accel);
+      if (std::holds_alternative<Bounce>(acts[k])) bounces.push_back(k);
+      if (std::holds_alternative<Move>(acts[k])) {
+        for (std::size_t b : bounces) curveForces[b] = forces;
+        forces.clear();
+        bounces.clear();
+      }
+    }
+  }
+  for (std::size_t k = 0; k < acts.size(); ++k) {
+    const Action& act = acts[k];
+    ActionSource& src = sources[k];
     reads.insert(src.reads);
     writes.insert(src.writes);
     g.neighbours |= src.neighbours;
@@ -428,7 +451,19 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
         body << "    /* (evaluated by the next Move's integrator) */\n";
         continue;
       }
-      if (std::holds_alternative<Bounce>(act)) pendingBounces.push_back(k);
+      if (std::holds_alternative<Bounce>(act)) {
+        pendingBounces.push_back(k);
+        const std::string call = bounceOnCurve(std::get<Bounce>(act), src.in.params, "fl_bounce_a");
+        if (!curveForces[k].empty() && !call.empty()) {
+          // The state under other names: the forces' code reads px.. in its own block.
+          body << "    { const float fl_b_px = px, fl_b_py = py, fl_b_pz = pz, fl_b_vx = vx, "
+                  "fl_b_vy = vy, fl_b_vz = vz;\n    float fl_bounce_ax, fl_bounce_ay, "
+                  "fl_bounce_az;\n    "
+               << evaluate(curveForces[k], "fl_b_", "time", "fl_bounce_") << "    " << call
+               << "    }\n";
+          continue;
+        }
+      }
       if (std::holds_alternative<Move>(act)) {
         reads.insert({Attribute::Position, Attribute::Velocity});
         writes.insert({Attribute::Position, Attribute::Velocity});

@@ -94,6 +94,9 @@ bool packForceAction(const Action& a, ActionPack& p);
 // actions that read neighbours.
 bool generateSurfaceAction(const Action& a, ActionSource& s);
 bool packSurfaceAction(const Action& a, ActionPack& p);
+/// A planar Bounce's call when the next Move integrates with the acceleration held in the
+/// variables `acc` + "x", "y", "z" (fl_bounce_planar_accel); "" for other surfaces.
+std::string bounceOnCurve(const Bounce& b, const std::string& params, const std::string& acc);
 
 /// Throws the Error that says an action (or a variant of one) does not run on the device.
 [[noreturn]] void notOnDevice(const std::string& what);
