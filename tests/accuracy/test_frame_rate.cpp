@@ -367,10 +367,11 @@ TEST(FrameRate, ChargeCirclesAtTheLarmorRadius) {
 
 // A ball dropped from h0 onto a plane with restitution e reaches apex n at e^{2n}·h0. The
 // apex is read from the step where vy turns negative as y + vy²/2g (exact on a parabola).
-// Bounce places the impact inside the step but reflects the velocity the step has (not
-// the velocity at the moment of impact, which differs by up to g·dt), so every integrator
-// is first order at a bounce: each bounce may change the energy height by up to
-// v_impact·dt ≤ sqrt(2g·h0)·dt. In flight, Exact, Verlet and RK4 are exact under constant
+// With the Eulers Bounce reflects the velocity the step has (not the one at the moment of
+// impact, which differs by up to g·dt), so they are first order at a bounce: each bounce
+// may change the energy height by up to v_impact·dt ≤ sqrt(2g·h0)·dt. Exact, Verlet and RK4
+// reflect the velocity at impact on their parabola (Integrators.BounceIsExactUnderConstant-
+// Gravity holds them to float error); this bound covers them with room. In flight, Exact, Verlet and RK4 are exact under constant
 // gravity; for the Eulers y + vy²/2g drifts by g·dt²/2 per step (exactly, for semi-implicit
 // Euler), g·t·dt/2 by time t. Allowed: g·t·dt + n·sqrt(2g·h0)·dt at apex n (2× the flight
 // term for margin).
