@@ -3,6 +3,10 @@
 //
 //   build/release/bench/bench_fountain --benchmark_repetitions=5
 //
+// Small groups (a game steps hundreds of ~1k-particle groups a frame) are measured apart:
+//
+//   build/release/bench/bench_fountain --benchmark_filter=Small --benchmark_repetitions=5
+//
 // After the runs it prints a summary of ratios between the medians of this run.
 #include <benchmark/benchmark.h>
 
@@ -22,7 +26,9 @@ using namespace flurry;
 
 namespace {
 
-unsigned threads() { return std::max(1u, std::thread::hardware_concurrency()); }
+unsigned threads() {
+  return std::max(1u, std::thread::hardware_concurrency());
+}
 
 // Bytes the fountain's update reads and writes per particle-step: position and velocity
 // read and written (24 + 24), age read and written (4 + 4), lifetime read (4).
@@ -101,6 +107,51 @@ void Emission(benchmark::State& state) {
       born / threads() * 1e-9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
+// A fountain-like group of about 1000 live particles at steady state: rate × lifetime =
+// 500/s × 2 s, gravity, a plane bounce, KillOld, Move (about 17 born and dying per step).
+constexpr std::size_t kSmallLive = 1000;
+
+Group& smallFountain(Context& ctx, const std::string& name) {
+  Group& g = ctx.createGroup(name, kSmallLive + kSmallLive / 2);
+  Emitter e;
+  e.shape = Domain::disc(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f), 0.1f);
+  ParticleType t;
+  t.velocity = Domain::cone(Vec3(0.0f), Vec3(0.0f, 8.0f, 0.0f), 1.5f);
+  t.lifetime = Fuzzy::percent(2.0f, 10.0f);
+  e.types = {t};
+  e.rate = double(kSmallLive) / 2.0;
+  g.addEmitter(e);
+  g.setActions(fountainActions());
+  return g;
+}
+
+// The whole Context::step() of `groups` small groups, on `threads` threads; reports the
+// time per group-step.
+void SmallGroups(benchmark::State& state) {
+  const auto groups = std::size_t(state.range(0));
+  ContextOptions o;
+  o.threads = unsigned(state.range(1));
+  Context ctx(o);
+  std::vector<Group*> all;
+  for (std::size_t k = 0; k < groups; ++k)
+    all.push_back(&smallFountain(ctx, "small" + std::to_string(k)));
+  ctx.run(90);  // 3 s: past the longest lifetime (2.2 s), births and deaths balance
+  double live = 0;
+  for (auto _ : state) {
+    ctx.step();
+    live += double(all[0]->size());
+  }
+  state.counters["live"] = live / double(state.iterations());
+  state.counters["us/group-step"] =
+      benchmark::Counter(double(state.iterations()) * double(groups) * 1e-6,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+// One small group alone.
+void SmallGroupStep(benchmark::State& state) {
+  SmallGroups(state);
+}
+
 // The ceiling, measured the same way in every benchmark (bench/common).
 void ReadModifyWrite(benchmark::State& state) {
   flurry::bench::readModifyWrite(state, kLanes, threads());
@@ -119,13 +170,18 @@ class RatioReporter : public benchmark::ConsoleReporter {
       const auto items = r.counters.find("items_per_second");
       std::string name = r.run_name.function_name + "/" + r.run_name.args;
       if (it != r.counters.end()) bytes_[name] = it->second;
+      if (name.rfind("Small", 0) == 0) {
+        const auto per = r.counters.find("us/group-step");
+        if (per != r.counters.end()) small_[name] = per->second;
+      }
       if (items != r.counters.end()) items_[name] = items->second;
     }
   }
   void Finalize() override {
     ConsoleReporter::Finalize();
-    std::printf("\nSummary (%u threads; GB/s count the bytes of the attributes read and written):\n",
-                threads());
+    std::printf(
+        "\nSummary (%u threads; GB/s count the bytes of the attributes read and written):\n",
+        threads());
     for (const char* n : {"1048576", "4194304"}) {
       const std::string N = n;
       const double rmw = bytes_["ReadModifyWrite/" + N];
@@ -138,24 +194,63 @@ class RatioReporter : public benchmark::ConsoleReporter {
         std::printf("    fused update   %.1f GB/s = %3.0f %% of it, %.2f G particle-steps/s\n",
                     upd / 1e9, 100 * upd / rmw, items_["UpdatePass/fused/" + N] / 1e9);
       if (step > 0)
-        std::printf("    whole step     %.1f GB/s = %3.0f %% of it (10 %% born and dying per step)\n",
-                    step / 1e9, 100 * step / rmw);
-      if (upd > 0 && unf > 0)
-        std::printf("    fused / unfused: %.2fx\n", upd / unf);
+        std::printf(
+            "    whole step     %.1f GB/s = %3.0f %% of it (10 %% born and dying per step)\n",
+            step / 1e9, 100 * step / rmw);
+      if (upd > 0 && unf > 0) std::printf("    fused / unfused: %.2fx\n", upd / unf);
     }
+    if (small_.empty()) return;
+    std::printf("  small groups (%zu live particles each), us per group-step (goal <= 5):\n",
+                kSmallLive);
+    for (const char* n : {"SmallGroupStep/groups:1", "SmallGroups/groups:100"}) {
+      const std::string N = n;
+      const double t1 = small_[N + "/threads:1"], t2 = small_[N + "/threads:2"];
+      if (t1 <= 0) continue;
+      std::printf("    %-24s 1 thread %6.2f", n, t1);
+      if (t2 > 0) std::printf(", 2 threads %6.2f (2 / 1 thread: %.2fx)", t2, t2 / t1);
+      std::printf("\n");
+    }
+    const double one = small_["SmallGroupStep/groups:1/threads:1"];
+    const double many = small_["SmallGroups/groups:100/threads:1"];
+    if (one > 0 && many > 0)
+      std::printf("    100 groups / 1 group (1 thread): %.2fx per group-step\n", many / one);
   }
 
  private:
-  std::map<std::string, double> bytes_, items_;
+  std::map<std::string, double> bytes_, items_, small_;
 };
 
 }  // namespace
 
-BENCHMARK(ReadModifyWrite)->Arg(1 << 20)->Arg(1 << 22)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(UpdatePass, fused, true)->Arg(1 << 20)->Arg(1 << 22)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(UpdatePass, unfused, false)->Arg(1 << 20)->Arg(1 << 22)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(ReadModifyWrite)
+    ->Arg(1 << 20)
+    ->Arg(1 << 22)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(UpdatePass, fused, true)
+    ->Arg(1 << 20)
+    ->Arg(1 << 22)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(UpdatePass, unfused, false)
+    ->Arg(1 << 20)
+    ->Arg(1 << 22)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(FountainStep)->Arg(1 << 20)->Arg(1 << 22)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(Emission)->Arg(1 << 18)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(SmallGroupStep)
+    ->ArgNames({"groups", "threads"})
+    ->Args({1, 1})
+    ->Args({1, 2})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+BENCHMARK(SmallGroups)
+    ->ArgNames({"groups", "threads"})
+    ->Args({100, 1})
+    ->Args({100, 2})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
 
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
