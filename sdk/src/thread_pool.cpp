@@ -38,7 +38,7 @@ void ThreadPool::runTasks() {
     const std::size_t i = next_.fetch_add(1, std::memory_order_relaxed);
     if (i >= tasks_) return;
     try {
-      (*job_)(i);
+      job_.call(job_.fn, i);
     } catch (...) {
       std::lock_guard lock(errorMutex_);
       if (!error_) error_ = std::current_exception();
@@ -64,15 +64,10 @@ void ThreadPool::workerLoop() {
   }
 }
 
-void ThreadPool::parallelFor(std::size_t tasks, const std::function<void(std::size_t)>& f) {
-  if (tasks == 0) return;
-  if (workers_.empty() || tasks == 1) {
-    for (std::size_t i = 0; i < tasks; ++i) f(i);
-    return;
-  }
+void ThreadPool::run(std::size_t tasks, Job job) {
   {
     std::lock_guard lock(mutex_);
-    job_ = &f;
+    job_ = job;
     tasks_ = tasks;
     next_.store(0, std::memory_order_relaxed);
     error_ = nullptr;
@@ -84,7 +79,7 @@ void ThreadPool::parallelFor(std::size_t tasks, const std::function<void(std::si
   {
     std::unique_lock lock(mutex_);
     done_.wait(lock, [&] { return busy_ == 0; });
-    job_ = nullptr;
+    job_ = {};
   }
   if (error_) std::rethrow_exception(error_);
 }

@@ -6,9 +6,9 @@
 #include <condition_variable>
 #include <cstddef>
 #include <exception>
-#include <functional>
 #include <mutex>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 namespace flurry::detail {
@@ -26,9 +26,28 @@ class ThreadPool {
 
   /// Runs f(i) for every i in [0, tasks) and returns when all are done. The first exception
   /// a task throws is rethrown here (the remaining tasks still finish or are skipped).
-  void parallelFor(std::size_t tasks, const std::function<void(std::size_t)>& f);
+  /// One task (or one thread) runs on the calling thread: no worker is woken, no lock taken,
+  /// nothing allocated, which is what keeps stepping a small group cheap.
+  template <class F>
+  void parallelFor(std::size_t tasks, F&& f) {
+    if (tasks == 0) return;
+    if (workers_.empty() || tasks == 1) {
+      for (std::size_t i = 0; i < tasks; ++i) f(i);
+      return;
+    }
+    using Fn = std::remove_reference_t<F>;
+    run(tasks, {const_cast<void*>(static_cast<const void*>(&f)),
+                [](void* fn, std::size_t i) { (*static_cast<Fn*>(fn))(i); }});
+  }
 
  private:
+  // A borrowed callable, not a std::function: wrapping a lambda of many captures in one
+  // would allocate on every call.
+  struct Job {
+    void* fn = nullptr;
+    void (*call)(void*, std::size_t) = nullptr;
+  };
+  void run(std::size_t tasks, Job job);
   void workerLoop();
   void stopWorkers();
   void runTasks();
@@ -40,7 +59,7 @@ class ThreadPool {
   bool stop_ = false;
   unsigned busy_ = 0;
   // The job in flight.
-  const std::function<void(std::size_t)>* job_ = nullptr;
+  Job job_;
   std::size_t tasks_ = 0;
   std::atomic<std::size_t> next_{0};
   std::exception_ptr error_;
