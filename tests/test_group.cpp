@@ -202,3 +202,28 @@ TEST(Io, PlyIsWrittenAtomicallyAndErrorsNameThePath) {
   }
   std::filesystem::remove_all(dir);
 }
+
+// The fused pass keeps its plan of the action list between steps: a new list must replace it.
+TEST(Group, SetActionsBetweenStepsRebuildsThePlan) {
+  Context ctx;
+  Group& g = ctx.createGroup("g", 4);
+  Particle p;
+  p.position = Vec3(0.0f, 1.0f, 0.0f);
+  p.velocity = Vec3(0.0f, -3.0f, 0.0f);
+  g.add(p);
+  ActionList curved{Gravity{Vec3(0.0f, -9.81f, 0.0f)},
+                    Bounce{Domain::plane(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f)), 0.4f, 0.0f, 0.0f},
+                    Move{}};
+  curved.setIntegrator(Integrator::RK4);  // the plan gathers the Gravity into the Move
+  g.setActions(curved);
+  ctx.step();
+  g.setActions({Move{}});  // no force: moves by v·dt
+  const Particle before = g.particle(0);
+  ctx.step();
+  const Particle after = g.particle(0);
+  EXPECT_EQ(after.velocity, before.velocity);
+  for (int c = 0; c < 3; ++c)
+    EXPECT_FLOAT_EQ(after.position[c],
+                    before.position[c] + before.velocity[c] * float(ctx.timeStep()));
+  EXPECT_NE(after.position.y, before.position.y);
+}

@@ -227,6 +227,7 @@ void Group::require(AttributeSet attributes) {
 Group& Group::setActions(ActionList actions) {
   impl_->syncHost();
   impl_->actions = std::move(actions);
+  ++impl_->actionsVersion;  // the fused pass's plan is rebuilt
   impl_->stats.killedByAction.assign(impl_->actions.size(), 0);
   impl_->ensureStorage();
   impl_->hostChanged();

@@ -100,6 +100,29 @@ class DeviceMirror {
   virtual void syncStats(GroupImpl& /*group*/) {}
 };
 
+/// What the CPU fused pass derives from the action list alone. Built when the list changes
+/// (GroupImpl::actionsVersion), not every step: a small group's step is short enough that
+/// rebuilding it (and its allocations) would be a good part of the step.
+struct ActionPlan {
+  std::uint64_t version = ~std::uint64_t(0);  ///< the actionsVersion it was built for
+  Integrator integrator = Integrator::SemiImplicitEuler;
+  std::vector<std::uint8_t> gathered;                // a force an integrating Move evaluates
+  std::vector<std::vector<std::uint32_t>> forcesOf;  // per Move: its forces
+  std::vector<std::vector<std::uint32_t>> guardsOf;  // per Move: the Bounces before it
+  // Per planar Bounce before a Move that integrates forces with Exact, Verlet or RK4: 1 +
+  // that Move's index (it bounces on the curve the Move takes); else 0.
+  std::vector<std::uint32_t> curvedBy;
+  bool guarded = false;              ///< some Move guards against Bounces
+  bool readsNeighbours = false;      ///< the pass reads a snapshot of the step's start
+  std::uint32_t firstBlocker = ~0u;  ///< index of the list's first Block action
+  std::vector<float> fastest;        ///< scratch: per chunk, the fastest squared speed
+};
+
+struct GroupImpl;
+/// Brings group.plan up to date with its action list (when actionsVersion changed) and
+/// returns it (cpu/cpu_backend.cpp).
+const ActionPlan& planActions(GroupImpl& group);
+
 struct GroupImpl {
   std::string name;
   std::uint32_t index = 0;  ///< creation order in the context: keeps groups' random streams apart
@@ -107,7 +130,8 @@ struct GroupImpl {
   std::size_t size = 0;
   AttributeSet required{Attribute::Position, Attribute::Id};
   AttributeSet stored;  ///< what the lanes hold now
-  ActionList actions;
+  ActionList actions;   ///< replace through Group::setActions, which bumps actionsVersion
+  std::uint64_t actionsVersion = 0;
   std::vector<Emitter> emitters;
   std::vector<EmitterState> emitterState;
   std::vector<PrimeEmitter> primes;
@@ -130,6 +154,7 @@ struct GroupImpl {
   std::vector<std::uint32_t> deadFlags;  ///< the unfused baseline's per-particle kill codes
   std::vector<float> snapshot;           ///< positions/velocities at the step's start
   std::vector<float> stepStart;          ///< positions at the step's start, for the guard
+  ActionPlan plan;                       ///< the fused pass's, for actionsVersion
 
   std::unique_ptr<DeviceMirror> mirror;  ///< null on the CPU backend
 

@@ -1,6 +1,57 @@
+#include <utility>
+#include <vector>
+
+#include "../action_traits.hpp"
 #include "../backend.hpp"
+#include "kernels.hpp"
 
 namespace flurry::detail {
+
+// Here, in a baseline translation unit, and not in the fused pass: the pass is compiled once
+// per instruction set, and the vector code it would instantiate here is shared between the
+// builds (the SSE2 build would then run the AVX2 copy).
+const ActionPlan& planActions(GroupImpl& g) {
+  ActionPlan& plan = g.plan;
+  if (plan.version == g.actionsVersion) return plan;
+  const auto& acts = g.actions.actions();
+  plan.integrator = g.actions.integrator();
+  plan.gathered.assign(acts.size(), 0);
+  plan.forcesOf.assign(acts.size(), {});
+  plan.guardsOf.assign(acts.size(), {});
+  plan.curvedBy.assign(acts.size(), 0);
+  // Explicit Euler moves on the straight line p + v·dt: the plain bounce is its own path.
+  const bool curved = plan.integrator == Integrator::Exact ||
+                      plan.integrator == Integrator::VelocityVerlet ||
+                      plan.integrator == Integrator::RK4;
+  if (plan.integrator != Integrator::SemiImplicitEuler) {
+    std::vector<std::uint32_t> pending, bounces;
+    for (std::uint32_t k = 0; k < acts.size(); ++k) {
+      if (isForce(acts[k])) pending.push_back(k);
+      if (std::holds_alternative<Bounce>(acts[k])) bounces.push_back(k);
+      if (std::holds_alternative<Move>(acts[k])) {
+        for (std::uint32_t f : pending) plan.gathered[f] = 1;
+        for (std::uint32_t b : bounces)
+          if (curved && !pending.empty() && cpu::isPlanarBounce(std::get<Bounce>(acts[b])))
+            plan.curvedBy[b] = k + 1;
+        plan.forcesOf[k] = std::move(pending);
+        plan.guardsOf[k] = std::move(bounces);
+        pending.clear();
+        bounces.clear();
+      }
+    }
+  }
+  plan.guarded = false;
+  for (const auto& gs : plan.guardsOf) plan.guarded |= !gs.empty();
+  plan.readsNeighbours = g.actions.readsNeighbours();
+  plan.firstBlocker = ~0u;
+  for (std::size_t k = 0; k < acts.size(); ++k)
+    if (std::holds_alternative<Block>(acts[k])) {
+      plan.firstBlocker = std::uint32_t(k);
+      break;
+    }
+  plan.version = g.actionsVersion;
+  return plan;
+}
 
 namespace {
 class CpuBackend final : public BackendImpl {

@@ -27,48 +27,15 @@ namespace {
 constexpr std::size_t kDefaultBlock = 1024;
 constexpr std::size_t kParticlesPerTask = 32768;  // below this a group is stepped inline
 
-// How each action of the list runs this step.
+// How each action of the list runs this step: what follows from the list (cached in the
+// group), and what follows from this step's velocities and dt.
 struct Plan {
-  Integrator integrator = Integrator::SemiImplicitEuler;
-  std::vector<std::uint8_t> gathered;                // a force an integrating Move evaluates
-  std::vector<std::vector<std::uint32_t>> forcesOf;  // per Move: its forces
-  std::vector<std::vector<std::uint32_t>> guardsOf;  // per Move: the Bounces before it
-  // Per planar Bounce before a Move that integrates forces with Exact, Verlet or RK4: 1 +
-  // that Move's index (it bounces on the curve the Move takes); else 0.
-  std::vector<std::uint32_t> curvedBy;
+  const ActionPlan& list;
   std::uint32_t substeps = 1;
   const float* start[3] = {};  // positions when the step (or sub-step) began, for the guard
 };
 
-Plan makePlan(const GroupImpl& g, const StepParams& sp, ThreadPool& pool) {
-  const auto& acts = g.actions.actions();
-  Plan plan;
-  plan.integrator = g.actions.integrator();
-  plan.gathered.assign(acts.size(), 0);
-  plan.forcesOf.resize(acts.size());
-  plan.guardsOf.resize(acts.size());
-  plan.curvedBy.assign(acts.size(), 0);
-  // Explicit Euler moves on the straight line p + v·dt: the plain bounce is its own path.
-  const bool curved = plan.integrator == Integrator::Exact ||
-                      plan.integrator == Integrator::VelocityVerlet ||
-                      plan.integrator == Integrator::RK4;
-  if (plan.integrator != Integrator::SemiImplicitEuler) {
-    std::vector<std::uint32_t> pending, bounces;
-    for (std::uint32_t k = 0; k < acts.size(); ++k) {
-      if (isForce(acts[k])) pending.push_back(k);
-      if (std::holds_alternative<Bounce>(acts[k])) bounces.push_back(k);
-      if (std::holds_alternative<Move>(acts[k])) {
-        for (std::uint32_t f : pending) plan.gathered[f] = 1;
-        for (std::uint32_t b : bounces)
-          if (curved && !pending.empty() && cpu::isPlanarBounce(std::get<Bounce>(acts[b])))
-            plan.curvedBy[b] = k + 1;
-        plan.forcesOf[k] = std::move(pending);
-        plan.guardsOf[k] = std::move(bounces);
-        pending.clear();
-        bounces.clear();
-      }
-    }
-  }
+std::uint32_t substepCount(GroupImpl& g, const StepParams& sp, ThreadPool& pool) {
   const Substeps& sub = g.actions.substeps();
   double n = 1;
   if (sub.maxStep > 0) n = std::max(n, std::ceil(sp.dt / sub.maxStep));
@@ -77,7 +44,8 @@ Plan makePlan(const GroupImpl& g, const StepParams& sp, ThreadPool& pool) {
     // on how the group is cut into blocks.
     const Lanes L = g.lanePointers();
     const std::size_t chunks = (g.size + 65535) / 65536;
-    std::vector<float> fastest(chunks, 0.0f);
+    std::vector<float>& fastest = g.plan.fastest;  // grows, never shrinks
+    fastest.assign(chunks, 0.0f);
     pool.parallelFor(chunks, [&](std::size_t c) {
       float m = 0.0f;
       for (std::size_t i = c * 65536; i < std::min(g.size, (c + 1) * 65536); ++i)
@@ -87,8 +55,7 @@ Plan makePlan(const GroupImpl& g, const StepParams& sp, ThreadPool& pool) {
     const float vmax = std::sqrt(*std::max_element(fastest.begin(), fastest.end()));
     if (std::isfinite(vmax)) n = std::max(n, std::ceil(vmax * sp.dt / sub.maxDistance));
   }
-  plan.substeps = std::uint32_t(std::min<double>(n, sub.maxSubsteps));
-  return plan;
+  return std::uint32_t(std::min<double>(n, sub.maxSubsteps));
 }
 
 // After an integrating Move, a particle that its curved step (or its bounce) left on the
@@ -139,23 +106,26 @@ void runActions(const std::vector<Action>& acts, const Plan& plan, std::size_t f
   thread_local cpu::IntegratorScratch scratchStore;
   for (std::size_t k = first; k < last; ++k) {
     ctx.action = std::uint32_t(k);
-    if (plan.gathered[k]) continue;  // evaluated inside its Move
-    if (plan.integrator != Integrator::SemiImplicitEuler && std::holds_alternative<Move>(acts[k])) {
+    if (plan.list.gathered[k]) continue;  // evaluated inside its Move
+    if (plan.list.integrator != Integrator::SemiImplicitEuler &&
+        std::holds_alternative<Move>(acts[k])) {
       cpu::IntegratorScratch& scratch = scratchStore;
-      cpu::integrate(plan.integrator, acts, plan.forcesOf[k], lanes, n, ctx, scratch);
-      if (!plan.guardsOf[k].empty()) {
+      cpu::integrate(plan.list.integrator, acts, plan.list.forcesOf[k], lanes, n, ctx, scratch);
+      if (!plan.list.guardsOf[k].empty()) {
         const float* start[3];
         for (int c = 0; c < 3; ++c) start[c] = plan.start[c] + ctx.base;
-        for (std::uint32_t b : plan.guardsOf[k]) guard(std::get<Bounce>(acts[b]), lanes, start, n);
+        for (std::uint32_t b : plan.list.guardsOf[k])
+          guard(std::get<Bounce>(acts[b]), lanes, start, n);
       }
       continue;
     }
-    if (plan.curvedBy[k]) {
+    if (plan.list.curvedBy[k]) {
       // The acceleration the Move's integrator starts from, taken as constant over the step.
       cpu::IntegratorScratch& scratch = scratchStore;
       scratch.reset(n, 3);
       float* acc[3] = {scratch.take(n), scratch.take(n), scratch.take(n)};
-      cpu::startAcceleration(acts, plan.forcesOf[plan.curvedBy[k] - 1], lanes, n, ctx, acc);
+      cpu::startAcceleration(acts, plan.list.forcesOf[plan.list.curvedBy[k] - 1], lanes, n, ctx,
+                             acc);
       cpu::applyAccelerated(std::get<Bounce>(acts[k]), lanes, n, ctx, acc);
       continue;
     }
@@ -163,12 +133,23 @@ void runActions(const std::vector<Action>& acts, const Plan& plan, std::size_t f
   }
 }
 
+// Whether any of n floats is NaN or infinite: a reduction with no stores, which vectorises
+// (the loop that marks the dead may alias them, and GCC gives it a scalar fallback).
+bool anyNonFinite(const float* __restrict x, std::size_t n) {
+  const std::uint32_t* __restrict bits = reinterpret_cast<const std::uint32_t*>(x);
+  std::uint32_t bad = 0;
+  for (std::size_t i = 0; i < n; ++i) bad |= std::uint32_t((bits[i] & 0x7f800000u) == 0x7f800000u);
+  return bad != 0;
+}
+
 // Kills what a step left NaN or infinite (an extreme input, a user callback): counted, never
-// propagated. A float is finite when its exponent bits are not all ones.
+// propagated. A float is finite when its exponent bits are not all ones. Almost always none
+// is: the lanes are only scanned, and marked only when one is.
 void guardFinite(const Lanes& L, std::size_t n, std::uint32_t* __restrict dead) {
   for (const float* const* lane : {L.p, L.v}) {
     if (!lane[0]) continue;
     for (int c = 0; c < 3; ++c) {
+      if (!anyNonFinite(lane[c], n)) continue;
       const std::uint32_t* __restrict bits = reinterpret_cast<const std::uint32_t*>(lane[c]);
       for (std::size_t i = 0; i < n; ++i) {
         const bool bad = (bits[i] & 0x7f800000u) == 0x7f800000u;
@@ -178,17 +159,25 @@ void guardFinite(const Lanes& L, std::size_t n, std::uint32_t* __restrict dead) 
   }
 }
 
-// Records a block's dead (ascending) in the block's own slice of deadIndex.
+// Records a block's dead (ascending) in the block's own slice of deadIndex. Few die in a
+// step: runs of 16 with none are skipped after one vectorised test, the rest are gathered
+// without branches (writing at `count` <= i stays inside the slice).
 std::uint32_t collectDead(GroupImpl& g, std::size_t base, std::size_t n,
-                          const std::uint32_t* dead) {
+                          const std::uint32_t* __restrict dead) {
+  constexpr std::size_t kRun = 16;
   std::uint32_t count = 0;
-  std::uint32_t* idx = g.deadIndex.data() + base;
-  std::uint8_t* code = g.deadCode.data() + base;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (dead[i] == 0u) continue;
-    idx[count] = std::uint32_t(base + i);
-    code[count] = std::uint8_t(dead[i]);
-    ++count;
+  std::uint32_t* __restrict idx = g.deadIndex.data() + base;
+  std::uint8_t* __restrict code = g.deadCode.data() + base;
+  for (std::size_t i0 = 0; i0 < n; i0 += kRun) {
+    const std::size_t end = std::min(n, i0 + kRun);
+    std::uint32_t any = 0;
+    for (std::size_t i = i0; i < end; ++i) any |= dead[i];
+    if (any == 0u) continue;
+    for (std::size_t i = i0; i < end; ++i) {
+      idx[count] = std::uint32_t(base + i);
+      code[count] = std::uint8_t(dead[i]);
+      count += dead[i] != 0u;
+    }
   }
   return count;
 }
@@ -198,6 +187,9 @@ std::uint32_t collectDead(GroupImpl& g, std::size_t base, std::size_t n,
 void actFusedImpl(GroupImpl& g, const StepParams& sp) {
   g.holes.clear();
   const std::size_t n = g.size;
+  // At most n die: room for all of them, grown geometrically, so that a step that kills
+  // more than any before does not allocate.
+  if (g.holes.capacity() < n) g.holes.reserve(std::max(n, 2 * g.holes.capacity()));
   const auto& acts = g.actions.actions();
   if (n == 0 || acts.empty()) return;
 
@@ -209,10 +201,8 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
   g.deadCode.resize(n);
   g.deadCount.assign(blocks, 0);
   const Lanes lanes = g.lanePointers();
-  Plan plan = makePlan(g, sp, *sp.pool);
-  bool guarded = false;
-  for (const auto& gs : plan.guardsOf) guarded |= !gs.empty();
-  if (guarded) {
+  Plan plan{planActions(g), substepCount(g, sp, *sp.pool)};
+  if (plan.list.guarded) {
     // Where each particle began the step: the guard compares with it.
     g.stepStart.resize(3 * n);
     for (int c = 0; c < 3; ++c) {
@@ -223,15 +213,11 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
   const float subDt = float(sp.dt / plan.substeps);
   cpu::BlockContext base{subDt, sp.seed, std::uint32_t(sp.step), g.index << 16, 0, nullptr};
   base.time = sp.time;
-  for (std::size_t k = 0; k < acts.size(); ++k)
-    if (std::holds_alternative<Block>(acts[k])) {
-      base.firstBlocker = std::uint32_t(k);
-      break;
-    }
+  base.firstBlocker = plan.list.firstBlocker;
   // Actions that read other particles read them as they were at the start of the step, so
   // the result does not depend on which block ran first.
   cpu::Snapshot snapshot;
-  if (g.actions.readsNeighbours()) {
+  if (plan.list.readsNeighbours) {
     g.snapshot.resize(9 * n);
     float* out = g.snapshot.data();
     auto keep = [&](float* const* src, const float** dst) {
