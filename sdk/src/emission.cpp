@@ -4,6 +4,7 @@
 // died than were born are the remaining holes filled from the tail. In a steady effect
 // births and deaths balance, so compaction moves almost nothing.
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "backend.hpp"
@@ -15,6 +16,7 @@ namespace flurry::detail {
 namespace {
 
 constexpr std::size_t kNewbornsPerTask = 8192;  // a multiple of kBatch
+constexpr std::size_t kInlineMoves = 16384;     // lane elements compaction copies inline
 
 // Particles a rate has produced by time t: floor(rate·elapsed), with a relative guard so
 // that 10.5/s over 10 s gives 105 despite the rounding of the accumulated time.
@@ -620,6 +622,9 @@ void emitAndCompact(GroupImpl& g, const StepParams& sp) {
   thread_local std::vector<std::pair<std::uint32_t, std::uint32_t>> movesStore;
   auto& moves = movesStore;  // (from, to)
   moves.clear();
+  // As many as the holes may ever be (their capacity only grows): a step that leaves more
+  // holes than any before does not allocate.
+  if (moves.capacity() < leftCount) moves.reserve(std::max(leftCount, g.holes.capacity()));
   std::size_t src = g.size;      // candidates below this
   std::size_t back = leftCount;  // holes at or above src are left[back..]
   for (std::size_t h = 0; h < leftCount && left[h] < newSize; ++h) {
@@ -630,16 +635,24 @@ void emitAndCompact(GroupImpl& g, const StepParams& sp) {
   }
   g.size = newSize;
   if (moves.empty()) return;
-  std::vector<LaneBuffer*> stored;
+  std::array<std::uint32_t*, std::size_t(Attribute::Count) * 4> stored;  // no allocation
+  std::size_t lanes = 0;
   for (auto& attr : g.lanes)
     for (auto& lane : attr)
-      if (lane) stored.push_back(&lane);
+      if (lane) stored[lanes++] = lane.u();
+  auto moveLane = [&](std::uint32_t* lane, std::size_t a, std::size_t b) {
+    for (std::size_t k = a; k < b; ++k) lane[moves[k].second] = lane[moves[k].first];
+  };
+  // A few moves (a small group, or a near-steady one) cost less than waking a worker.
+  if (moves.size() * lanes <= kInlineMoves) {
+    for (std::size_t l = 0; l < lanes; ++l) moveLane(stored[l], 0, moves.size());
+    return;
+  }
   const std::size_t perTask = 65536;
   const std::size_t chunks = (moves.size() + perTask - 1) / perTask;
-  sp.pool->parallelFor(stored.size() * chunks, [&](std::size_t t) {
-    std::uint32_t* lane = stored[t / chunks]->u();
-    const std::size_t a = (t % chunks) * perTask, b = std::min(moves.size(), a + perTask);
-    for (std::size_t k = a; k < b; ++k) lane[moves[k].second] = lane[moves[k].first];
+  sp.pool->parallelFor(lanes * chunks, [&](std::size_t t) {
+    const std::size_t a = (t % chunks) * perTask;
+    moveLane(stored[t / chunks], a, std::min(moves.size(), a + perTask));
   });
 }
 
