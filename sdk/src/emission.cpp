@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
 
 #include "backend.hpp"
 #include "emission_plan.hpp"
@@ -123,8 +124,9 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
                std::size_t i0, std::size_t m) {
   const Lanes& L = nc.L;
   const ParticleType& type = em.types[0];
-  // Scratch per thread, looked up once: in a shared library every thread_local access in a
-  // loop would go through __tls_get_addr.
+  // Scratch per thread, on the heap and reached through a pointer read once: in a shared
+  // library every access to a thread_local object goes through __tls_get_addr, and GCC
+  // folds a reference to one back into such accesses, once per element of the loops below.
   struct Scratch {
     float rows[kMaxDraws][kBatch];
     float attr[16][kBatch];
@@ -132,8 +134,9 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
     float age[kBatch];
     std::uint32_t slot[kBatch];
   };
-  thread_local Scratch scratch;
-  Scratch& sc = scratch;
+  thread_local std::unique_ptr<Scratch> scratch;
+  if (!scratch) scratch = std::make_unique<Scratch>();  // once per thread
+  Scratch& sc = *scratch;
   auto& rows = sc.rows;
   auto& attr = sc.attr;
   auto& up = sc.up;
