@@ -133,28 +133,31 @@ void runActions(const std::vector<Action>& acts, const Plan& plan, std::size_t f
   }
 }
 
-// Whether any of n floats is NaN or infinite: a reduction with no stores, which vectorises
-// (the loop that marks the dead may alias them, and GCC gives it a scalar fallback).
-bool anyNonFinite(const float* __restrict x, std::size_t n) {
-  const std::uint32_t* __restrict bits = reinterpret_cast<const std::uint32_t*>(x);
+// Whether a float's exponent bits are all ones: NaN or infinite.
+inline std::uint32_t nonFinite(std::uint32_t bits) {
+  return std::uint32_t((bits & 0x7f800000u) == 0x7f800000u);
+}
+
+// Whether any of the three lanes' n floats is NaN or infinite: one reduction with no stores,
+// which vectorises (the loop that marks the dead may alias the lanes, and GCC gives it a
+// scalar fallback).
+bool anyNonFinite(const float* const* lane, std::size_t n) {
+  const auto* __restrict x = reinterpret_cast<const std::uint32_t*>(lane[0]);
+  const auto* __restrict y = reinterpret_cast<const std::uint32_t*>(lane[1]);
+  const auto* __restrict z = reinterpret_cast<const std::uint32_t*>(lane[2]);
   std::uint32_t bad = 0;
-  for (std::size_t i = 0; i < n; ++i) bad |= std::uint32_t((bits[i] & 0x7f800000u) == 0x7f800000u);
+  for (std::size_t i = 0; i < n; ++i) bad |= nonFinite(x[i]) | nonFinite(y[i]) | nonFinite(z[i]);
   return bad != 0;
 }
 
 // Kills what a step left NaN or infinite (an extreme input, a user callback): counted, never
-// propagated. A float is finite when its exponent bits are not all ones. Almost always none
-// is: the lanes are only scanned, and marked only when one is.
+// propagated. Almost always none is: the lanes are scanned, and marked only when one is.
 void guardFinite(const Lanes& L, std::size_t n, std::uint32_t* __restrict dead) {
   for (const float* const* lane : {L.p, L.v}) {
-    if (!lane[0]) continue;
+    if (!lane[0] || !anyNonFinite(lane, n)) continue;
     for (int c = 0; c < 3; ++c) {
-      if (!anyNonFinite(lane[c], n)) continue;
       const std::uint32_t* __restrict bits = reinterpret_cast<const std::uint32_t*>(lane[c]);
-      for (std::size_t i = 0; i < n; ++i) {
-        const bool bad = (bits[i] & 0x7f800000u) == 0x7f800000u;
-        dead[i] = bad ? kNonFiniteCode : dead[i];
-      }
+      for (std::size_t i = 0; i < n; ++i) dead[i] = nonFinite(bits[i]) ? kNonFiniteCode : dead[i];
     }
   }
 }
