@@ -2,6 +2,7 @@
 // grown (issue #11). Counts every operator new of this process while stepping.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdlib>
 #include <new>
