@@ -261,6 +261,11 @@ struct SizeOverLife {
 /// box (from outside, or keeping particles inside when `inside`), and in 2-D a line segment
 /// (its normal in the group's plane). Put Bounce after the forces and before Move: it places
 /// the particle so that Move ends it at its reflected place, never behind the surface.
+/// A two-sided piece treats its sides alike: a particle born or placed exactly on its plane
+/// belongs to neither side and leaves it freely (an emitter on a floor emits through it); one
+/// that ends a step on the plane by moving is bounced. With the Exact, VelocityVerlet and RK4
+/// integrators a planar piece reflects the velocity at the moment of impact on the step's
+/// curved path (second order at the bounce); spheres and boxes use the straight path.
 struct Bounce {
   Domain surface;
   float restitution = 1.0f;
