@@ -7,14 +7,16 @@
 #include <cmath>
 
 #include "../field_math.hpp"
-#include "kernels.hpp"
 #include "../isa_namespace.hpp"
+#include "kernels.hpp"
 
 namespace flurry::detail::cpu {
 inline namespace FLURRY_ISA_NAMESPACE {  // see isa_namespace.hpp
 
 namespace {
-inline Vec3 at(const float* const* a, std::size_t i) { return Vec3(a[0][i], a[1][i], a[2][i]); }
+inline Vec3 at(const float* const* a, std::size_t i) {
+  return Vec3(a[0][i], a[1][i], a[2][i]);
+}
 inline void put(float* const* a, std::size_t i, Vec3 v) {
   a[0][i] = v.x;
   a[1][i] = v.y;
@@ -27,7 +29,9 @@ inline float falloffWeight(const Falloff& f, Vec3 p) {
   return f.power == 1.0f ? t : std::pow(t, f.power);
 }
 // The fraction of the way an exponential approach covers in dt: never more than 1.
-inline float approach(float rate, float dt) { return 1.0f - std::exp(-rate * dt); }
+inline float approach(float rate, float dt) {
+  return 1.0f - std::exp(-rate * dt);
+}
 // Softened inverse-square pull towards d: magnitude·d / (|d|² + eps)^(3/2), zero beyond maxR
 // and at the centre: there s·√s underflows to 0 for eps below ~1e-26, and 0·inf would be NaN.
 // Elsewhere a pull that overflows stays infinite, and the NaN guard kills the particle.
@@ -79,14 +83,18 @@ inline void apply(const Sink& a, const Lanes& L, std::size_t n, const BlockConte
   using M = Sink::Mode;
   if (a.mode == M::Inside || a.mode == M::Outside) {
     const bool killInside = a.mode == M::Inside ? a.killInside : !a.killInside;
-    std::visit([&](const auto& shape) {
-      sinkLoop(shape, L.p[0], L.p[1], L.p[2], c.dead, n, code, killInside);
-    }, a.region.shape());
+    std::visit(
+        [&](const auto& shape) {
+          sinkLoop(shape, L.p[0], L.p[1], L.p[2], c.dead, n, code, killInside);
+        },
+        a.region.shape());
   } else if (a.mode == M::Enter || a.mode == M::Leave) {
-    std::visit([&](const auto& shape) {
-      sinkMotionLoop(shape, L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], c.dead, n, c.dt, code,
-                     a.mode == M::Enter);
-    }, a.region.shape());
+    std::visit(
+        [&](const auto& shape) {
+          sinkMotionLoop(shape, L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], c.dead, n, c.dt,
+                         code, a.mode == M::Enter);
+        },
+        a.region.shape());
   } else {  // Hit: the coming Move crosses the plane piece
     for (std::size_t i = 0; i < n; ++i) {
       const Vec3 p = at(L.p, i), v = at(L.v, i);
@@ -103,24 +111,28 @@ inline void apply(const Sink& a, const Lanes& L, std::size_t n, const BlockConte
 }
 
 inline void apply(const SinkVelocity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  std::visit([&](const auto& shape) {
-    sinkLoop(shape, L.v[0], L.v[1], L.v[2], c.dead, n, c.action + 1, a.killInside);
-  }, a.velocity.shape());
+  std::visit(
+      [&](const auto& shape) {
+        sinkLoop(shape, L.v[0], L.v[1], L.v[2], c.dead, n, c.action + 1, a.killInside);
+      },
+      a.velocity.shape());
 }
 
 inline void apply(const Block& a, const Lanes& L, std::size_t n, const BlockContext& c) {
   // The list's first blocker starts from "visible"; the others can only hide more.
   std::uint32_t* __restrict vis = L.visible;
   if (c.action == c.firstBlocker) std::fill_n(vis, n, 1u);
-  std::visit([&](const auto& shape) {
-    const float* __restrict px = L.p[0];
-    const float* __restrict py = L.p[1];
-    const float* __restrict pz = L.p[2];
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::uint32_t in = detail::inside(shape, Vec3(px[i], py[i], pz[i])) ? 1u : 0u;
-      vis[i] &= 1u - in;
-    }
-  }, a.region.shape());
+  std::visit(
+      [&](const auto& shape) {
+        const float* __restrict px = L.p[0];
+        const float* __restrict py = L.p[1];
+        const float* __restrict pz = L.p[2];
+        for (std::size_t i = 0; i < n; ++i) {
+          const std::uint32_t in = detail::inside(shape, Vec3(px[i], py[i], pz[i])) ? 1u : 0u;
+          vis[i] &= 1u - in;
+        }
+      },
+      a.region.shape());
 }
 
 // ---- Forces ------------------------------------------------------------------------------
@@ -135,8 +147,9 @@ inline void applyWeighted(const Damping& a, const Lanes& L, std::size_t n, const
   for (std::size_t i = 0; i < n; ++i) {
     const float w = falloffWeight(a.falloff, at(L.p, i));
     const Vec3 v = at(L.v, i);
-    put(L.v, i, Vec3(v.x * std::exp(-a.rate.x * c.dt * w), v.y * std::exp(-a.rate.y * c.dt * w),
-                     v.z * std::exp(-a.rate.z * c.dt * w)));
+    put(L.v, i,
+        Vec3(v.x * std::exp(-a.rate.x * c.dt * w), v.y * std::exp(-a.rate.y * c.dt * w),
+             v.z * std::exp(-a.rate.z * c.dt * w)));
   }
 }
 
@@ -169,7 +182,8 @@ inline void apply(const Gravitate& a, const Lanes& L, std::size_t n, const Block
     Vec3 acc(0.0f);
     for (std::size_t j = 0; j < s.size; ++j) {
       if (j == self) continue;
-      acc += softPull(Vec3(s.p[0][j], s.p[1][j], s.p[2][j]) - p, a.magnitude, a.epsilon, a.maxRadius);
+      acc +=
+          softPull(Vec3(s.p[0][j], s.p[1][j], s.p[2][j]) - p, a.magnitude, a.epsilon, a.maxRadius);
     }
     put(L.v, i, at(L.v, i) + acc * c.dt);
   }
@@ -242,7 +256,8 @@ inline void apply(const RandomVelocity& a, const Lanes& L, std::size_t n, const 
     put(L.v, i, a.velocity.sample(rng));
   }
 }
-inline void apply(const RandomRotVelocity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+inline void apply(const RandomRotVelocity& a, const Lanes& L, std::size_t n,
+                  const BlockContext& c) {
   for (std::size_t i = 0; i < n; ++i) {
     Random rng = actionRandom(c, L, i);
     put(L.rot, i, a.rotVelocity.sample(rng));
@@ -295,7 +310,8 @@ inline void apply(const SampledField& a, const Lanes& L, std::size_t n, const Bl
     const float w = falloffWeight(a.falloff, p);
     const Vec3 u = sampleTrilinear(f, p) * a.strength;
     const Vec3 v = at(L.v, i);
-    put(L.v, i, a.mode == SampledField::Mode::Acceleration ? v + u * (c.dt * w) : v + (u - v) * (k * w));
+    put(L.v, i,
+        a.mode == SampledField::Mode::Acceleration ? v + u * (c.dt * w) : v + (u - v) * (k * w));
   }
 }
 
@@ -309,8 +325,9 @@ inline void apply(const Avoid& a, const Lanes& L, std::size_t n, const BlockCont
       const Vec3 nrm = a.obstacle.normal(p);
       const Vec3 o = a.obstacle.closestPoint(p);
       const float d0 = glm::dot(p - o, nrm), d1 = glm::dot(ahead - o, nrm);
-      threat = (d0 >= 0.0f) != (d1 >= 0.0f) &&
-               a.obstacle.distance(p + (ahead - p) * (d0 / (d0 - d1))) < 1e-4f * (1.0f + glm::length(p));
+      threat =
+          (d0 >= 0.0f) != (d1 >= 0.0f) &&
+          a.obstacle.distance(p + (ahead - p) * (d0 / (d0 - d1))) < 1e-4f * (1.0f + glm::length(p));
     } else {
       threat = !a.obstacle.contains(p) && a.obstacle.contains(ahead);
     }
@@ -370,7 +387,8 @@ inline void apply(const TargetVelocity& a, const Lanes& L, std::size_t n, const 
   const float k = approach(a.rate, c.dt);
   for (int d = 0; d < 3; ++d) approachLoop(L.v[d], n, a.velocity[d], k);
 }
-inline void apply(const TargetRotVelocity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+inline void apply(const TargetRotVelocity& a, const Lanes& L, std::size_t n,
+                  const BlockContext& c) {
   const float k = approach(a.rate, c.dt);
   for (int d = 0; d < 3; ++d) approachLoop(L.rot[d], n, a.rotVelocity[d], k);
 }
@@ -387,8 +405,10 @@ inline void apply(const SpeedClamp& a, const Lanes& L, std::size_t n, const Bloc
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3 v = at(L.v, i);
     const float s = glm::length(v);
-    if (s > a.maxSpeed) put(L.v, i, v * (a.maxSpeed / s));
-    else if (s < a.minSpeed && s > 0.0f) put(L.v, i, v * (a.minSpeed / s));
+    if (s > a.maxSpeed)
+      put(L.v, i, v * (a.maxSpeed / s));
+    else if (s < a.minSpeed && s > 0.0f)
+      put(L.v, i, v * (a.minSpeed / s));
   }
 }
 

@@ -42,6 +42,27 @@ struct BlockContext {
 // The loops take their arrays as __restrict parameters: GCC 12 vectorises these, but not
 // the same loops over __restrict locals loaded from a struct.
 
+/// The step length of a loop: the same for every particle (a block's sub-step), or each
+/// particle's own (newborns, which live only what is left of their birth step).
+struct UniformDt {
+  float h;
+  float operator[](std::size_t) const { return h; }
+};
+struct OwnDt {
+  const float* h;
+  float operator[](std::size_t i) const { return h[i]; }
+};
+
+/// v += a·dt with each particle's own dt.
+inline void addScaledLoop(float* __restrict x, float* __restrict y, float* __restrict z,
+                          const float* __restrict h, std::size_t n, float ax, float ay, float az) {
+  for (std::size_t i = 0; i < n; ++i) {
+    x[i] += ax * h[i];
+    y[i] += ay * h[i];
+    z[i] += az * h[i];
+  }
+}
+
 inline void addLoop(float* __restrict x, float* __restrict y, float* __restrict z, std::size_t n,
                     float ax, float ay, float az) {
   for (std::size_t i = 0; i < n; ++i) {
@@ -70,18 +91,20 @@ inline void copyLoop(float* __restrict qx, float* __restrict qy, float* __restri
   }
 }
 
+template <class Dt>
 inline void moveLoop(float* __restrict px, float* __restrict py, float* __restrict pz,
                      const float* __restrict vx, const float* __restrict vy,
-                     const float* __restrict vz, std::size_t n, float dt) {
+                     const float* __restrict vz, std::size_t n, Dt dt) {
   for (std::size_t i = 0; i < n; ++i) {
-    px[i] += vx[i] * dt;
-    py[i] += vy[i] * dt;
-    pz[i] += vz[i] * dt;
+    px[i] += vx[i] * dt[i];
+    py[i] += vy[i] * dt[i];
+    pz[i] += vz[i] * dt[i];
   }
 }
 
-inline void ageLoop(float* __restrict age, std::size_t n, float dt) {
-  for (std::size_t i = 0; i < n; ++i) age[i] += dt;
+template <class Dt>
+inline void ageLoop(float* __restrict age, std::size_t n, Dt dt) {
+  for (std::size_t i = 0; i < n; ++i) age[i] += dt[i];
 }
 
 inline void killOldLoop(const float* __restrict age, const float* __restrict life,
@@ -132,8 +155,8 @@ inline void apply(const Damping& a, const Lanes& L, std::size_t n, const BlockCo
 
 inline void apply(const Move&, const Lanes& L, std::size_t n, const BlockContext& c) {
   if (L.prev[0]) copyLoop(L.prev[0], L.prev[1], L.prev[2], L.p[0], L.p[1], L.p[2], n);
-  moveLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, c.dt);
-  if (L.age) ageLoop(L.age, n, c.dt);
+  moveLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, UniformDt{c.dt});
+  if (L.age) ageLoop(L.age, n, UniformDt{c.dt});
   if (L.up[0] && L.rot[0]) {
     // The up vector turns with the angular velocity: exactly, about ω by |ω|·dt.
     for (std::size_t i = 0; i < n; ++i) {
@@ -178,13 +201,14 @@ struct Reflect {
 
 /// A two-sided planar deflector (plane, rectangle, disc, triangle): `onPiece` says whether a
 /// point of the plane belongs to the piece.
-template <class OnPiece>
+template <class Dt, class OnPiece>
 inline void bouncePlanarLoop(float* __restrict px, float* __restrict py, float* __restrict pz,
                              float* __restrict vxs, float* __restrict vys, float* __restrict vzs,
-                             std::size_t n, float dt, Vec3 P, Vec3 N, OnPiece onPiece,
+                             std::size_t n, Dt dts, Vec3 P, Vec3 N, OnPiece onPiece,
                              const Bounce& b) {
   const Reflect reflect{b.restitution, 1.0f - b.friction, b.cutoff * b.cutoff};
   for (std::size_t i = 0; i < n; ++i) {
+    const float dt = dts[i];
     const float x = px[i], y = py[i], z = pz[i];
     const float vx = vxs[i], vy = vys[i], vz = vzs[i];
     const float d0 = (x - P.x) * N.x + (y - P.y) * N.y + (z - P.z) * N.z;
@@ -574,7 +598,8 @@ inline bool isPlanarBounce(const Bounce& a) {
 
 inline void apply(const Bounce& a, const Lanes& L, std::size_t n, const BlockContext& c) {
   const bool planar = withPlanarPiece(a, [&](Vec3 P, Vec3 N, auto onPiece) {
-    bouncePlanarLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, c.dt, P, N, onPiece, a);
+    bouncePlanarLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, UniformDt{c.dt}, P, N,
+                     onPiece, a);
   });
   if (planar) return;
   const auto& shape = a.surface.shape();
