@@ -70,7 +70,7 @@ class VdbPlugin final : public Plugin {
       throw;
     }
     ++queued_;
-    progress(false);
+    if (!info_.progress) progress(false);  // the tool's own bar is on: draw none beside it
   }
 
   void end(Context&) override {
@@ -109,7 +109,8 @@ class VdbPlugin final : public Plugin {
   bool due(int frame) const { return frame % every_ == 0 || frame == info_.frames; }
 
   /// A bar with ETA on stderr: redrawn in place on a terminal (at most 10 times a second),
-  /// a line per tenth of the work otherwise (logs stay short).
+  /// a line per tenth of the work otherwise (logs stay short). While the tool draws its own
+  /// bar (RunInfo::progress) it is drawn only in end(), for the files still being written.
   void progress(bool final) {
     if (info_.quiet || toWrite_ == 0) return;
     const std::size_t done = writer_->written();
