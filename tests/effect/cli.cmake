@@ -4,7 +4,7 @@
 #   MODE=run:      --quiet prints one summary line accounting for every particle; --out writes
 #                  PLY files; a file path runs; what the system refuses (memory, threads) is
 #                  one line and exit 1, never an abort.
-#   MODE=list:     every built-in effect with a description.
+#   MODE=list:     every effect file of samples/effects, with its description.
 #   MODE=log:      stdout and stderr into one pipe are whole lines; FLURRY_PROGRESS=1 there
 #                  prints a line per tenth of the run instead of a line per frame.
 # SANITIZE: the sanitizer build (no address-space limits); RENDER: the tool has --png; VDB:
@@ -106,9 +106,29 @@ elseif(MODE STREQUAL "run")
   endif()
 elseif(MODE STREQUAL "list")
   flurry_expect(RC 0 OUT "fountain +a water fountain" ARGS list)
-  foreach(name fireworks snow hair tornado pinball2d magnetic)
-    if(NOT last_out MATCHES "\n?${name} +[a-zA-Z0-9]")
+  # Every effect file of samples/effects, one line each: its name, then its "description"
+  # as the file has it (stored once, with the effect; a new sample needs one).
+  file(GLOB files ${SRC}/samples/effects/*.json)
+  list(LENGTH files n)
+  string(REGEX MATCHALL "\n" lines "${last_out}")
+  list(LENGTH lines listed)
+  if(NOT listed EQUAL n)
+    message(FATAL_ERROR "`flurry list` printed ${listed} lines for ${n} effect files:\n${last_out}")
+  endif()
+  foreach(f IN LISTS files)
+    file(READ ${f} json)
+    string(JSON name GET "${json}" name)
+    string(JSON description ERROR_VARIABLE none GET "${json}" description)
+    if(none OR description STREQUAL "")
+      message(FATAL_ERROR "${f} has no \"description\" for `flurry list`")
+    endif()
+    string(FIND "${last_out}" "\n${name} " at)
+    if(at LESS 0 AND NOT last_out MATCHES "^${name} ")
       message(FATAL_ERROR "`flurry list` lacks ${name}:\n${last_out}")
+    endif()
+    string(REGEX MATCH "(^|\n)${name} +([^\n]*)" line "${last_out}")
+    if(NOT CMAKE_MATCH_2 STREQUAL description)
+      message(FATAL_ERROR "`flurry list`: ${name}: '${CMAKE_MATCH_2}', the file says '${description}'")
     endif()
   endforeach()
 elseif(MODE STREQUAL "log")
