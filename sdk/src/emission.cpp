@@ -5,6 +5,7 @@
 // births and deaths balance, so compaction moves almost nothing.
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <memory>
 
@@ -566,6 +567,8 @@ void retireDead(GroupImpl& g, double t1) {
 }
 
 void emitAndCompact(GroupImpl& g, const StepParams& sp) {
+  using Clock = std::chrono::steady_clock;
+  const auto emitStart = Clock::now();
   const double t1 = sp.time + sp.dt;
 
   // 1. How many are born, by which emitter, when.
@@ -613,6 +616,13 @@ void emitAndCompact(GroupImpl& g, const StepParams& sp) {
   }
 
   retireDead(g, t1);
+  g.stats.stepSeconds.emit += std::chrono::duration<double>(Clock::now() - emitStart).count();
+  // The compaction's time, added on every return below.
+  struct CompactTimer {
+    double& total;
+    Clock::time_point start = Clock::now();
+    ~CompactTimer() { total += std::chrono::duration<double>(Clock::now() - start).count(); }
+  } compactTimer{g.stats.stepSeconds.compact};
 
   // 3. Close the holes no newborn filled, with the live particles at the tail.
   if (accepted >= holes) {

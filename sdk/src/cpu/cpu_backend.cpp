@@ -1,3 +1,4 @@
+#include <chrono>
 #include <utility>
 #include <vector>
 
@@ -58,7 +59,10 @@ class CpuBackend final : public BackendImpl {
  public:
   const char* name() const override { return "cpu"; }
   void step(GroupImpl& group, const StepParams& params) override {
+    const auto t0 = std::chrono::steady_clock::now();
     actFused(group, params);
+    group.stats.stepSeconds.act +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     emitAndCompact(group, params);
     if (group.hair.enabled) simulateHair(group, params);
   }
