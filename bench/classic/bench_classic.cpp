@@ -19,6 +19,8 @@
 
 #include "common/read_modify_write.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -237,6 +239,7 @@ std::string argOf(const std::string& args, const std::string& name) {
 // threads, with the matching lanes, median of this run) and prints a summary at the end.
 class ClassicReporter : public benchmark::ConsoleReporter {
  public:
+  using ConsoleReporter::ConsoleReporter;
   void ReportRuns(const std::vector<Run>& runs) override {
     std::vector<Run> out = runs;
     for (Run& r : out) {
@@ -252,7 +255,8 @@ class ClassicReporter : public benchmark::ConsoleReporter {
         continue;
       }
       const std::string threads = argOf(args, "threads"), render = argOf(args, "render");
-      const double ceiling = rmw_[std::string(render == "1" ? "14" : "9") + "/" + threads];
+      const auto found = rmw_.find(std::string(render == "1" ? "14" : "9") + "/" + threads);
+      const double ceiling = found == rmw_.end() ? 0.0 : found->second;
       if (ceiling > 0) r.counters["RMW%"] = 100.0 * bytes->second / ceiling;
       if (aggregate && r.aggregate_name == "mean") continue;
       Row& row = rows_[fn][render + "/" + threads];  // the median, or the single run
@@ -275,11 +279,15 @@ class ClassicReporter : public benchmark::ConsoleReporter {
     for (const auto& [rmwKey, bps] : rmw_)
       std::printf("  read-modify-write, lanes/threads %s: %.1f GB/s\n", rmwKey.c_str(), bps / 1e9);
     for (const auto& [fn, byKey] : rows_) {
-      for (const auto& [key, r] : byKey)
+      for (const auto& [key, r] : byKey) {
+        // No ceiling when --benchmark_filter left ReadModifyWrite out.
+        const std::string rmw = r.rmw > 0 ? std::to_string(int(std::lround(r.rmw))) + " %" : "n/a";
         std::printf(
-            "  %-22s render/threads %s: %6.1f M/s  %4.0f %% RMW  %3.0f/%3.0f/%3.0f  "
+            "  %-22s render/threads %s: %6.1f M/s  %6s RMW  %3.0f/%3.0f/%3.0f  "
             "(%.0fk live)\n",
-            fn.c_str(), key.c_str(), r.items / 1e6, r.rmw, r.emit, r.act, r.compact, r.live / 1e3);
+            fn.c_str(), key.c_str(), r.items / 1e6, rmw.c_str(), r.emit, r.act, r.compact,
+            r.live / 1e3);
+      }
     }
   }
 
@@ -314,7 +322,9 @@ FLURRY_CLASSIC(Atom);
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  ClassicReporter reporter;
+  // Colours only on a terminal (a reporter of our own does not read --benchmark_color).
+  ClassicReporter reporter(isatty(STDOUT_FILENO) ? benchmark::ConsoleReporter::OO_ColorTabular
+                                                 : benchmark::ConsoleReporter::OO_Tabular);
   benchmark::RunSpecifiedBenchmarks(&reporter);
   benchmark::Shutdown();
   return 0;
