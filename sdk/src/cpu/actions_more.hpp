@@ -1,6 +1,7 @@
 // The CPU kernels of the force fields, absorbers, blockers and the rest of the vocabulary.
 // Those that are plain arithmetic keep the branch-free, __restrict style of kernels.hpp;
-// those that sample domains, draw random numbers or call user code run per particle.
+// most that sample domains, draw random numbers or call user code run per particle (RandomAccel
+// draws and samples in batches).
 #pragma once
 
 #include <algorithm>
@@ -8,6 +9,7 @@
 
 #include "../field_math.hpp"
 #include "../isa_namespace.hpp"
+#include "../sampling.hpp"
 #include "kernels.hpp"
 
 namespace flurry::detail::cpu {
@@ -57,6 +59,57 @@ inline void passThrough(const BlockContext& c, const Lanes& L, std::size_t n, fl
 }
 inline Random actionRandom(const BlockContext& c, const Lanes& L, std::size_t i) {
   return Random(c.seed, L.id[i], c.step, c.streamBase + c.action);
+}
+
+// Philox block `block` of every particle's action stream as uniforms: words 0-3 of the block
+// are uniforms 4·block .. 4·block + 3 of actionRandom(c, L, i), as Random draws them. One
+// block per particle per loop, vectorised (the 32×32→64-bit products included).
+inline void actionUniforms(const BlockContext& c, const std::uint32_t* __restrict id,
+                           std::uint32_t block, std::size_t n, float* __restrict u0,
+                           float* __restrict u1, float* __restrict u2, float* __restrict u3) {
+  const std::uint32_t k0 = std::uint32_t(c.seed), k1 = std::uint32_t(c.seed >> 32);
+  const std::uint32_t step = c.step, stream = c.streamBase + c.action;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Philox4x32::Block b = Philox4x32::generate(id[i], step, stream, block, k0, k1);
+    u0[i] = uniformFloat(b.v[0]);
+    u1[i] = uniformFloat(b.v[1]);
+    u2[i] = uniformFloat(b.v[2]);
+    u3[i] = uniformFloat(b.v[3]);
+  }
+}
+
+constexpr std::size_t kDrawBatch = 256;  // particles sampled at once (the rows live on the stack)
+
+// Samples `d` for every particle of the block from its action stream, in batches: the same
+// numbers as d.sample(actionRandom(c, L, i)) (Domain::sample is sampleBatch with a batch of
+// one). use(first, m, x, y, z) receives each batch.
+template <class Use>
+inline void sampleFromActionStreams(const Domain& d, const Lanes& L, std::size_t n,
+                                    const BlockContext& c, Use use) {
+  const int draws = drawCount(d);
+  alignas(64) float u[kMaxDomainDraws][kDrawBatch];
+  alignas(64) float out[3][kDrawBatch];
+  const float* rows[kMaxDomainDraws];
+  for (int k = 0; k < kMaxDomainDraws; ++k) rows[k] = u[k];
+  for (std::size_t first = 0; first < n; first += kDrawBatch) {
+    const std::size_t m = std::min(kDrawBatch, n - first);
+    for (int blk = 0; blk * 4 < draws; ++blk)
+      actionUniforms(c, L.id + first, std::uint32_t(blk), m, u[4 * blk], u[4 * blk + 1],
+                     u[4 * blk + 2], u[4 * blk + 3]);
+    sampleBatch(d, rows, m, out[0], out[1], out[2]);
+    use(first, m, out[0], out[1], out[2]);
+  }
+}
+
+// v += a·dt over a batch.
+inline void addScaledLoop(float* __restrict vx, float* __restrict vy, float* __restrict vz,
+                          const float* __restrict ax, const float* __restrict ay,
+                          const float* __restrict az, std::size_t n, float dt) {
+  for (std::size_t i = 0; i < n; ++i) {
+    vx[i] = vx[i] + ax[i] * dt;
+    vy[i] = vy[i] + ay[i] * dt;
+    vz[i] = vz[i] + az[i] * dt;
+  }
 }
 }  // namespace
 
@@ -158,11 +211,28 @@ inline void apply(const RotDamping& a, const Lanes& L, std::size_t n, const Bloc
             std::exp(-a.rate.z * c.dt));
 }
 
-inline void apply(const OrbitPoint& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+// softPull's arithmetic, branch-free over __restrict lanes so that it vectorises: the pull
+// is computed everywhere and selected where it applies (0 beyond maxRadius and at the centre,
+// where softPull returns 0 untouched: the select keeps out what is computed there).
+inline void orbitPointLoop(const float* __restrict px, const float* __restrict py,
+                           const float* __restrict pz, float* __restrict vx, float* __restrict vy,
+                           float* __restrict vz, std::size_t n, Vec3 center, float magnitude,
+                           float eps, float maxR2, float dt) {
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 acc = softPull(a.center - at(L.p, i), a.magnitude, a.epsilon, a.maxRadius);
-    put(L.v, i, at(L.v, i) + acc * c.dt);
+    const float dx = center.x - px[i], dy = center.y - py[i], dz = center.z - pz[i];
+    const float r2 = dx * dx + dy * dy + dz * dz;  // glm::dot's order
+    const bool pulls = (r2 <= maxR2) & (r2 > 0.0f);
+    const float s = r2 + eps;
+    const float k = magnitude / (s * std::sqrt(s));
+    vx[i] = vx[i] + (pulls ? dx * k : 0.0f) * dt;
+    vy[i] = vy[i] + (pulls ? dy * k : 0.0f) * dt;
+    vz[i] = vz[i] + (pulls ? dz * k : 0.0f) * dt;
   }
+}
+
+inline void apply(const OrbitPoint& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  orbitPointLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, a.center, a.magnitude,
+                 a.epsilon, a.maxRadius * a.maxRadius, c.dt);
 }
 
 inline void apply(const OrbitLine& a, const Lanes& L, std::size_t n, const BlockContext& c) {
@@ -237,12 +307,22 @@ inline void apply(const Explosion& a, const Lanes& L, std::size_t n, const Block
   }
 }
 
+// The accelerations are drawn for a batch of particles at once (Philox vectorised, the
+// domain sampled by sampleBatch), the same numbers as one Random per particle.
 inline void apply(const RandomAccel& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  for (std::size_t i = 0; i < n; ++i) {
-    Random rng = actionRandom(c, L, i);
-    const float w = falloffWeight(a.falloff, at(L.p, i));
-    put(L.v, i, at(L.v, i) + a.acceleration.sample(rng) * (c.dt * w));
-  }
+  const bool weighted = a.falloff.radius < kInfinity;
+  sampleFromActionStreams(a.acceleration, L, n, c,
+                          [&](std::size_t first, std::size_t m, float* ax, float* ay, float* az) {
+                            if (weighted)  // v + a·(dt·w), as without a falloff (w = 1)
+                              for (std::size_t k = 0; k < m; ++k) {
+                                const float s = c.dt * falloffWeight(a.falloff, at(L.p, first + k));
+                                ax[k] *= s;
+                                ay[k] *= s;
+                                az[k] *= s;
+                              }
+                            addScaledLoop(L.v[0] + first, L.v[1] + first, L.v[2] + first, ax, ay,
+                                          az, m, weighted ? 1.0f : c.dt);
+                          });
 }
 inline void apply(const RandomDisplace& a, const Lanes& L, std::size_t n, const BlockContext& c) {
   for (std::size_t i = 0; i < n; ++i) {
