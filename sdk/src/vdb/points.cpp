@@ -52,33 +52,49 @@ Columns gather(const Frame& frame, const ExportOptions& o) {
   return c;
 }
 
+/// A point grid over `p` (the voxel size chosen from them when not given), to which `add`
+/// appends attributes in the same order; `what` names a point in errors.
+class PointGrid {
+ public:
+  PointGrid(const std::vector<openvdb::Vec3f>& p, const ExportOptions& o, float& voxelSize,
+            const char* what) {
+    namespace pts = openvdb::points;
+    const pts::PointAttributeVector<openvdb::Vec3f> positions(p);
+    if (!(voxelSize > 0.0f)) voxelSize = pts::computeVoxelSize(positions, o.pointsPerVoxel);
+    for (const auto& x : p)
+      for (int a = 0; a < 3; ++a)
+        if (!(std::abs(x[a]) / voxelSize < 1e9))
+          throw InvalidArgument("pointsVoxelSize",
+                                std::string(what) + " at " + std::to_string(x[a]) +
+                                    " is too far from the origin for voxels of " +
+                                    std::to_string(voxelSize));
+    const auto xform = openvdb::math::Transform::createLinearTransform(voxelSize);
+    index = openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(positions, *xform);
+    // Positions stored as full floats (NullCodec): exact to float rounding, at 12 bytes a point.
+    grid = pts::createPointDataGrid<pts::NullCodec, pts::PointDataGrid>(*index, positions, *xform);
+  }
+  template <class T>
+  void add(const char* name, const std::vector<T>& values) {
+    namespace pts = openvdb::points;
+    pts::appendAttribute<T>(grid->tree(), name);
+    pts::populateAttribute(grid->tree(), index->tree(), name, pts::PointAttributeVector<T>(values));
+  }
+
+  openvdb::points::PointDataGrid::Ptr grid;
+  openvdb::tools::PointIndexGrid::Ptr index;
+};
+
 }  // namespace
 
 openvdb::points::PointDataGrid::Ptr buildPoints(const Frame& frame, const ExportOptions& o,
                                                 float& voxelSize) {
   namespace pts = openvdb::points;
   const Columns c = gather(frame, o);
-  const pts::PointAttributeVector<openvdb::Vec3f> positions(c.p);
-  if (!(voxelSize > 0.0f)) voxelSize = pts::computeVoxelSize(positions, o.pointsPerVoxel);
-  for (const auto& p : c.p)
-    for (int a = 0; a < 3; ++a)
-      if (!(std::abs(p[a]) / voxelSize < 1e9))
-        throw InvalidArgument("pointsVoxelSize", "a point at " + std::to_string(p[a]) +
-                                                     " is too far from the origin for voxels of " +
-                                                     std::to_string(voxelSize));
-  const auto xform = openvdb::math::Transform::createLinearTransform(voxelSize);
-  const auto index =
-      openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(positions, *xform);
-  // Positions stored as full floats (NullCodec): exact to float rounding, at 12 bytes a point.
-  auto grid =
-      pts::createPointDataGrid<pts::NullCodec, pts::PointDataGrid>(*index, positions, *xform);
+  PointGrid points(c.p, o, voxelSize, "a point");
+  auto& grid = points.grid;
   auto& tree = grid->tree();
-  const auto& indexTree = index->tree();
-  auto add = [&](const char* name, const auto& values) {
-    using T = typename std::decay_t<decltype(values)>::value_type;
-    pts::appendAttribute<T>(tree, name);
-    pts::populateAttribute(tree, indexTree, name, pts::PointAttributeVector<T>(values));
-  };
+  const auto& indexTree = points.index->tree();
+  auto add = [&](const char* name, const auto& values) { points.add(name, values); };
   if (c.hasV) add("v", c.v);
   if (c.hasCd) add("Cd", c.cd);
   add("pscale", c.pscale);
@@ -136,26 +152,9 @@ openvdb::points::PointDataGrid::Ptr buildStrandPoints(const Frame& frame, const 
       }
     }
   }
-  const pts::PointAttributeVector<openvdb::Vec3f> positions(p);
-  if (!(voxelSize > 0.0f)) voxelSize = pts::computeVoxelSize(positions, o.pointsPerVoxel);
-  for (const auto& x : p)
-    for (int a = 0; a < 3; ++a)
-      if (!(std::abs(x[a]) / voxelSize < 1e9))
-        throw InvalidArgument("pointsVoxelSize", "a strand vertex at " + std::to_string(x[a]) +
-                                                     " is too far from the origin for voxels of " +
-                                                     std::to_string(voxelSize));
-  const auto xform = openvdb::math::Transform::createLinearTransform(voxelSize);
-  const auto index =
-      openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(positions, *xform);
-  auto grid =
-      pts::createPointDataGrid<pts::NullCodec, pts::PointDataGrid>(*index, positions, *xform);
-  auto& tree = grid->tree();
-  const auto& indexTree = index->tree();
-  auto add = [&](const char* attr, const auto& values) {
-    using T = typename std::decay_t<decltype(values)>::value_type;
-    pts::appendAttribute<T>(tree, attr);
-    pts::populateAttribute(tree, indexTree, attr, pts::PointAttributeVector<T>(values));
-  };
+  PointGrid points(p, o, voxelSize, "a strand vertex");
+  auto& grid = points.grid;
+  auto add = [&](const char* attr, const auto& values) { points.add(attr, values); };
   add("Cd", cd);
   add("pscale", pscale);
   add("strand_id", strand);
