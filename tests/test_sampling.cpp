@@ -15,7 +15,8 @@ TEST(Sampling, SinCos2PiMatchesLibm) {
     const float u = float(i) / 100000.0f;
     float s, c;
     detail::sinCos2Pi(u, s, c);
-    worst = std::max({worst, std::abs(s - std::sin(2 * M_PI * u)), std::abs(c - std::cos(2 * M_PI * u))});
+    worst = std::max(
+        {worst, std::abs(s - std::sin(2 * M_PI * u)), std::abs(c - std::cos(2 * M_PI * u))});
   }
   EXPECT_LT(worst, 5e-7);
 }
@@ -43,7 +44,7 @@ TEST(Sampling, NewbornsFollowTheDocumentedDrawOrder) {
   g.require({Attribute::Velocity, Attribute::Lifetime, Attribute::Color, Attribute::Size});
   Emitter e;
   e.shape = Domain::sphere(Vec3(1, 2, 3), 2.0f, 0.5f);
-  e.bursts = {{0.0, 600, 0, 1}};  // > one batch of 256, born at t = 0: aged by dt
+  e.bursts = {{0.0, 600, 0, 1}};  // > one batch of 256, born at t = 0: moved by v·dt
   ParticleType t;
   t.velocity = Domain::cone(Vec3(0), Vec3(0, 3, 0), 1.0f);
   t.lifetime = Fuzzy(2.0f, 0.5f);
@@ -52,6 +53,7 @@ TEST(Sampling, NewbornsFollowTheDocumentedDrawOrder) {
   t.size = Fuzzy(0.1f, 0.05f, Fuzzy::Distribution::Normal);
   e.types = {t};
   g.addEmitter(e);
+  g.setActions({Move{}});
   ctx.step();
   ASSERT_EQ(g.size(), 600u);
   for (std::size_t i = 0; i < g.size(); i += 37) {

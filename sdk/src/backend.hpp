@@ -24,7 +24,8 @@ class BackendImpl {
  public:
   virtual ~BackendImpl() = default;
   virtual const char* name() const = 0;
-  /// Act, then remove the dead and emit the newborns (the seed's order of the update).
+  /// Emit the step's newborns, act on every particle (the newborns for what is left of the
+  /// step after their birth), remove the dead.
   virtual void step(GroupImpl& group, const StepParams& params) = 0;
 };
 
@@ -35,16 +36,21 @@ std::unique_ptr<BackendImpl> makeCpuBackend();
 std::unique_ptr<BackendImpl> makeOpenCLBackend(const ContextOptions& options);
 #endif
 
-/// Runs the group's action list over [0, size) as one fused pass and gathers the dead into
-/// group.holes (ascending) with their kill counts tallied into group.stats.
+/// Runs the group's action list over [0, size) as one fused pass, the newborns for what is
+/// left of the step after their birth, and gathers the dead into group.holes (ascending)
+/// with their kill counts tallied into group.stats.
 void actFused(GroupImpl& group, const StepParams& params);
 /// Hair mode: runs the group's newborns to their deaths through its action list, recording
 /// their paths as strands; the group keeps no live particles.
 void simulateHair(GroupImpl& group, const StepParams& params);
 /// The instruction set the fused pass runs with here: "avx512", "avx2" or "baseline".
 const char* fusedPassIsa();
-/// Creates the step's newborns from the emitters: first into holes, then at the end.
-/// Remaining holes are filled from the tail, so [0, size) is dense again.
-void emitAndCompact(GroupImpl& group, const StepParams& params);
+/// Creates the step's newborns from the emitters at the end of the group, where they were
+/// born, each with the part of the step it still has to live (group.bornFirst, bornCount,
+/// bornRemaining): the act pass that follows runs them through the action list for it.
+void emitNewborns(GroupImpl& group, const StepParams& params);
+/// Fills the act pass's holes with the live particles at the tail, so [0, size) is dense
+/// again.
+void compact(GroupImpl& group, const StepParams& params);
 
 }  // namespace flurry::detail

@@ -1,8 +1,10 @@
-// Emission and compaction, after the act pass (the seed's order: update, delete, produce).
+// Emission, before the act pass, and compaction, after it.
 //
-// Newborns go first into the slots of this step's dead, then at the end; only when more
-// died than were born are the remaining holes filled from the tail. In a steady effect
-// births and deaths balance, so compaction moves almost nothing.
+// A particle is born inside the step, at its birth time, where its emitter was then; it
+// lives what is left of the step like every other particle: the act pass that follows runs
+// it through the whole action list for that time (forces, deflectors, absorbers). So the
+// newborns are written at the end of the group, each with the time it has left, and the
+// holes the pass leaves are filled from the tail afterwards.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -47,15 +49,14 @@ struct NewbornContext {
   GroupImpl& g;
   Lanes L;
   const StepParams& sp;
-  double t1;              // end of the step: newborns are aged to it
+  double t1;              // end of the step
   std::uint32_t firstId;  // id of newborn 0 of this step
-  std::size_t oldSize;    // appended newborns start here
-  const std::uint32_t* holes;
-  std::size_t holeCount;  // newborns [0, holeCount) fill these slots
+  std::size_t oldSize;    // newborn i is in slot oldSize + i
+  float* remaining;       // newborn i lives remaining[i] of this step
 
-  std::size_t slot(std::size_t i) const {
-    return i < holeCount ? holes[i] : oldSize + (i - holeCount);
-  }
+  std::size_t slot(std::size_t i) const { return oldSize + i; }
+  // What is left of the step after a birth at tb.
+  float left(double tb) const { return float(std::max(0.0, t1 - tb)); }
 };
 
 double birthTime(const BirthRun& run, const Emitter& em, std::uint64_t q) {
@@ -73,8 +74,7 @@ const Emitter& emitterOf(const GroupImpl& g, const BirthRun& run) {
   return run.live ? g.live[run.index].emitter : g.emitters[run.index];
 }
 
-// Writes one newborn: born at tb where the emitter was then, carried on for the rest of the
-// step with its initial velocity.
+// One newborn, where and as it was born.
 struct Newborn {
   Vec3 pos, vel;
   float lifetime, r, gr, bl, alpha, size, mass, charge;
@@ -89,8 +89,7 @@ void storeBirth(const Lanes& L, std::size_t slot) {
   if (L.birthSize) L.birthSize[slot] = L.size ? L.size[slot] : Particle().size;
 }
 
-void store(const NewbornContext& nc, std::size_t slot, std::uint32_t id, float age,
-           const Newborn& b) {
+void store(const NewbornContext& nc, std::size_t slot, std::uint32_t id, const Newborn& b) {
   const Lanes& L = nc.L;
   for (int c = 0; c < 3; ++c) {
     L.p[c][slot] = b.pos[c];
@@ -113,7 +112,7 @@ void store(const NewbornContext& nc, std::size_t slot, std::uint32_t id, float a
   storeBirth(L, slot);
   if (L.mass) L.mass[slot] = b.mass;
   if (L.charge) L.charge[slot] = b.charge;
-  if (L.age) L.age[slot] = age;
+  if (L.age) L.age[slot] = 0.0f;
   L.id[slot] = id;
   if (L.visible) L.visible[slot] = 1u;
   if (L.user) L.user[slot] = 0.0f;
@@ -131,7 +130,7 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
     float rows[kMaxDraws][kBatch];
     float attr[16][kBatch];
     float up[3][kBatch], rot[3][kBatch];
-    float age[kBatch];
+    float age[kBatch];  // zeros
     std::uint32_t slot[kBatch];
   };
   thread_local std::unique_ptr<Scratch> scratch;
@@ -195,22 +194,19 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
   }
   if (L.rot[0]) sampleBatch(type.rotVelocity, row + cur, m, rot[0], rot[1], rot[2]);
 
-  // Birth times and ages; positions where the emitter was at birth, carried on for the rest
-  // of the step.
+  // Birth places: where the emitter was at the birth time; and the time left of the step.
   float* const px = attr[3];
   float* const py = attr[4];
   float* const pz = attr[5];
-  const float* const vx = attr[0];
-  const float* const vy = attr[1];
-  const float* const vz = attr[2];
   for (std::size_t k = 0; k < m; ++k) {
     const double tb = birthTime(run, em, q0 + k);
-    age[k] = float(std::max(0.0, nc.t1 - tb));
+    nc.remaining[i0 + k] = nc.left(tb);
     const Vec3 e =
         em.path.empty() ? em.position + em.velocity * float(tb - em.start) : em.positionAt(tb);
-    px[k] += e.x + vx[k] * age[k];
-    py[k] += e.y + vy[k] * age[k];
-    pz[k] += e.z + vz[k] * age[k];
+    px[k] += e.x;
+    py[k] += e.y;
+    pz[k] += e.z;
+    age[k] = 0.0f;
     slot[k] = std::uint32_t(nc.slot(i0 + k));
   }
   // Scatter into the slots, one lane at a time.
@@ -257,13 +253,13 @@ void emitOneByOne(const NewbornContext& nc, const BirthRun& run, const Emitter& 
     Random rng(nc.sp.seed, id, nc.g.index, stream::kEmission);
     const ParticleType& type = em.types[chooseType(em, rng)];
     const double tb = birthTime(run, em, q0 + k);
-    const float age = float(std::max(0.0, nc.t1 - tb));
+    nc.remaining[i0 + k] = nc.left(tb);
     Newborn b{};
     b.vel = type.velocity.sample(rng);
     const Vec3 local = em.shape.sample(rng);
     if (!(em.normalSpeed.constant() && em.normalSpeed.center == 0.0f))
       b.vel += em.shape.normal(local) * em.normalSpeed.sample(rng);
-    b.pos = local + em.positionAt(tb) + b.vel * age;
+    b.pos = local + em.positionAt(tb);
     if (L.lifetime) b.lifetime = type.lifetime.sample(rng);
     if (L.color[0]) {
       const Vec3 rgb = type.color.sample(rng);
@@ -277,7 +273,7 @@ void emitOneByOne(const NewbornContext& nc, const BirthRun& run, const Emitter& 
     if (L.charge) b.charge = type.charge.sample(rng);
     if (L.up[0]) b.up = type.up.sample(rng);
     if (L.rot[0]) b.rot = type.rotVelocity.sample(rng);
-    store(nc, nc.slot(i0 + k), id, age, b);
+    store(nc, nc.slot(i0 + k), id, b);
   }
 }
 
@@ -565,8 +561,10 @@ void retireDead(GroupImpl& g, double t1) {
   });
 }
 
-void emitAndCompact(GroupImpl& g, const StepParams& sp) {
+void emitNewborns(GroupImpl& g, const StepParams& sp) {
   const double t1 = sp.time + sp.dt;
+  g.bornFirst = g.size;
+  g.bornCount = 0;
 
   // 1. How many are born, by which emitter, when.
   // Scratch kept between steps; named through references because the worker threads below
@@ -578,16 +576,18 @@ void emitAndCompact(GroupImpl& g, const StepParams& sp) {
   runs.clear();
   const std::uint64_t total = planBirths(g, sp, runs);
   g.stats.emitted += total;
-  const std::size_t holes = g.holes.size();
-  const std::size_t alive = g.size - holes;
-  const std::size_t accepted = std::size_t(std::min<std::uint64_t>(total, g.capacity - alive));
+  const std::size_t accepted = std::size_t(std::min<std::uint64_t>(total, g.capacity - g.size));
   g.stats.droppedAtCapacity += total - accepted;
 
   // 2. The newborns, in parallel: each one's attributes depend only on its id.
   if (accepted > 0) {
+    // Grown geometrically: a step that gives birth to more than any before seldom allocates.
+    if (g.bornRemaining.size() < accepted)
+      g.bornRemaining.resize(
+          std::min<std::size_t>(g.capacity, std::max(accepted, 2 * g.bornRemaining.size())));
     runStart.assign(runs.size() + 1, 0);
     for (std::size_t r = 0; r < runs.size(); ++r) runStart[r + 1] = runStart[r] + runs[r].count;
-    NewbornContext nc{g, g.lanePointers(), sp, t1, g.nextId, g.size, g.holes.data(), holes};
+    NewbornContext nc{g, g.lanePointers(), sp, t1, g.nextId, g.size, g.bornRemaining.data()};
     const std::size_t tasks = (accepted + kNewbornsPerTask - 1) / kNewbornsPerTask;
     sp.pool->parallelFor(tasks, [&](std::size_t task) {
       const std::size_t a = task * kNewbornsPerTask;
@@ -610,17 +610,19 @@ void emitAndCompact(GroupImpl& g, const StepParams& sp) {
       }
     });
     g.nextId += std::uint32_t(accepted);
+    g.bornCount = accepted;
+    g.size += accepted;
   }
 
   retireDead(g, t1);
+}
 
-  // 3. Close the holes no newborn filled, with the live particles at the tail.
-  if (accepted >= holes) {
-    g.size += accepted - holes;
-    return;
-  }
-  const std::uint32_t* left = g.holes.data() + accepted;  // ascending
-  const std::size_t leftCount = holes - accepted;
+void compact(GroupImpl& g, const StepParams& sp) {
+  g.bornCount = 0;  // the step's newborns are ordinary particles from now on
+  // Close the holes with the live particles at the tail: the lowest hole takes the last.
+  if (g.holes.empty()) return;
+  const std::uint32_t* left = g.holes.data();  // ascending
+  const std::size_t leftCount = g.holes.size();
   const std::size_t newSize = g.size - leftCount;
   thread_local std::vector<std::pair<std::uint32_t, std::uint32_t>> movesStore;
   auto& moves = movesStore;  // (from, to)

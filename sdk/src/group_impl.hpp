@@ -112,6 +112,9 @@ struct ActionPlan {
   // Per planar Bounce before a Move that integrates forces with Exact, Verlet or RK4: 1 +
   // that Move's index (it bounces on the curve the Move takes); else 0.
   std::vector<std::uint32_t> curvedBy;
+  // Per action: its result does not depend on the step's length or time (a sink by region,
+  // KillOld, colour over life, ...), so it runs over a block of newborns as over any block.
+  std::vector<std::uint8_t> timeFree;
   bool guarded = false;              ///< some Move guards against Bounces
   bool readsNeighbours = false;      ///< the pass reads a snapshot of the step's start
   std::uint32_t firstBlocker = ~0u;  ///< index of the list's first Block action
@@ -151,6 +154,11 @@ struct GroupImpl {
   std::vector<std::uint8_t> deadCode;    ///< 1 + index of the action that killed
   std::vector<std::uint32_t> deadCount;  ///< per block
   std::vector<std::uint32_t> holes;      ///< sorted dead indices of this step
+  /// This step's newborns, written before the act pass: [bornFirst, bornFirst + bornCount),
+  /// each with the part of the step it still has to live (seconds, bornRemaining[r]), which
+  /// the pass runs it through the action list for.
+  std::size_t bornFirst = 0, bornCount = 0;
+  std::vector<float> bornRemaining;      ///< grows, never shrinks
   std::vector<std::uint32_t> deadFlags;  ///< the unfused baseline's per-particle kill codes
   std::vector<float> snapshot;           ///< positions/velocities at the step's start
   std::vector<float> stepStart;          ///< positions at the step's start, for the guard

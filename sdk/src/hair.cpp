@@ -50,7 +50,7 @@ void simulateHair(GroupImpl& g, const StepParams& sp) {
   const std::size_t maxSteps = std::size_t(g.hair.maxVertices) * g.hair.every;
   for (std::size_t k = 1; k <= maxSteps && h.size > 0; ++k) {
     actFused(h, hs);
-    emitAndCompact(h, hs);  // no emitters: only removes the dead
+    compact(h, hs);
     hs.time += hs.dt;
     ++hs.step;
     if (k % g.hair.every == 0) record();

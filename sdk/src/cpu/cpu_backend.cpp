@@ -7,6 +7,18 @@
 
 namespace flurry::detail {
 
+namespace {
+bool isTimeFree(const Action& a) {
+  if (const auto* sink = std::get_if<Sink>(&a))
+    return sink->mode == Sink::Mode::Inside || sink->mode == Sink::Mode::Outside;
+  return std::holds_alternative<SinkVelocity>(a) || std::holds_alternative<Block>(a) ||
+         std::holds_alternative<KillOld>(a) || std::holds_alternative<RandomVelocity>(a) ||
+         std::holds_alternative<RandomRotVelocity>(a) || std::holds_alternative<SpeedClamp>(a) ||
+         std::holds_alternative<ColorOverLife>(a) || std::holds_alternative<SizeOverLife>(a) ||
+         std::holds_alternative<Constrain2D>(a) || std::holds_alternative<CopyVertexB>(a);
+}
+}  // namespace
+
 // Here, in a baseline translation unit, and not in the fused pass: the pass is compiled once
 // per instruction set, and the vector code it would instantiate here is shared between the
 // builds (the SSE2 build would then run the AVX2 copy).
@@ -19,6 +31,8 @@ const ActionPlan& planActions(GroupImpl& g) {
   plan.forcesOf.assign(acts.size(), {});
   plan.guardsOf.assign(acts.size(), {});
   plan.curvedBy.assign(acts.size(), 0);
+  plan.timeFree.assign(acts.size(), 0);
+  for (std::size_t k = 0; k < acts.size(); ++k) plan.timeFree[k] = isTimeFree(acts[k]);
   // Explicit Euler moves on the straight line p + v·dt: the plain bounce is its own path.
   const bool curved = plan.integrator == Integrator::Exact ||
                       plan.integrator == Integrator::VelocityVerlet ||
@@ -58,13 +72,16 @@ class CpuBackend final : public BackendImpl {
  public:
   const char* name() const override { return "cpu"; }
   void step(GroupImpl& group, const StepParams& params) override {
+    emitNewborns(group, params);
     actFused(group, params);
-    emitAndCompact(group, params);
+    compact(group, params);
     if (group.hair.enabled) simulateHair(group, params);
   }
 };
 }  // namespace
 
-std::unique_ptr<BackendImpl> makeCpuBackend() { return std::make_unique<CpuBackend>(); }
+std::unique_ptr<BackendImpl> makeCpuBackend() {
+  return std::make_unique<CpuBackend>();
+}
 
 }  // namespace flurry::detail

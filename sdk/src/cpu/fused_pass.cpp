@@ -133,6 +133,43 @@ void runActions(const std::vector<Action>& acts, const Plan& plan, std::size_t f
   }
 }
 
+// Actions [first, last) of the list over a block's newborns, [0, count) of `lanes`: each
+// lives only what is left of the step after its birth (remaining[i]), so what depends on
+// the step's length or time runs per particle with its own, the rest over all at once.
+// `ctx` is the sub-step's (sub of plan.substeps).
+void runNewborns(const std::vector<Action>& acts, const Plan& plan, std::size_t first,
+                 std::size_t last, const Lanes& lanes, std::size_t count,
+                 const cpu::BlockContext& ctx, const float* remaining, std::uint32_t sub,
+                 double t1) {
+  for (std::size_t k = first; k < last; ++k) {
+    if (plan.list.timeFree[k]) {
+      runActions(acts, plan, k, k + 1, lanes, count, ctx);
+      continue;
+    }
+    for (std::size_t i = 0; i < count; ++i) {
+      cpu::BlockContext c = ctx;
+      c.dt = float(double(remaining[i]) / double(plan.substeps));
+      c.time = (t1 - double(remaining[i])) + double(sub) * double(c.dt);
+      c.base += i;
+      c.dead += i;
+      runActions(acts, plan, k, k + 1, lanes.offset(i), 1, c);
+    }
+  }
+}
+
+// Actions [first, last) over a block [0, m) of `lanes` (group index ctx.base) whose
+// particles from `old` on are this step's newborns.
+void runBlock(const std::vector<Action>& acts, const Plan& plan, std::size_t first,
+              std::size_t last, const Lanes& lanes, std::size_t m, std::size_t old,
+              const cpu::BlockContext& ctx, const float* remaining, std::uint32_t sub, double t1) {
+  if (old > 0) runActions(acts, plan, first, last, lanes, old, ctx);
+  if (old == m) return;
+  cpu::BlockContext c = ctx;
+  c.base += old;
+  c.dead += old;
+  runNewborns(acts, plan, first, last, lanes.offset(old), m - old, c, remaining, sub, t1);
+}
+
 // Whether a float's exponent bits are all ones: NaN or infinite.
 inline std::uint32_t nonFinite(std::uint32_t bits) {
   return std::uint32_t((bits & 0x7f800000u) == 0x7f800000u);
@@ -236,6 +273,18 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
     snapshot.size = n;
     base.snapshot = &snapshot;
   }
+  // This step's newborns are [bornFirst, n), and newborn r lives remaining[r] of it.
+  const std::size_t bornFirst = g.bornCount > 0 ? g.bornFirst : n;
+  const float* const remaining = g.bornRemaining.data();
+  const double t1 = sp.time + sp.dt;
+  // Of a block starting at `first` of m particles, how many come before the newborns; and
+  // where the block's newborns' remaining times are.
+  auto oldIn = [&](std::size_t first, std::size_t m) {
+    return first < bornFirst ? std::min(m, bornFirst - first) : std::size_t(0);
+  };
+  auto remainingAt = [&](std::size_t first, std::size_t old) {
+    return remaining ? remaining + (first + old - std::min(bornFirst, first + old)) : nullptr;
+  };
   // Sub-step s draws its own random numbers: the substep number goes into the stream.
   auto atSubstep = [&](cpu::BlockContext c, std::uint32_t s) {
     c.time = sp.time + double(s) * double(subDt);
@@ -256,8 +305,10 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
         std::fill_n(dead.data(), m, 0u);
         ctx.dead = dead.data();
         const Lanes blockLanes = lanes.offset(first);
+        const std::size_t old = oldIn(first, m);
         for (std::uint32_t s = 0; s < plan.substeps; ++s)
-          runActions(acts, plan, 0, acts.size(), blockLanes, m, atSubstep(ctx, s));
+          runBlock(acts, plan, 0, acts.size(), blockLanes, m, old, atSubstep(ctx, s),
+                   remainingAt(first, old), s, t1);
         guardFinite(blockLanes, m, dead.data());
         g.deadCount[b] = collectDead(g, first, m, dead.data());
       }
@@ -274,7 +325,9 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
             cpu::BlockContext ctx = base;
             ctx.base = first;
             ctx.dead = g.deadFlags.data() + first;
-            runActions(acts, plan, k, k + 1, lanes.offset(first), m, atSubstep(ctx, s));
+            const std::size_t old = oldIn(first, m);
+            runBlock(acts, plan, k, k + 1, lanes.offset(first), m, old, atSubstep(ctx, s),
+                     remainingAt(first, old), s, t1);
           }
         });
       }
