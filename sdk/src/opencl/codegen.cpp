@@ -571,7 +571,9 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   // A small group's whole step in one launch of one work-group: births, act,
   // count-scan-list, tail. PoCL pays several microseconds per launch; this is one instead of
   // four.
-  g.small = !g.substepsByDistance && !hair;
+  // Not for lists that read neighbours: their snapshot, copied before the act kernel, must
+  // hold the newborns where they were born, so fl_birth runs before the copy.
+  g.small = !g.substepsByDistance && !hair && !g.neighbours;
   if (g.small)
     s << "/* ---- generated: a small group's step */\n"
          "__kernel void fl_small(FL_LANE_PARAMS, "
