@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include <algorithm>
+#include <chrono>
 #include <cstring>
 #include <set>
 
@@ -226,4 +227,24 @@ TEST(Group, SetActionsBetweenStepsRebuildsThePlan) {
     EXPECT_FLOAT_EQ(after.position[c],
                     before.position[c] + before.velocity[c] * float(ctx.timeStep()));
   EXPECT_NE(after.position.y, before.position.y);
+}
+
+TEST(Group, StepSecondsTimeTheCpuBackendsParts) {
+  Context ctx({.threads = 1});
+  Group& g = samples::buildFountain(ctx, 20000, 30000.0, 0.3f);
+  g.setActions({Gravity{}, Move{}, KillOld{}});
+  const auto start = std::chrono::steady_clock::now();
+  ctx.run(30);
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const GroupStats::StepSeconds s = g.stats().stepSeconds;
+  EXPECT_GT(s.act, 0.0);
+  EXPECT_GT(s.emit, 0.0);
+  EXPECT_GT(g.stats().killedByAge, 0u);
+  EXPECT_LE(s.act + s.emit + s.compact, wall);
+  // Deaths and no births: every step compacts.
+  g.emitters()[0].stop = ctx.time();
+  ctx.run(5);
+  EXPECT_GT(g.stats().stepSeconds.compact, s.compact);
+  EXPECT_GT(g.stats().stepSeconds.act, s.act);
 }

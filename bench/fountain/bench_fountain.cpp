@@ -90,14 +90,15 @@ void FountainStep(benchmark::State& state) {
   state.counters["B/particle"] = g.attributes().bytesPerParticle();
 }
 
-// Emission alone (nearly): every particle dies after one step and n are born per step.
+// Births and deaths alone (nearly): n are born per step and every one dies in its birth
+// step (it lives what is left of the step after its birth, longer than its lifetime).
 void Emission(benchmark::State& state) {
   const auto n = std::size_t(state.range(0));
   ContextOptions o;
   o.threads = threads();
   Context ctx(o);
   Group& g = samples::buildFountain(ctx, n, double(n) / o.dt, 1e-6f);
-  g.setActions({KillOld{}});
+  g.setActions({Move{}, KillOld{}});
   ctx.run(3);
   const std::uint64_t before = g.stats().emitted;
   for (auto _ : state) ctx.step();

@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -138,8 +139,9 @@ std::string hms(double secs) {
   return buf;
 }
 
-/// A one-line progress bar with ETA on stderr. It appears only once a run has taken a second
-/// (short runs stay silent), on a terminal or when FLURRY_PROGRESS=1.
+/// A progress bar with ETA on stderr, on a terminal or when FLURRY_PROGRESS=1. A terminal
+/// gets one line redrawn in place, once a run has taken a second (short runs stay silent); a
+/// log gets a whole line at each tenth of the run, ten lines however long it is.
 class Progress {
  public:
   Progress(int total, bool quiet) : total_(total), start_(Clock::now()) {
@@ -156,11 +158,17 @@ class Progress {
     if (!active_) return;
     const auto now = Clock::now();
     const double elapsed = std::chrono::duration<double>(now - start_).count();
-    // A terminal redraws in place; a log (FLURRY_PROGRESS=1) gets a line a second.
-    const auto every = std::chrono::milliseconds(tty_ ? 100 : 1000);
-    if (elapsed < 1.0 || (shown_ && now - last_ < every && done < total_)) return;
+    if (tty_) {
+      if (elapsed < 1.0 ||
+          (shown_ && now - last_ < std::chrono::milliseconds(100) && done < total_))
+        return;
+    } else {
+      const int tenth = total_ > 0 ? int(std::int64_t(done) * 10 / total_) : 10;
+      if (tenth == 0 || tenth == lastTenth_) return;
+      lastTenth_ = tenth;
+    }
     last_ = now;
-    shown_ = true;
+    shown_ = tty_;  // a log's line is finished: nothing to clear
     const double frac = total_ > 0 ? double(done) / total_ : 1.0;
     const int width = 30, fill = int(frac * width);
     std::string bar(std::size_t(fill), '#');
@@ -183,6 +191,7 @@ class Progress {
  private:
   int total_;
   Clock::time_point start_, last_;
+  int lastTenth_ = 0;
   bool tty_ = false, active_ = false, shown_ = false;
 };
 
@@ -324,6 +333,9 @@ int validate(const std::vector<std::string>& files) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Whole lines on stdout even into a pipe or a file: the progress lines on stderr then fall
+  // between its lines, never inside one (a full buffer would be flushed mid-line).
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
   CLI::App app{"flurry: run particle effects"};
   app.require_subcommand(1);
   RunOptions o;

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include "builtin.hpp"
 #include "flurry/effect.hpp"
@@ -121,6 +122,9 @@ class PngPlugin : public Plugin {
         ->check(CLI::Range(std::size_t(0), std::size_t(1) << 31));
     view_->add_option("--exit-after", viewFrames_, "close after N frames (for scripts)")
         ->check(CLI::Range(0, 100000000));
+    // The same bounds as `run --dt`, so a step that runs also views.
+    view_->add_option("--dt", viewDt_, "seconds per step (default: the effect's)")
+        ->check(CLI::Range(1e-6, 10.0));
     addLookOptions(*view_, viewLook_);
   }
 
@@ -139,7 +143,9 @@ class PngPlugin : public Plugin {
       runViewer(
           [&] {
             ViewerScene scene;
-            scene.context = std::make_unique<Context>(fx.contextOptions());
+            ContextOptions co = fx.contextOptions();
+            if (viewDt_) co.dt = *viewDt_;
+            scene.context = std::make_unique<Context>(co);
             fx.build(*scene.context, viewCapacity_);
             return scene;
           },
@@ -220,6 +226,7 @@ class PngPlugin : public Plugin {
   std::string viewEffect_;
   std::size_t viewCapacity_ = 0;
   int viewFrames_ = 0;
+  std::optional<double> viewDt_;
   RunInfo info_;
   std::unique_ptr<OffscreenRenderer> renderer_;
   double renderSecs_ = 0, writeSecs_ = 0;

@@ -1,11 +1,13 @@
 // `flurry run ... --vdb DIR`: one OpenVDB file per frame (fog volume and points), written on
 // a background thread while the simulation goes on, with a progress bar and a cost report.
+// An effect of hair alone is static: a frame is written only when strands were added.
 #include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
 #include <optional>
 #include <thread>
+#include <vector>
 
 #include "flurry/vdb.hpp"
 #include "outputs.hpp"
@@ -25,10 +27,11 @@ class VdbPlugin final : public Plugin {
     run.add_flag("--vdb-fog", fogOnly_, "write only the fog volume (density, vel, Cd)");
     run.add_flag("--vdb-points", pointsOnly_, "write only the points (PointDataGrid 'points')");
     run.add_option("--voxel-size", options_.fogVoxelSize,
-                   "fog voxel size in world units (default: half the median particle radius)")
+                   "fog voxel size in world units (default: half the median particle radius, "
+                   "or for hair half a strand segment)")
         ->check(CLI::PositiveNumber);
     run.add_option("--points-voxel-size", options_.pointsVoxelSize,
-                   "points voxel size (default: about 8 points per voxel)")
+                   "voxel size of the points and strands grids (default: about 8 points per voxel)")
         ->check(CLI::PositiveNumber);
     run.add_option("--vdb-density", options_.density, "fog density inside a particle")
         ->check(CLI::NonNegativeNumber);
@@ -57,12 +60,29 @@ class VdbPlugin final : public Plugin {
                   writer_->removedTemporaries().size(), folder_.c_str());
     for (int f = 1; f <= info.frames; ++f)
       if (due(f)) ++toWrite_;
+    hairOnly_ = !ctx.groups().empty();
+    for (const Group* g : ctx.groups()) hairOnly_ = hairOnly_ && g->hair().enabled;
     tty_ = ::isatty(STDERR_FILENO) == 1;
     start_ = Clock::now();
   }
 
   void frame(Context& ctx, int frame) override {
     if (!due(frame)) return;
+    if (hairOnly_) {
+      // Hair is static: strands never move once made, so a frame differs from the file
+      // before it only if strands were added (they are only ever appended).
+      strandCounts_.clear();
+      for (const Group* g : ctx.groups()) {
+        strandCounts_.push_back(g->strands().size());
+        strandCounts_.push_back(g->strands().vertexCount());
+      }
+      if (queued_ > 0 && strandCounts_ == lastStrandCounts_) {
+        ++unchanged_;
+        --toWrite_;
+        return;
+      }
+      lastStrandCounts_ = strandCounts_;
+    }
     try {
       writer_->write(ctx.groups(), frame, ctx.time());
     } catch (...) {
@@ -70,7 +90,7 @@ class VdbPlugin final : public Plugin {
       throw;
     }
     ++queued_;
-    progress(false);
+    if (!info_.progress) progress(false);  // the tool's own bar is on: draw none beside it
   }
 
   void end(Context&) override {
@@ -99,17 +119,26 @@ class VdbPlugin final : public Plugin {
         cost.files ? 1e3 * cost.captureSeconds / double(cost.files) : 0.0,
         cost.files ? 1e3 * cost.waitSeconds / double(cost.files) : 0.0);
     const vdb::FileStats last = writer_->last();
-    if (cost.files)
-      std::printf("vdb: last file %s: %zu points, %llu fog voxels of %.4g (points voxel %.4g)\n",
+    if (cost.files) {
+      std::printf("vdb: last file %s: %zu points, %llu fog voxels of %.4g (points voxel %.4g)",
                   last.path.c_str(), last.points, (unsigned long long)last.fogVoxels,
                   double(last.fogVoxelSize), double(last.pointsVoxelSize));
+      if (last.strandVertices > 0) std::printf(", %zu strand vertices", last.strandVertices);
+      std::printf("\n");
+    }
+    if (unchanged_ > 0)
+      std::printf(
+          "vdb: hair is static: %d later frames, unchanged since the last file, not "
+          "written\n",
+          unchanged_);
   }
 
  private:
   bool due(int frame) const { return frame % every_ == 0 || frame == info_.frames; }
 
   /// A bar with ETA on stderr: redrawn in place on a terminal (at most 10 times a second),
-  /// a line per tenth of the work otherwise (logs stay short).
+  /// a line per tenth of the work otherwise (logs stay short). While the tool draws its own
+  /// bar (RunInfo::progress) it is drawn only in end(), for the files still being written.
   void progress(bool final) {
     if (info_.quiet || toWrite_ == 0) return;
     const std::size_t done = writer_->written();
@@ -149,6 +178,9 @@ class VdbPlugin final : public Plugin {
   RunInfo info_;
   std::optional<vdb::SequenceWriter> writer_;
   int toWrite_ = 0, queued_ = 0;
+  bool hairOnly_ = false;  ///< every group is in hair mode: nothing but strands to write
+  std::vector<std::size_t> strandCounts_, lastStrandCounts_;  ///< per group: strands, vertices
+  int unchanged_ = 0;
   bool tty_ = false, drawn_ = false;
   std::size_t lastTenth_ = std::size_t(-1);
   Clock::time_point start_, lastDraw_;

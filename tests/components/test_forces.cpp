@@ -134,15 +134,21 @@ TEST(Turbulence, CurlNoiseIsDivergenceFree) {
   double worstDiv = 0, typicalGrad = 0;
   for (int k = 0; k < 200; ++k) {
     const Vec3 p = Domain::box(Vec3(-10), Vec3(10)).sample(rng);
-    const Vec3 dx = (detail::curlNoise(p + Vec3(h, 0, 0), 2) - detail::curlNoise(p - Vec3(h, 0, 0), 2)) / (2 * h);
-    const Vec3 dy = (detail::curlNoise(p + Vec3(0, h, 0), 2) - detail::curlNoise(p - Vec3(0, h, 0), 2)) / (2 * h);
-    const Vec3 dz = (detail::curlNoise(p + Vec3(0, 0, h), 2) - detail::curlNoise(p - Vec3(0, 0, h), 2)) / (2 * h);
+    const Vec3 dx =
+        (detail::curlNoise(p + Vec3(h, 0, 0), 2) - detail::curlNoise(p - Vec3(h, 0, 0), 2)) /
+        (2 * h);
+    const Vec3 dy =
+        (detail::curlNoise(p + Vec3(0, h, 0), 2) - detail::curlNoise(p - Vec3(0, h, 0), 2)) /
+        (2 * h);
+    const Vec3 dz =
+        (detail::curlNoise(p + Vec3(0, 0, h), 2) - detail::curlNoise(p - Vec3(0, 0, h), 2)) /
+        (2 * h);
     worstDiv = std::max(worstDiv, double(std::abs(dx.x + dy.y + dz.z)));
     typicalGrad += std::abs(dx.y) + std::abs(dy.z) + std::abs(dz.x);
   }
   typicalGrad /= 600;
-  EXPECT_GT(typicalGrad, 0.1);                // the field does vary...
-  EXPECT_LT(worstDiv, 0.01 * typicalGrad);    // ...with no divergence beyond the differences' error
+  EXPECT_GT(typicalGrad, 0.1);              // the field does vary...
+  EXPECT_LT(worstDiv, 0.01 * typicalGrad);  // ...with no divergence beyond the differences' error
 }
 
 TEST(MagneticField, DoesNoWorkAndGyratesAtTheLarmorRadius) {
@@ -333,8 +339,8 @@ TEST(Explosion, PushesOutwardNearTheFront) {
   Context ctx = makeContext(0.1);
   Group& g = ctx.createGroup("g", 2);
   g.setActions({Explosion{Vec3(0), 10.0f, 100.0f, 0.5f, 1e-3f, 0.0f}});
-  g.add(at(Vec3(0.5f, 0, 0)));   // the front is at 0.5 at mid-step
-  g.add(at(Vec3(0, -20, 0)));    // far from it
+  g.add(at(Vec3(0.5f, 0, 0)));  // the front is at 0.5 at mid-step
+  g.add(at(Vec3(0, -20, 0)));   // far from it
   ctx.step();
   EXPECT_GT(g.particle(0).velocity.x, 1.0f);
   EXPECT_NEAR(g.particle(1).velocity.y, 0.0f, 1e-6f);
@@ -449,4 +455,32 @@ TEST(Falloff, FadesFieldsToZeroAtTheRadius) {
   EXPECT_LT(glm::length(g.particle(0).velocity - expect(1.0f)), 1e-5f);  // full strength
   EXPECT_LT(glm::length(g.particle(1).velocity - expect(0.5f)), 1e-5f);  // halfway out
   EXPECT_EQ(g.particle(2).velocity, Vec3(1, 0, 0));                      // outside: untouched
+}
+
+// RandomAccel draws for a block of particles at once: each particle still gets the numbers
+// of its own stream (seed, id, step, group << 16 | action), in Random's order, as
+// Domain::sample draws them (the OpenCL backend draws the same). Blob takes two Philox
+// blocks per sample; 1000 particles are several batches and a partial one.
+TEST(RandomAccel, EachParticleDrawsItsOwnStream) {
+  for (const Domain& d : {Domain::sphere(Vec3(0, 1, 0), 6.0f), Domain::blob(Vec3(1, 0, 0), 8.0f),
+                          Domain::box(Vec3(-1), Vec3(2))}) {
+    ContextOptions o;
+    o.dt = 0.5;
+    o.threads = 2;
+    o.seed = 0x1234'5678'9ABCull;
+    Context ctx(o);
+    Group& g = ctx.createGroup("g", 1000);
+    g.setActions({Gravity{Vec3(0.0f)}, RandomAccel{d}});  // RandomAccel is action 1
+    for (int i = 0; i < 1000; ++i) g.add(at(Vec3(float(i), 0, 0)));
+    ctx.run(2);
+    for (std::size_t i = 0; i < g.size(); ++i) {
+      const Particle p = g.particle(i);
+      Vec3 v(0.0f);
+      for (std::uint32_t step = 0; step < 2; ++step) {
+        Random rng(o.seed, p.id, step, 1);
+        v += d.sample(rng) * 0.5f;
+      }
+      ASSERT_EQ(p.velocity, v) << d.name() << " particle " << i;
+    }
+  }
 }

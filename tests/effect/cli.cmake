@@ -4,8 +4,11 @@
 #   MODE=run:      --quiet prints one summary line accounting for every particle; --out writes
 #                  PLY files; a file path runs; what the system refuses (memory, threads) is
 #                  one line and exit 1, never an abort.
-#   MODE=list:     every built-in effect with a description.
-# SANITIZE: the sanitizer build (no address-space limits); RENDER: the tool has --png.
+#   MODE=list:     every effect file of samples/effects, with its description.
+#   MODE=log:      stdout and stderr into one pipe are whole lines; FLURRY_PROGRESS=1 there
+#                  prints a line per tenth of the run instead of a line per frame.
+# SANITIZE: the sanitizer build (no address-space limits); RENDER: the tool has --png; VDB:
+# the tool has --vdb.
 cmake_minimum_required(VERSION 3.25)
 
 function(flurry_expect)
@@ -103,11 +106,81 @@ elseif(MODE STREQUAL "run")
   endif()
 elseif(MODE STREQUAL "list")
   flurry_expect(RC 0 OUT "fountain +a water fountain" ARGS list)
-  foreach(name fireworks snow hair tornado pinball2d magnetic)
-    if(NOT last_out MATCHES "\n?${name} +[a-zA-Z0-9]")
+  # Every effect file of samples/effects, one line each: its name, then its "description"
+  # as the file has it (stored once, with the effect; a new sample needs one).
+  file(GLOB files ${SRC}/samples/effects/*.json)
+  list(LENGTH files n)
+  string(REGEX MATCHALL "\n" lines "${last_out}")
+  list(LENGTH lines listed)
+  if(NOT listed EQUAL n)
+    message(FATAL_ERROR "`flurry list` printed ${listed} lines for ${n} effect files:\n${last_out}")
+  endif()
+  foreach(f IN LISTS files)
+    file(READ ${f} json)
+    string(JSON name GET "${json}" name)
+    string(JSON description ERROR_VARIABLE none GET "${json}" description)
+    if(none OR description STREQUAL "")
+      message(FATAL_ERROR "${f} has no \"description\" for `flurry list`")
+    endif()
+    string(FIND "${last_out}" "\n${name} " at)
+    if(at LESS 0 AND NOT last_out MATCHES "^${name} ")
       message(FATAL_ERROR "`flurry list` lacks ${name}:\n${last_out}")
     endif()
+    string(REGEX MATCH "(^|\n)${name} +([^\n]*)" line "${last_out}")
+    if(NOT CMAKE_MATCH_2 STREQUAL description)
+      message(FATAL_ERROR "`flurry list`: ${name}: '${CMAKE_MATCH_2}', the file says '${description}'")
+    endif()
   endforeach()
+elseif(MODE STREQUAL "log")
+  # A log: stdout and stderr into one pipe, as `bash scripts/demo.sh > log 2>&1` makes.
+  file(REMOVE_RECURSE ${DIR})
+  set(vdb)
+  if(VDB)  # the export's progress lines are the stderr that meets the per-frame lines
+    set(vdb --vdb ${DIR} --vdb-every 6 --voxel-size 0.2)
+  endif()
+  function(flurry_log progress var)
+    execute_process(COMMAND ${CMAKE_COMMAND} -E env FLURRY_PROGRESS=${progress}
+                            sh -c "exec \"$@\" 2>&1" sh ${FLURRY} run fountain --frames 60 ${vdb}
+                    RESULT_VARIABLE rc OUTPUT_VARIABLE out)
+    if(NOT rc EQUAL 0)
+      message(FATAL_ERROR "flurry run fountain ${vdb}: exit ${rc}\n${out}")
+    endif()
+    # Whole lines only: each one starts as the tool starts its lines, none is cut by another.
+    string(REPLACE ";" "," lines "${out}")  # a CMake list splits at ';'
+    string(REGEX MATCHALL "[^\n]*\n" lines "${lines}")
+    foreach(line IN LISTS lines)
+      if(NOT line MATCHES "^(frame +[0-9]+  t=[^\n]*live|\\[[#.]+\\] +[0-9]+%  frame [0-9]+/60  [^\n]*ETA [0-9:]+\n$|vdb \\[[#.]+\\] [0-9]+/[0-9]+ files [^\n]*ETA [0-9]+ s\n$|vdb: (wrote|last file) |fountain: 60 steps)")
+        message(FATAL_ERROR "FLURRY_PROGRESS=${progress}: a line that is not whole: '${line}' in\n${out}")
+      endif()
+    endforeach()
+    set(${var} "${out}" PARENT_SCOPE)
+  endfunction()
+  # Per-frame lines (no bar): the export's progress lines fall between them.
+  flurry_log(0 out)
+  string(REGEX MATCHALL "(^|\n)frame +[0-9]+ " frames "${out}")
+  list(LENGTH frames n)
+  if(NOT n EQUAL 60)
+    message(FATAL_ERROR "FLURRY_PROGRESS=0: ${n} per-frame lines, expected 60:\n${out}")
+  endif()
+  # The bar in a log: a whole line at each tenth of the run (however short it is), no
+  # per-frame lines but the last frame's statistics, and the export draws no bar of its own
+  # beside it, only for the files still being written once the steps are done.
+  flurry_log(1 out)
+  string(REGEX MATCHALL "\\] +[0-9]+%  frame [0-9]+/60 " bars "${out}")
+  string(REGEX REPLACE "\\] +[0-9]+%  frame ([0-9]+)/60 " "\\1" bars "${bars}")
+  if(NOT bars STREQUAL "6;12;18;24;30;36;42;48;54;60")
+    message(FATAL_ERROR "FLURRY_PROGRESS=1: progress lines at frames '${bars}', expected one per tenth:\n${out}")
+  endif()
+  string(REGEX MATCHALL "(^|\n)frame +[0-9]+ " frames "${out}")
+  list(LENGTH frames n)
+  if(NOT n EQUAL 1 OR NOT out MATCHES "\nframe +60 ")
+    message(FATAL_ERROR "FLURRY_PROGRESS=1: per-frame lines beside the bar:\n${out}")
+  endif()
+  string(FIND "${out}" "100%  frame 60/60" end)
+  string(FIND "${out}" "vdb [" export)
+  if(export GREATER_EQUAL 0 AND export LESS end)
+    message(FATAL_ERROR "FLURRY_PROGRESS=1: the export drew its bar beside the tool's:\n${out}")
+  endif()
 else()
   message(FATAL_ERROR "unknown MODE ${MODE}")
 endif()

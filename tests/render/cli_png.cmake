@@ -2,7 +2,8 @@
 #   MODE=png:   `run --png` writes PNG frames at the --every cadence.
 #   MODE=nogl:  with no display and no Xvfb on PATH, `--png` fails with a clear message,
 #               and the same run without it still simulates and writes PLY files.
-#   MODE=view:  `view` refuses to open without a display, naming the reason.
+#   MODE=view:  `view` refuses to open without a display, naming the reason; its --dt is
+#               accepted and checked like run's.
 cmake_minimum_required(VERSION 3.25)
 file(REMOVE_RECURSE ${DIR})
 
@@ -56,6 +57,22 @@ elseif(MODE STREQUAL "view")
   if(rc EQUAL 0 OR NOT err MATCHES "view: no usable OpenGL: DISPLAY is not set")
     message(FATAL_ERROR "expected `view` to need a display, got (${rc}):\n${out}\n${err}")
   endif()
+  # `--dt` (docs/rendering.md) is accepted, then the display is what is missing ...
+  execute_process(
+    COMMAND ${CMAKE_COMMAND} -E env --unset=DISPLAY ${FLURRY} view fountain --dt 0.02 --exit-after 2
+    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(rc EQUAL 0 OR NOT err MATCHES "view: no usable OpenGL: DISPLAY is not set")
+    message(FATAL_ERROR "`view --dt 0.02` should parse, then need a display (${rc}):\n${out}\n${err}")
+  endif()
+  # ... and is checked like `run --dt`.
+  foreach(bad 0 -1 11 x)
+    execute_process(
+      COMMAND ${CMAKE_COMMAND} -E env --unset=DISPLAY ${FLURRY} view fountain --dt ${bad}
+      RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+    if(rc EQUAL 0 OR NOT err MATCHES "--dt" OR err MATCHES "OpenGL")
+      message(FATAL_ERROR "`view --dt ${bad}` should be refused naming --dt (${rc}):\n${out}\n${err}")
+    endif()
+  endforeach()
 else()
   message(FATAL_ERROR "MODE must be png, nogl or view")
 endif()

@@ -455,6 +455,129 @@ TEST(VdbStrands, TubeVolumeWithVaryingThickness) {
   }
 }
 
+TEST(VdbStrands, PointsRebuildTheCurves) {
+  // Two sets of strands (two hair groups): ids run on across them.
+  Strands a, b;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), c(0.0f, 1.0f);
+  auto strand = [&](Strands& s, int n) {
+    std::vector<Vec3> p;
+    std::vector<Vec4> col;
+    std::vector<float> r;
+    Vec3 x(u(rng), u(rng), u(rng));
+    for (int i = 0; i < n; ++i) {
+      p.push_back(x);
+      x += 0.05f * Vec3(u(rng), 1.0f, u(rng));
+      col.push_back(Vec4(c(rng), c(rng), c(rng), 1.0f));
+      r.push_back(0.001f + 0.01f * c(rng));
+    }
+    s.add(p, col, r);
+  };
+  for (int k = 0; k < 40; ++k) strand(a, 2 + k % 17);
+  for (int k = 0; k < 25; ++k) strand(b, 5 + k % 9);
+  const std::vector<const Strands*> sets{&a, &b};
+  vdb::Frame frame;
+  frame.strands = {a, b};
+  vdb::ExportOptions o;
+  o.fogVoxelSize = 0.05f;  // the fog is not what this test checks
+  const fs::path path = scratch("strand_points") / "hair.vdb";
+  const vdb::FileStats st = vdb::writeFile(path, frame, o);
+  EXPECT_EQ(st.strandVertices, a.vertexCount() + b.vertexCount());
+  EXPECT_GT(st.strandsVoxelSize, 0.0f);
+  VdbFile f(path);
+  EXPECT_EQ(f.names(), (std::vector<std::string>{"Cd", "density", "points", "strands"}));
+  auto grid = f.get<openvdb::points::PointDataGrid>("strands");
+  ASSERT_TRUE(grid);
+  EXPECT_EQ(openvdb::points::pointCount(grid->tree()), st.strandVertices);
+  EXPECT_EQ(grid->metaValue<std::string>("pscale_meaning"), "radius");
+
+  // Read every point back, keyed by (strand, vertex): what a user rebuilds curves from.
+  namespace pts = openvdb::points;
+  struct V {
+    openvdb::Vec3d p;
+    openvdb::Vec3f cd;
+    float pscale;
+  };
+  std::map<std::pair<std::int32_t, std::int32_t>, V> read;
+  for (auto leaf = grid->tree().cbeginLeaf(); leaf; ++leaf) {
+    const auto& desc = leaf->attributeSet().descriptor();
+    ASSERT_EQ(desc.valueType(desc.find("strand_id")), "int32");
+    ASSERT_EQ(desc.valueType(desc.find("strand_vertex")), "int32");
+    pts::AttributeHandle<openvdb::Vec3f> P(leaf->constAttributeArray("P"));
+    pts::AttributeHandle<openvdb::Vec3f> cd(leaf->constAttributeArray("Cd"));
+    pts::AttributeHandle<float> pscale(leaf->constAttributeArray("pscale"));
+    pts::AttributeHandle<std::int32_t> sid(leaf->constAttributeArray("strand_id"));
+    pts::AttributeHandle<std::int32_t> vtx(leaf->constAttributeArray("strand_vertex"));
+    for (auto idx = leaf->beginIndexOn(); idx; ++idx) {
+      const V v{grid->transform().indexToWorld(idx.getCoord().asVec3d() + P.get(*idx)),
+                cd.get(*idx), pscale.get(*idx)};
+      EXPECT_TRUE(read.emplace(std::make_pair(sid.get(*idx), vtx.get(*idx)), v).second)
+          << "strand " << sid.get(*idx) << " vertex " << vtx.get(*idx) << " twice";
+    }
+  }
+  ASSERT_EQ(read.size(), st.strandVertices);
+  std::int32_t id = 0;
+  for (const Strands* s : sets)
+    for (std::size_t k = 0; k < s->size(); ++k, ++id)
+      for (std::uint32_t i = s->start[k]; i < s->start[k + 1]; ++i) {
+        const auto it = read.find({id, std::int32_t(i - s->start[k])});
+        ASSERT_NE(it, read.end()) << "strand " << id << " vertex " << i - s->start[k];
+        const V& v = it->second;
+        const double tol = 1e-6 * (1.0 + grid->voxelSize()[0]);
+        EXPECT_NEAR(v.p.x(), s->position[i].x, tol);
+        EXPECT_NEAR(v.p.y(), s->position[i].y, tol);
+        EXPECT_NEAR(v.p.z(), s->position[i].z, tol);
+        EXPECT_EQ(v.cd, openvdb::Vec3f(s->color[i].x, s->color[i].y, s->color[i].z));
+        EXPECT_EQ(v.pscale, s->radius[i]);
+      }
+
+  // writeFog and --vdb-fog write no points of either kind.
+  o.points = false;
+  EXPECT_EQ(vdb::writeFile(path, frame, o).strandVertices, 0u);
+  EXPECT_EQ(VdbFile(path).names(), (std::vector<std::string>{"Cd", "density"}));
+}
+
+TEST(VdbStrands, AutomaticVoxelSizeSuitsThinStrands) {
+  // Thin strands (radius 0.002) with vertices 0.05 apart: voxels of half a segment, not of
+  // half the radius (which would be 25 times finer: millions of voxels for a head of hair).
+  auto strands = [](float radius, float segment) {
+    Strands s;
+    for (int k = 0; k < 20; ++k) {
+      std::vector<Vec3> p;
+      for (int i = 0; i < 10; ++i) p.push_back(Vec3(0.1f * float(k), segment * float(i), 0.0f));
+      s.add(p, std::vector<Vec4>(p.size(), Vec4(1.0f)), std::vector<float>(p.size(), radius));
+    }
+    return s;
+  };
+  vdb::Frame thin;
+  thin.strands.push_back(strands(0.002f, 0.05f));
+  EXPECT_FLOAT_EQ(vdb::fogVoxelSize(thin), 0.025f);
+  // A thick strand still gets four voxels across.
+  vdb::Frame thick;
+  thick.strands.push_back(strands(0.1f, 0.05f));
+  EXPECT_FLOAT_EQ(vdb::fogVoxelSize(thick), 0.05f);
+  // Particles are unchanged: half the median radius.
+  vdb::Frame particles;
+  vdb::Particles p;
+  for (int i = 0; i < 5; ++i) {
+    p.position.push_back(Vec3(float(i), 0.0f, 0.0f));
+    p.id.push_back(std::uint32_t(i));
+    p.radius.push_back(0.01f * float(i + 1));
+  }
+  particles.groups.push_back(p);
+  EXPECT_FLOAT_EQ(vdb::fogVoxelSize(particles), 0.015f);
+  // The thin strands' fog stays small and keeps their whole tube volume.
+  const fs::path path = scratch("thin_strands") / "hair.vdb";
+  vdb::ExportOptions o;
+  o.points = false;
+  const vdb::FileStats st = vdb::writeFile(path, thin, o);
+  EXPECT_FLOAT_EQ(st.fogVoxelSize, 0.025f);
+  const double tube = 20 * 9 * std::numbers::pi * 0.002 * 0.002 * 0.05;
+  EXPECT_NEAR(st.mass, tube, 1e-6 * tube);  // float vertices and radii
+  EXPECT_NEAR(integral(*VdbFile(path).get<openvdb::FloatGrid>("density")), tube,
+              kMassTolerance * tube);
+}
+
 // ------------------------------------------------------------------------------ sequence --
 
 TEST(VdbSequence, OneFilePerFrameMatchingTheLiveGroup) {

@@ -42,8 +42,10 @@ class Context {
   Group& group(std::string_view name);
   std::vector<Group*> groups();
 
-  /// Advances every group by one step of timeStep() seconds: the action list runs as one
-  /// fused pass, the dead are removed, emitters create the newborns.
+  /// Advances every group by one step of timeStep() seconds: emitters create the step's
+  /// newborns where and when each is born, the action list runs as one fused pass over
+  /// every particle (a newborn for what is left of the step after its birth), and the dead
+  /// are removed.
   void step();
   void run(std::size_t steps) {
     for (std::size_t i = 0; i < steps; ++i) step();

@@ -55,9 +55,9 @@ struct Emitter {
   double rate = 0.0;
   std::vector<Burst> bursts;
   /// The emitter's position at time `start`; it then moves at `velocity`, or follows `path`
-  /// when that is not empty. A particle born inside a step is placed where the emitter was
-  /// at its birth time and aged by the rest of the step, so a moving emitter leaves an even
-  /// trail at any frame rate.
+  /// when that is not empty. A particle born inside a step starts where the emitter was at
+  /// its birth time and runs the action list for the rest of the step, so a moving emitter
+  /// leaves an even trail at any frame rate.
   Vec3 position{0.0f};
   Vec3 velocity{0.0f};
   std::vector<Keyframe> path;

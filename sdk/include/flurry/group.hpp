@@ -70,6 +70,15 @@ struct GroupStats {
   std::uint64_t emittersSpawned = 0;  ///< by prime emitters and death spawns, all levels
   /// Not spawned: the prime emitter already had PrimeEmitter::maxEmitters live emitters.
   std::uint64_t emittersDropped = 0;
+  /// Cumulative wall-clock seconds the CPU backend spent in each part of its steps: the
+  /// action pass, the newborns (births planned and written), the compaction (holes closed
+  /// from the tail). For profiling; other backends leave them 0.
+  struct StepSeconds {
+    double emit = 0.0;
+    double act = 0.0;
+    double compact = 0.0;
+  };
+  StepSeconds stepSeconds;
 };
 
 struct Bounds {

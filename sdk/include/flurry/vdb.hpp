@@ -1,8 +1,9 @@
 // OpenVDB export and import (target flurry::vdb): particles as a fog volume (`density`,
 // `vel`, `Cd` grids) and as a point cloud (a PointDataGrid named `points`), hair strands
-// rasterised into the fog volume, one file per frame written atomically on a background
-// thread (temporaries that a killed run left are cleaned up by the next sequence), and OpenVDB
-// vector grids read back as a VectorField for the sampled-field force.
+// rasterised into the fog volume and as points of a `strands` PointDataGrid, one file per frame
+// written atomically on a background thread (temporaries that a killed run left are cleaned up by
+// the next sequence), and OpenVDB vector grids read back as a VectorField for the sampled-field
+// force.
 //
 // This header does not include OpenVDB: a game that includes it links flurry::vdb, which
 // links OpenVDB privately.
@@ -34,12 +35,17 @@ namespace flurry::vdb {
 /// the volume of its tube, `density · π · ∫ r(s)² ds`, with r linear along each segment.
 /// `vel` and `Cd` are mass-weighted averages over the voxel.
 struct ExportOptions {
-  bool fog = true;     ///< the `density`, `vel` and `Cd` grids
-  bool points = true;  ///< the `points` PointDataGrid (strands are never written as points)
-  /// Fog voxel edge in world units; 0 picks half the median particle (and strand) radius,
-  /// so a typical particle is four voxels across.
+  bool fog = true;  ///< the `density`, `vel` and `Cd` grids
+  /// The `points` PointDataGrid of the particles, and the `strands` PointDataGrid of the
+  /// strands' vertices (with `strand_id` and `strand_vertex`, to rebuild them as curves).
+  bool points = true;
+  /// Fog voxel edge in world units; 0 picks the median of what each particle and strand
+  /// vertex asks for: half a particle's radius (a typical particle is four voxels across);
+  /// for a strand vertex, half its radius or half its segment's length, the larger (a thin
+  /// strand keeps its volume in voxels wider than it; finer ones add nothing along it).
   float fogVoxelSize = 0.0f;
-  /// Points voxel edge; 0 picks a size giving about pointsPerVoxel points per voxel.
+  /// Points voxel edge (of `points` and `strands`); 0 picks, per grid, a size giving about
+  /// pointsPerVoxel points per voxel.
   float pointsVoxelSize = 0.0f;
   std::uint32_t pointsPerVoxel = 8;
   /// Density inside a particle's sphere (the fog volume's unit of mass per volume).
@@ -76,20 +82,22 @@ struct Frame {
   int number = 0;     ///< frame number, written as metadata and used in the file name
   double time = 0.0;  ///< simulation time in seconds
   std::vector<Particles> groups;
-  std::vector<Strands> strands;  ///< hair, rasterised into the fog volume
+  std::vector<Strands> strands;  ///< hair: rasterised into the fog volume, vertices as points
 };
 
 /// What writing one file did and cost.
 struct FileStats {
   std::filesystem::path path;
   std::uint64_t bytes = 0;
-  std::size_t points = 0;        ///< points in the `points` grid
-  std::uint64_t fogVoxels = 0;   ///< active voxels of `density`
-  float fogVoxelSize = 0.0f;     ///< 0 if no fog was written
-  float pointsVoxelSize = 0.0f;  ///< 0 if no points were written
-  double mass = 0.0;             ///< sum of the particles' and strands' masses (double)
-  double buildSeconds = 0.0;     ///< splatting and building the grids
-  double writeSeconds = 0.0;     ///< serialising, writing, syncing, renaming
+  std::size_t points = 0;          ///< points in the `points` grid
+  std::uint64_t fogVoxels = 0;     ///< active voxels of `density`
+  float fogVoxelSize = 0.0f;       ///< 0 if no fog was written
+  float pointsVoxelSize = 0.0f;    ///< 0 if no points were written
+  std::size_t strandVertices = 0;  ///< points in the `strands` grid
+  float strandsVoxelSize = 0.0f;   ///< 0 if no strands grid was written
+  double mass = 0.0;               ///< sum of the particles' and strands' masses (double)
+  double buildSeconds = 0.0;       ///< splatting and building the grids
+  double writeSeconds = 0.0;       ///< serialising, writing, syncing, renaming
 };
 
 /// Writes one frame to `path` (written to `path.tmp.PID` in the same folder, PID this

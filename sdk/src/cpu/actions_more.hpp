@@ -1,20 +1,24 @@
 // The CPU kernels of the force fields, absorbers, blockers and the rest of the vocabulary.
 // Those that are plain arithmetic keep the branch-free, __restrict style of kernels.hpp;
-// those that sample domains, draw random numbers or call user code run per particle.
+// most that sample domains, draw random numbers or call user code run per particle (RandomAccel
+// draws and samples in batches).
 #pragma once
 
 #include <algorithm>
 #include <cmath>
 
 #include "../field_math.hpp"
-#include "kernels.hpp"
 #include "../isa_namespace.hpp"
+#include "../sampling.hpp"
+#include "kernels.hpp"
 
 namespace flurry::detail::cpu {
 inline namespace FLURRY_ISA_NAMESPACE {  // see isa_namespace.hpp
 
 namespace {
-inline Vec3 at(const float* const* a, std::size_t i) { return Vec3(a[0][i], a[1][i], a[2][i]); }
+inline Vec3 at(const float* const* a, std::size_t i) {
+  return Vec3(a[0][i], a[1][i], a[2][i]);
+}
 inline void put(float* const* a, std::size_t i, Vec3 v) {
   a[0][i] = v.x;
   a[1][i] = v.y;
@@ -27,7 +31,9 @@ inline float falloffWeight(const Falloff& f, Vec3 p) {
   return f.power == 1.0f ? t : std::pow(t, f.power);
 }
 // The fraction of the way an exponential approach covers in dt: never more than 1.
-inline float approach(float rate, float dt) { return 1.0f - std::exp(-rate * dt); }
+inline float approach(float rate, float dt) {
+  return 1.0f - std::exp(-rate * dt);
+}
 // Softened inverse-square pull towards d: magnitude·d / (|d|² + eps)^(3/2), zero beyond maxR
 // and at the centre: there s·√s underflows to 0 for eps below ~1e-26, and 0·inf would be NaN.
 // Elsewhere a pull that overflows stays infinite, and the NaN guard kills the particle.
@@ -54,6 +60,57 @@ inline void passThrough(const BlockContext& c, const Lanes& L, std::size_t n, fl
 inline Random actionRandom(const BlockContext& c, const Lanes& L, std::size_t i) {
   return Random(c.seed, L.id[i], c.step, c.streamBase + c.action);
 }
+
+// Philox block `block` of every particle's action stream as uniforms: words 0-3 of the block
+// are uniforms 4·block .. 4·block + 3 of actionRandom(c, L, i), as Random draws them. One
+// block per particle per loop, vectorised (the 32×32→64-bit products included).
+inline void actionUniforms(const BlockContext& c, const std::uint32_t* __restrict id,
+                           std::uint32_t block, std::size_t n, float* __restrict u0,
+                           float* __restrict u1, float* __restrict u2, float* __restrict u3) {
+  const std::uint32_t k0 = std::uint32_t(c.seed), k1 = std::uint32_t(c.seed >> 32);
+  const std::uint32_t step = c.step, stream = c.streamBase + c.action;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Philox4x32::Block b = Philox4x32::generate(id[i], step, stream, block, k0, k1);
+    u0[i] = uniformFloat(b.v[0]);
+    u1[i] = uniformFloat(b.v[1]);
+    u2[i] = uniformFloat(b.v[2]);
+    u3[i] = uniformFloat(b.v[3]);
+  }
+}
+
+constexpr std::size_t kDrawBatch = 256;  // particles sampled at once (the rows live on the stack)
+
+// Samples `d` for every particle of the block from its action stream, in batches: the same
+// numbers as d.sample(actionRandom(c, L, i)) (Domain::sample is sampleBatch with a batch of
+// one). use(first, m, x, y, z) receives each batch.
+template <class Use>
+inline void sampleFromActionStreams(const Domain& d, const Lanes& L, std::size_t n,
+                                    const BlockContext& c, Use use) {
+  const int draws = drawCount(d);
+  alignas(64) float u[kMaxDomainDraws][kDrawBatch];
+  alignas(64) float out[3][kDrawBatch];
+  const float* rows[kMaxDomainDraws];
+  for (int k = 0; k < kMaxDomainDraws; ++k) rows[k] = u[k];
+  for (std::size_t first = 0; first < n; first += kDrawBatch) {
+    const std::size_t m = std::min(kDrawBatch, n - first);
+    for (int blk = 0; blk * 4 < draws; ++blk)
+      actionUniforms(c, L.id + first, std::uint32_t(blk), m, u[4 * blk], u[4 * blk + 1],
+                     u[4 * blk + 2], u[4 * blk + 3]);
+    sampleBatch(d, rows, m, out[0], out[1], out[2]);
+    use(first, m, out[0], out[1], out[2]);
+  }
+}
+
+// v += a·dt over a batch.
+inline void addScaledLoop(float* __restrict vx, float* __restrict vy, float* __restrict vz,
+                          const float* __restrict ax, const float* __restrict ay,
+                          const float* __restrict az, std::size_t n, float dt) {
+  for (std::size_t i = 0; i < n; ++i) {
+    vx[i] = vx[i] + ax[i] * dt;
+    vy[i] = vy[i] + ay[i] * dt;
+    vz[i] = vz[i] + az[i] * dt;
+  }
+}
 }  // namespace
 
 // ---- Absorbers, blockers -----------------------------------------------------------------
@@ -79,14 +136,18 @@ inline void apply(const Sink& a, const Lanes& L, std::size_t n, const BlockConte
   using M = Sink::Mode;
   if (a.mode == M::Inside || a.mode == M::Outside) {
     const bool killInside = a.mode == M::Inside ? a.killInside : !a.killInside;
-    std::visit([&](const auto& shape) {
-      sinkLoop(shape, L.p[0], L.p[1], L.p[2], c.dead, n, code, killInside);
-    }, a.region.shape());
+    std::visit(
+        [&](const auto& shape) {
+          sinkLoop(shape, L.p[0], L.p[1], L.p[2], c.dead, n, code, killInside);
+        },
+        a.region.shape());
   } else if (a.mode == M::Enter || a.mode == M::Leave) {
-    std::visit([&](const auto& shape) {
-      sinkMotionLoop(shape, L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], c.dead, n, c.dt, code,
-                     a.mode == M::Enter);
-    }, a.region.shape());
+    std::visit(
+        [&](const auto& shape) {
+          sinkMotionLoop(shape, L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], c.dead, n, c.dt,
+                         code, a.mode == M::Enter);
+        },
+        a.region.shape());
   } else {  // Hit: the coming Move crosses the plane piece
     for (std::size_t i = 0; i < n; ++i) {
       const Vec3 p = at(L.p, i), v = at(L.v, i);
@@ -103,24 +164,28 @@ inline void apply(const Sink& a, const Lanes& L, std::size_t n, const BlockConte
 }
 
 inline void apply(const SinkVelocity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  std::visit([&](const auto& shape) {
-    sinkLoop(shape, L.v[0], L.v[1], L.v[2], c.dead, n, c.action + 1, a.killInside);
-  }, a.velocity.shape());
+  std::visit(
+      [&](const auto& shape) {
+        sinkLoop(shape, L.v[0], L.v[1], L.v[2], c.dead, n, c.action + 1, a.killInside);
+      },
+      a.velocity.shape());
 }
 
 inline void apply(const Block& a, const Lanes& L, std::size_t n, const BlockContext& c) {
   // The list's first blocker starts from "visible"; the others can only hide more.
   std::uint32_t* __restrict vis = L.visible;
   if (c.action == c.firstBlocker) std::fill_n(vis, n, 1u);
-  std::visit([&](const auto& shape) {
-    const float* __restrict px = L.p[0];
-    const float* __restrict py = L.p[1];
-    const float* __restrict pz = L.p[2];
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::uint32_t in = detail::inside(shape, Vec3(px[i], py[i], pz[i])) ? 1u : 0u;
-      vis[i] &= 1u - in;
-    }
-  }, a.region.shape());
+  std::visit(
+      [&](const auto& shape) {
+        const float* __restrict px = L.p[0];
+        const float* __restrict py = L.p[1];
+        const float* __restrict pz = L.p[2];
+        for (std::size_t i = 0; i < n; ++i) {
+          const std::uint32_t in = detail::inside(shape, Vec3(px[i], py[i], pz[i])) ? 1u : 0u;
+          vis[i] &= 1u - in;
+        }
+      },
+      a.region.shape());
 }
 
 // ---- Forces ------------------------------------------------------------------------------
@@ -135,8 +200,9 @@ inline void applyWeighted(const Damping& a, const Lanes& L, std::size_t n, const
   for (std::size_t i = 0; i < n; ++i) {
     const float w = falloffWeight(a.falloff, at(L.p, i));
     const Vec3 v = at(L.v, i);
-    put(L.v, i, Vec3(v.x * std::exp(-a.rate.x * c.dt * w), v.y * std::exp(-a.rate.y * c.dt * w),
-                     v.z * std::exp(-a.rate.z * c.dt * w)));
+    put(L.v, i,
+        Vec3(v.x * std::exp(-a.rate.x * c.dt * w), v.y * std::exp(-a.rate.y * c.dt * w),
+             v.z * std::exp(-a.rate.z * c.dt * w)));
   }
 }
 
@@ -145,11 +211,28 @@ inline void apply(const RotDamping& a, const Lanes& L, std::size_t n, const Bloc
             std::exp(-a.rate.z * c.dt));
 }
 
-inline void apply(const OrbitPoint& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+// softPull's arithmetic, branch-free over __restrict lanes so that it vectorises: the pull
+// is computed everywhere and selected where it applies (0 beyond maxRadius and at the centre,
+// where softPull returns 0 untouched: the select keeps out what is computed there).
+inline void orbitPointLoop(const float* __restrict px, const float* __restrict py,
+                           const float* __restrict pz, float* __restrict vx, float* __restrict vy,
+                           float* __restrict vz, std::size_t n, Vec3 center, float magnitude,
+                           float eps, float maxR2, float dt) {
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 acc = softPull(a.center - at(L.p, i), a.magnitude, a.epsilon, a.maxRadius);
-    put(L.v, i, at(L.v, i) + acc * c.dt);
+    const float dx = center.x - px[i], dy = center.y - py[i], dz = center.z - pz[i];
+    const float r2 = dx * dx + dy * dy + dz * dz;  // glm::dot's order
+    const bool pulls = (r2 <= maxR2) & (r2 > 0.0f);
+    const float s = r2 + eps;
+    const float k = magnitude / (s * std::sqrt(s));
+    vx[i] = vx[i] + (pulls ? dx * k : 0.0f) * dt;
+    vy[i] = vy[i] + (pulls ? dy * k : 0.0f) * dt;
+    vz[i] = vz[i] + (pulls ? dz * k : 0.0f) * dt;
   }
+}
+
+inline void apply(const OrbitPoint& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  orbitPointLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, a.center, a.magnitude,
+                 a.epsilon, a.maxRadius * a.maxRadius, c.dt);
 }
 
 inline void apply(const OrbitLine& a, const Lanes& L, std::size_t n, const BlockContext& c) {
@@ -169,7 +252,8 @@ inline void apply(const Gravitate& a, const Lanes& L, std::size_t n, const Block
     Vec3 acc(0.0f);
     for (std::size_t j = 0; j < s.size; ++j) {
       if (j == self) continue;
-      acc += softPull(Vec3(s.p[0][j], s.p[1][j], s.p[2][j]) - p, a.magnitude, a.epsilon, a.maxRadius);
+      acc +=
+          softPull(Vec3(s.p[0][j], s.p[1][j], s.p[2][j]) - p, a.magnitude, a.epsilon, a.maxRadius);
     }
     put(L.v, i, at(L.v, i) + acc * c.dt);
   }
@@ -223,12 +307,22 @@ inline void apply(const Explosion& a, const Lanes& L, std::size_t n, const Block
   }
 }
 
+// The accelerations are drawn for a batch of particles at once (Philox vectorised, the
+// domain sampled by sampleBatch), the same numbers as one Random per particle.
 inline void apply(const RandomAccel& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  for (std::size_t i = 0; i < n; ++i) {
-    Random rng = actionRandom(c, L, i);
-    const float w = falloffWeight(a.falloff, at(L.p, i));
-    put(L.v, i, at(L.v, i) + a.acceleration.sample(rng) * (c.dt * w));
-  }
+  const bool weighted = a.falloff.radius < kInfinity;
+  sampleFromActionStreams(a.acceleration, L, n, c,
+                          [&](std::size_t first, std::size_t m, float* ax, float* ay, float* az) {
+                            if (weighted)  // v + a·(dt·w), as without a falloff (w = 1)
+                              for (std::size_t k = 0; k < m; ++k) {
+                                const float s = c.dt * falloffWeight(a.falloff, at(L.p, first + k));
+                                ax[k] *= s;
+                                ay[k] *= s;
+                                az[k] *= s;
+                              }
+                            addScaledLoop(L.v[0] + first, L.v[1] + first, L.v[2] + first, ax, ay,
+                                          az, m, weighted ? 1.0f : c.dt);
+                          });
 }
 inline void apply(const RandomDisplace& a, const Lanes& L, std::size_t n, const BlockContext& c) {
   for (std::size_t i = 0; i < n; ++i) {
@@ -242,7 +336,8 @@ inline void apply(const RandomVelocity& a, const Lanes& L, std::size_t n, const 
     put(L.v, i, a.velocity.sample(rng));
   }
 }
-inline void apply(const RandomRotVelocity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+inline void apply(const RandomRotVelocity& a, const Lanes& L, std::size_t n,
+                  const BlockContext& c) {
   for (std::size_t i = 0; i < n; ++i) {
     Random rng = actionRandom(c, L, i);
     put(L.rot, i, a.rotVelocity.sample(rng));
@@ -295,7 +390,8 @@ inline void apply(const SampledField& a, const Lanes& L, std::size_t n, const Bl
     const float w = falloffWeight(a.falloff, p);
     const Vec3 u = sampleTrilinear(f, p) * a.strength;
     const Vec3 v = at(L.v, i);
-    put(L.v, i, a.mode == SampledField::Mode::Acceleration ? v + u * (c.dt * w) : v + (u - v) * (k * w));
+    put(L.v, i,
+        a.mode == SampledField::Mode::Acceleration ? v + u * (c.dt * w) : v + (u - v) * (k * w));
   }
 }
 
@@ -309,8 +405,9 @@ inline void apply(const Avoid& a, const Lanes& L, std::size_t n, const BlockCont
       const Vec3 nrm = a.obstacle.normal(p);
       const Vec3 o = a.obstacle.closestPoint(p);
       const float d0 = glm::dot(p - o, nrm), d1 = glm::dot(ahead - o, nrm);
-      threat = (d0 >= 0.0f) != (d1 >= 0.0f) &&
-               a.obstacle.distance(p + (ahead - p) * (d0 / (d0 - d1))) < 1e-4f * (1.0f + glm::length(p));
+      threat =
+          (d0 >= 0.0f) != (d1 >= 0.0f) &&
+          a.obstacle.distance(p + (ahead - p) * (d0 / (d0 - d1))) < 1e-4f * (1.0f + glm::length(p));
     } else {
       threat = !a.obstacle.contains(p) && a.obstacle.contains(ahead);
     }
@@ -370,7 +467,8 @@ inline void apply(const TargetVelocity& a, const Lanes& L, std::size_t n, const 
   const float k = approach(a.rate, c.dt);
   for (int d = 0; d < 3; ++d) approachLoop(L.v[d], n, a.velocity[d], k);
 }
-inline void apply(const TargetRotVelocity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+inline void apply(const TargetRotVelocity& a, const Lanes& L, std::size_t n,
+                  const BlockContext& c) {
   const float k = approach(a.rate, c.dt);
   for (int d = 0; d < 3; ++d) approachLoop(L.rot[d], n, a.rotVelocity[d], k);
 }
@@ -387,8 +485,10 @@ inline void apply(const SpeedClamp& a, const Lanes& L, std::size_t n, const Bloc
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3 v = at(L.v, i);
     const float s = glm::length(v);
-    if (s > a.maxSpeed) put(L.v, i, v * (a.maxSpeed / s));
-    else if (s < a.minSpeed && s > 0.0f) put(L.v, i, v * (a.minSpeed / s));
+    if (s > a.maxSpeed)
+      put(L.v, i, v * (a.maxSpeed / s));
+    else if (s < a.minSpeed && s > 0.0f)
+      put(L.v, i, v * (a.minSpeed / s));
   }
 }
 

@@ -1,3 +1,4 @@
+#include <chrono>
 #include <utility>
 #include <vector>
 
@@ -72,9 +73,20 @@ class CpuBackend final : public BackendImpl {
  public:
   const char* name() const override { return "cpu"; }
   void step(GroupImpl& group, const StepParams& params) override {
+    // Each part's time, for GroupStats::stepSeconds.
+    using Clock = std::chrono::steady_clock;
+    auto last = Clock::now();
+    auto lap = [&](double& total) {
+      const auto now = Clock::now();
+      total += std::chrono::duration<double>(now - last).count();
+      last = now;
+    };
     emitNewborns(group, params);
+    lap(group.stats.stepSeconds.emit);
     actFused(group, params);
+    lap(group.stats.stepSeconds.act);
     compact(group, params);
+    lap(group.stats.stepSeconds.compact);
     if (group.hair.enabled) simulateHair(group, params);
   }
 };

@@ -133,6 +133,31 @@ void runActions(const std::vector<Action>& acts, const Plan& plan, std::size_t f
   }
 }
 
+// The actions most effects run, over newborns each with its own step length h[i]: vectorised
+// like the block's loops. False for the others (they run per particle).
+bool runWithOwnSteps(const Action& act, bool eulerMove, const Lanes& L, std::size_t n,
+                     const float* h) {
+  if (const auto* a = std::get_if<Gravity>(&act)) {
+    if (a->falloff.radius < kInfinity) return false;
+    cpu::addScaledLoop(L.v[0], L.v[1], L.v[2], h, n, a->acceleration.x, a->acceleration.y,
+                       a->acceleration.z);
+    return true;
+  }
+  if (std::holds_alternative<Move>(act)) {
+    if (!eulerMove || (L.up[0] && L.rot[0])) return false;
+    if (L.prev[0]) cpu::copyLoop(L.prev[0], L.prev[1], L.prev[2], L.p[0], L.p[1], L.p[2], n);
+    cpu::moveLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, cpu::OwnDt{h});
+    if (L.age) cpu::ageLoop(L.age, n, cpu::OwnDt{h});
+    return true;
+  }
+  if (const auto* a = std::get_if<Bounce>(&act))
+    return cpu::withPlanarPiece(*a, [&](Vec3 P, Vec3 N, auto onPiece) {
+      cpu::bouncePlanarLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, cpu::OwnDt{h}, P, N,
+                            onPiece, *a);
+    });
+  return false;
+}
+
 // Actions [first, last) of the list over a block's newborns, [0, count) of `lanes`: each
 // lives only what is left of the step after its birth (remaining[i]), so what depends on
 // the step's length or time runs per particle with its own, the rest over all at once.
@@ -141,14 +166,24 @@ void runNewborns(const std::vector<Action>& acts, const Plan& plan, std::size_t 
                  std::size_t last, const Lanes& lanes, std::size_t count,
                  const cpu::BlockContext& ctx, const float* remaining, std::uint32_t sub,
                  double t1) {
+  // Each newborn's sub-step length.
+  thread_local std::vector<float> ownStore;
+  std::vector<float>& own = ownStore;
+  if (own.size() < count) own.resize(std::max<std::size_t>(count, 1024));
+  for (std::size_t i = 0; i < count; ++i)
+    own[i] = float(double(remaining[i]) / double(plan.substeps));
+  const bool euler = plan.list.integrator == Integrator::SemiImplicitEuler;
   for (std::size_t k = first; k < last; ++k) {
+    if (plan.list.gathered[k]) continue;  // evaluated inside its Move
     if (plan.list.timeFree[k]) {
       runActions(acts, plan, k, k + 1, lanes, count, ctx);
       continue;
     }
+    if (!plan.list.curvedBy[k] && runWithOwnSteps(acts[k], euler, lanes, count, own.data()))
+      continue;
     for (std::size_t i = 0; i < count; ++i) {
       cpu::BlockContext c = ctx;
-      c.dt = float(double(remaining[i]) / double(plan.substeps));
+      c.dt = own[i];
       c.time = (t1 - double(remaining[i])) + double(sub) * double(c.dt);
       c.base += i;
       c.dead += i;

@@ -264,7 +264,7 @@ inline void integrate(Integrator integrator, const std::vector<Action>& acts,
     case Integrator::SemiImplicitEuler:
       break;  // not used: the forces ran as their own updates
   }
-  if (L.age) ageLoop(L.age, n, dt);
+  if (L.age) ageLoop(L.age, n, UniformDt{dt});
 }
 
 }  // namespace FLURRY_ISA_NAMESPACE

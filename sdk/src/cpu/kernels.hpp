@@ -42,6 +42,27 @@ struct BlockContext {
 // The loops take their arrays as __restrict parameters: GCC 12 vectorises these, but not
 // the same loops over __restrict locals loaded from a struct.
 
+/// The step length of a loop: the same for every particle (a block's sub-step), or each
+/// particle's own (newborns, which live only what is left of their birth step).
+struct UniformDt {
+  float h;
+  float operator[](std::size_t) const { return h; }
+};
+struct OwnDt {
+  const float* h;
+  float operator[](std::size_t i) const { return h[i]; }
+};
+
+/// v += a·dt with each particle's own dt.
+inline void addScaledLoop(float* __restrict x, float* __restrict y, float* __restrict z,
+                          const float* __restrict h, std::size_t n, float ax, float ay, float az) {
+  for (std::size_t i = 0; i < n; ++i) {
+    x[i] += ax * h[i];
+    y[i] += ay * h[i];
+    z[i] += az * h[i];
+  }
+}
+
 inline void addLoop(float* __restrict x, float* __restrict y, float* __restrict z, std::size_t n,
                     float ax, float ay, float az) {
   for (std::size_t i = 0; i < n; ++i) {
@@ -70,18 +91,20 @@ inline void copyLoop(float* __restrict qx, float* __restrict qy, float* __restri
   }
 }
 
+template <class Dt>
 inline void moveLoop(float* __restrict px, float* __restrict py, float* __restrict pz,
                      const float* __restrict vx, const float* __restrict vy,
-                     const float* __restrict vz, std::size_t n, float dt) {
+                     const float* __restrict vz, std::size_t n, Dt dt) {
   for (std::size_t i = 0; i < n; ++i) {
-    px[i] += vx[i] * dt;
-    py[i] += vy[i] * dt;
-    pz[i] += vz[i] * dt;
+    px[i] += vx[i] * dt[i];
+    py[i] += vy[i] * dt[i];
+    pz[i] += vz[i] * dt[i];
   }
 }
 
-inline void ageLoop(float* __restrict age, std::size_t n, float dt) {
-  for (std::size_t i = 0; i < n; ++i) age[i] += dt;
+template <class Dt>
+inline void ageLoop(float* __restrict age, std::size_t n, Dt dt) {
+  for (std::size_t i = 0; i < n; ++i) age[i] += dt[i];
 }
 
 inline void killOldLoop(const float* __restrict age, const float* __restrict life,
@@ -132,8 +155,8 @@ inline void apply(const Damping& a, const Lanes& L, std::size_t n, const BlockCo
 
 inline void apply(const Move&, const Lanes& L, std::size_t n, const BlockContext& c) {
   if (L.prev[0]) copyLoop(L.prev[0], L.prev[1], L.prev[2], L.p[0], L.p[1], L.p[2], n);
-  moveLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, c.dt);
-  if (L.age) ageLoop(L.age, n, c.dt);
+  moveLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, UniformDt{c.dt});
+  if (L.age) ageLoop(L.age, n, UniformDt{c.dt});
   if (L.up[0] && L.rot[0]) {
     // The up vector turns with the angular velocity: exactly, about ω by |ω|·dt.
     for (std::size_t i = 0; i < n; ++i) {
@@ -176,66 +199,88 @@ struct Reflect {
   }
 };
 
-/// A two-sided planar deflector (plane, rectangle, disc, triangle): `onPiece` says whether a
-/// point of the plane belongs to the piece.
-template <class OnPiece>
-inline void bouncePlanarLoop(float* __restrict px, float* __restrict py, float* __restrict pz,
-                             float* __restrict vxs, float* __restrict vys, float* __restrict vzs,
-                             std::size_t n, float dt, Vec3 P, Vec3 N, OnPiece onPiece,
-                             const Bounce& b) {
-  const Reflect reflect{b.restitution, 1.0f - b.friction, b.cutoff * b.cutoff};
-  for (std::size_t i = 0; i < n; ++i) {
-    const float x = px[i], y = py[i], z = pz[i];
-    const float vx = vxs[i], vy = vys[i], vz = vzs[i];
-    const float d0 = (x - P.x) * N.x + (y - P.y) * N.y + (z - P.z) * N.z;
-    const float vn = vx * N.x + vy * N.y + vz * N.z;
-    const float d1 = d0 + vn * dt;
-    const float side = d0 >= 0.0f ? 1.0f : -1.0f;
+/// Where a particle is against a plane (point P, unit normal N) over a step of dt: its
+/// distances at the start and end of the straight path, and how close to the plane its end
+/// counts as arriving on it.
+struct PlanarPath {
+  float d0, vn, d1, side, reach;
+  PlanarPath(float x, float y, float z, float vx, float vy, float vz, float dt, Vec3 P, Vec3 N) {
+    d0 = (x - P.x) * N.x + (y - P.y) * N.y + (z - P.z) * N.z;
+    vn = vx * N.x + vy * N.y + vz * N.z;
+    d1 = d0 + vn * dt;
+    side = d0 >= 0.0f ? 1.0f : -1.0f;
     // Ending within a few ulps of the plane counts as arriving on it (Move's p + v·dt may
     // round onto the plane where d1 does not): bounced at the end of the step and pushed
     // out, so that no particle comes to rest on a piece by moving.
-    const float reach =
-        1.2e-7f * (std::abs(N.x) * (std::abs(x) + std::abs(P.x) + 2.0f * std::abs(vx * dt)) +
-                   std::abs(N.y) * (std::abs(y) + std::abs(P.y) + 2.0f * std::abs(vy * dt)) +
-                   std::abs(N.z) * (std::abs(z) + std::abs(P.z) + 2.0f * std::abs(vz * dt))) +
-        1e-30f;
-    // Computed for every particle and kept only on a hit (one if-block: GCC 12 vectorises
-    // that, but not several selects on the same condition). Lanes that miss may hold inf.
-    const float tau = std::min(d0 / (d0 - d1), 1.0f) * dt;
-    const float hx = x + vx * tau, hy = y + vy * tau, hz = z + vz * tau;
-    // A crossing or an arrival, approaching the plane. A particle born or placed exactly on
-    // the plane (d0 = 0) belongs to neither side and leaves it freely, whichever way the
-    // piece's normal points: an emitter on a floor emits through it.
-    const bool hit = (side * d1 <= reach) & (side * vn < 0.0f) & (d0 != 0.0f) & onPiece(hx, hy, hz);
-    float nx = x, ny = y, nz = z, nvx = vx, nvy = vy, nvz = vz;
-    reflect(nx, ny, nz, nvx, nvy, nvz, hx, hy, hz, N.x, N.y, N.z, tau);
-    // Where Move will put it; push it out if rounding left it on or behind the plane.
-    const float qx = nx + nvx * dt, qy = ny + nvy * dt, qz = nz + nvz * dt;
-    const float qd = side * ((qx - P.x) * N.x + (qy - P.y) * N.y + (qz - P.z) * N.z);
-    // A few ulps of what decides the side: the coordinates along the normal, and the step
-    // Move adds to them (p + v·dt loses bits to cancellation when |v·dt| is large). Far from
-    // the origin along the plane this stays small, so bounces do not gain height.
-    const float margin =
-        1.2e-7f * (std::abs(N.x) * (std::abs(qx) + std::abs(P.x) + std::abs(nvx * dt)) +
-                   std::abs(N.y) * (std::abs(qy) + std::abs(P.y) + std::abs(nvy * dt)) +
-                   std::abs(N.z) * (std::abs(qz) + std::abs(P.z) + std::abs(nvz * dt))) +
-        1e-30f;
-    const float push = std::max(margin - qd, 0.0f) * side;
-    float ox = x, oy = y, oz = z, ovx = vx, ovy = vy, ovz = vz;
-    if (hit) {
-      ox = nx + push * N.x;
-      oy = ny + push * N.y;
-      oz = nz + push * N.z;
-      ovx = nvx;
-      ovy = nvy;
-      ovz = nvz;
+    reach = 1.2e-7f * (std::abs(N.x) * (std::abs(x) + std::abs(P.x) + 2.0f * std::abs(vx * dt)) +
+                       std::abs(N.y) * (std::abs(y) + std::abs(P.y) + 2.0f * std::abs(vy * dt)) +
+                       std::abs(N.z) * (std::abs(z) + std::abs(P.z) + 2.0f * std::abs(vz * dt))) +
+            1e-30f;
+  }
+  /// Approaching the plane and reaching it within the step: a hit where the piece is.
+  bool reaches() const { return (side * d1 <= reach) & (side * vn < 0.0f); }
+};
+
+/// A two-sided planar deflector (plane, rectangle, disc, triangle): `onPiece` says whether a
+/// point of the plane belongs to the piece. Most particles are far from it: runs of 16 none
+/// of which reaches the plane are skipped after one vectorised test.
+template <class Dt, class OnPiece>
+inline void bouncePlanarLoop(float* __restrict px, float* __restrict py, float* __restrict pz,
+                             float* __restrict vxs, float* __restrict vys, float* __restrict vzs,
+                             std::size_t n, Dt dts, Vec3 P, Vec3 N, OnPiece onPiece,
+                             const Bounce& b) {
+  constexpr std::size_t kRun = 16;
+  const Reflect reflect{b.restitution, 1.0f - b.friction, b.cutoff * b.cutoff};
+  for (std::size_t i0 = 0; i0 < n; i0 += kRun) {
+    const std::size_t end = std::min(n, i0 + kRun);
+    std::uint32_t any = 0;
+    for (std::size_t i = i0; i < end; ++i)
+      any |= PlanarPath(px[i], py[i], pz[i], vxs[i], vys[i], vzs[i], dts[i], P, N).reaches();
+    if (any == 0u) continue;
+    for (std::size_t i = i0; i < end; ++i) {
+      const float dt = dts[i];
+      const float x = px[i], y = py[i], z = pz[i];
+      const float vx = vxs[i], vy = vys[i], vz = vzs[i];
+      const PlanarPath path(x, y, z, vx, vy, vz, dt, P, N);
+      const float d0 = path.d0, d1 = path.d1, side = path.side;
+      // Computed for every particle and kept only on a hit (one if-block: GCC 12 vectorises
+      // that, but not several selects on the same condition). Lanes that miss may hold inf.
+      const float tau = std::min(d0 / (d0 - d1), 1.0f) * dt;
+      const float hx = x + vx * tau, hy = y + vy * tau, hz = z + vz * tau;
+      // A crossing or an arrival, approaching the plane. A particle born or placed exactly on
+      // the plane (d0 = 0) belongs to neither side and leaves it freely, whichever way the
+      // piece's normal points: an emitter on a floor emits through it.
+      const bool hit = path.reaches() & (d0 != 0.0f) & onPiece(hx, hy, hz);
+      float nx = x, ny = y, nz = z, nvx = vx, nvy = vy, nvz = vz;
+      reflect(nx, ny, nz, nvx, nvy, nvz, hx, hy, hz, N.x, N.y, N.z, tau);
+      // Where Move will put it; push it out if rounding left it on or behind the plane.
+      const float qx = nx + nvx * dt, qy = ny + nvy * dt, qz = nz + nvz * dt;
+      const float qd = side * ((qx - P.x) * N.x + (qy - P.y) * N.y + (qz - P.z) * N.z);
+      // A few ulps of what decides the side: the coordinates along the normal, and the step
+      // Move adds to them (p + v·dt loses bits to cancellation when |v·dt| is large). Far from
+      // the origin along the plane this stays small, so bounces do not gain height.
+      const float margin =
+          1.2e-7f * (std::abs(N.x) * (std::abs(qx) + std::abs(P.x) + std::abs(nvx * dt)) +
+                     std::abs(N.y) * (std::abs(qy) + std::abs(P.y) + std::abs(nvy * dt)) +
+                     std::abs(N.z) * (std::abs(qz) + std::abs(P.z) + std::abs(nvz * dt))) +
+          1e-30f;
+      const float push = std::max(margin - qd, 0.0f) * side;
+      float ox = x, oy = y, oz = z, ovx = vx, ovy = vy, ovz = vz;
+      if (hit) {
+        ox = nx + push * N.x;
+        oy = ny + push * N.y;
+        oz = nz + push * N.z;
+        ovx = nvx;
+        ovy = nvy;
+        ovz = nvz;
+      }
+      px[i] = ox;
+      py[i] = oy;
+      pz[i] = oz;
+      vxs[i] = ovx;
+      vys[i] = ovy;
+      vzs[i] = ovz;
     }
-    px[i] = ox;
-    py[i] = oy;
-    pz[i] = oz;
-    vxs[i] = ovx;
-    vys[i] = ovy;
-    vzs[i] = ovz;
   }
 }
 
@@ -574,7 +619,8 @@ inline bool isPlanarBounce(const Bounce& a) {
 
 inline void apply(const Bounce& a, const Lanes& L, std::size_t n, const BlockContext& c) {
   const bool planar = withPlanarPiece(a, [&](Vec3 P, Vec3 N, auto onPiece) {
-    bouncePlanarLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, c.dt, P, N, onPiece, a);
+    bouncePlanarLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, UniformDt{c.dt}, P, N,
+                     onPiece, a);
   });
   if (planar) return;
   const auto& shape = a.surface.shape();

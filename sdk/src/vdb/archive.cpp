@@ -63,6 +63,13 @@ std::string encode(const Frame& frame, const ExportOptions& o, FileStats& st) {
     for (const Particles& g : frame.groups) st.points += g.size();
     grids.push_back(points);
   }
+  std::size_t vertices = 0;
+  for (const Strands& s : frame.strands) vertices += s.vertexCount();
+  if (o.points && vertices > 0) {
+    st.strandsVoxelSize = o.pointsVoxelSize;
+    grids.push_back(buildStrandPoints(frame, o, st.strandsVoxelSize));
+    st.strandVertices = vertices;
+  }
   meta.insertMeta("creator", openvdb::StringMetadata(std::string("Flurry ") + versionString()));
   meta.insertMeta("flurry:frame", openvdb::Int32Metadata(frame.number));
   meta.insertMeta("flurry:time", openvdb::DoubleMetadata(frame.time));

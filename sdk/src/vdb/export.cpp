@@ -139,8 +139,12 @@ Particles Particles::capture(const Group& group, const ExportOptions& o) {
 
 float fogVoxelSize(const Frame& frame, const ExportOptions& o) {
   if (o.fogVoxelSize > 0.0f) return o.fogVoxelSize;
-  // Half the median radius; a strided sample of at most ~64k radii is plenty for a median.
-  std::vector<float> radii;
+  // The median of what each sample asks for; a strided sample of at most ~64k is plenty.
+  // A particle asks for half its radius (four voxels across). A strand vertex asks for no
+  // less than half its segment: finer voxels add nothing along a polyline, and a strand
+  // thinner than a voxel still deposits its whole tube volume (the kernel spreads it), so
+  // thin hair is not resolved across at the cost of millions of voxels.
+  std::vector<float> wanted;
   std::size_t total = 0;
   for (const Particles& g : frame.groups) total += g.size();
   for (const Strands& s : frame.strands) total += s.vertexCount();
@@ -148,15 +152,26 @@ float fogVoxelSize(const Frame& frame, const ExportOptions& o) {
   std::size_t k = 0;
   for (const Particles& g : frame.groups)
     for (std::size_t i = 0; i < g.size(); ++i, ++k)
-      if (k % stride == 0) radii.push_back(g.radius.empty() ? o.defaultRadius : g.radius[i]);
+      if (k % stride == 0)
+        wanted.push_back(0.5f * (g.radius.empty() ? o.defaultRadius : g.radius[i]));
   for (const Strands& s : frame.strands)
-    for (std::size_t i = 0; i < s.vertexCount(); ++i, ++k)
-      if (k % stride == 0) radii.push_back(s.radius.empty() ? o.defaultRadius : s.radius[i]);
-  std::erase_if(radii, [](float r) { return !(r > 0.0f) || !std::isfinite(r); });
-  if (radii.empty()) return o.defaultRadius > 0.0f ? 0.5f * o.defaultRadius : 0.025f;
-  auto mid = radii.begin() + std::ptrdiff_t(radii.size() / 2);
-  std::nth_element(radii.begin(), mid, radii.end());
-  return 0.5f * *mid;
+    for (std::size_t j = 0; j + 1 < s.start.size(); ++j) {
+      const std::uint32_t a = s.start[j],
+                          b = std::min<std::size_t>(s.start[j + 1], s.vertexCount());
+      for (std::uint32_t i = a; i < b; ++i, ++k) {
+        if (k % stride != 0) continue;
+        const float r = s.radius.size() > i ? s.radius[i] : o.defaultRadius;
+        // The segment that starts here, or for the last vertex the one that ends here.
+        const std::uint32_t n = i + 1 < b ? i + 1 : (i > a ? i - 1 : i);
+        const float seg = glm::length(s.position[n] - s.position[i]);
+        wanted.push_back(0.5f * std::max(r, std::isfinite(seg) ? seg : 0.0f));
+      }
+    }
+  std::erase_if(wanted, [](float w) { return !(w > 0.0f) || !std::isfinite(w); });
+  if (wanted.empty()) return o.defaultRadius > 0.0f ? 0.5f * o.defaultRadius : 0.025f;
+  auto mid = wanted.begin() + std::ptrdiff_t(wanted.size() / 2);
+  std::nth_element(wanted.begin(), mid, wanted.end());
+  return *mid;
 }
 
 namespace {

@@ -23,4 +23,10 @@ FogGrids buildFog(const Frame& frame, const ExportOptions& options, float voxelS
 openvdb::points::PointDataGrid::Ptr buildPoints(const Frame& frame, const ExportOptions& options,
                                                 float& voxelSize);
 
+/// The `strands` PointDataGrid: every strand vertex of the frame, with the strand it is on
+/// (`strand_id`) and its place along it (`strand_vertex`); `voxelSize` 0 picks one.
+openvdb::points::PointDataGrid::Ptr buildStrandPoints(const Frame& frame,
+                                                      const ExportOptions& options,
+                                                      float& voxelSize);
+
 }  // namespace flurry::vdb::detail
