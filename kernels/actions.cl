@@ -43,7 +43,7 @@ FL_INLINE fl_real fl_real_from_words(uint lo, uint hi) {
 }
 
 /* Restore (actions_more.hpp apply(Restore)): steer to PositionB so as to arrive on time.
- * u[0..1]: start, u[2..3]: start + duration, as doubles. */
+ * u[0..1]: start, u[2..3]: start + duration, as doubles. dt: the particle's sub-step. */
 FL_INLINE void fl_restore(__global const FlActionParams* a, float dt, fl_real time, float* px,
                           float* py, float* pz, float* vx, float* vy, float* vz, float hx,
                           float hy, float hz) {
@@ -51,10 +51,13 @@ FL_INLINE void fl_restore(__global const FlActionParams* a, float dt, fl_real ti
   if (time + (fl_real)1e-9 < start) return;
   const float left = (float)(fl_real_from_words(a->u[2], a->u[3]) - time);
   const float dx = hx - *px, dy = hy - *py, dz = hz - *pz;
-  const float by = left > dt ? left : dt;
-  *vx = dx / by;
-  *vy = dy / by;
-  *vz = dz / by;
+  /* A newborn born at the step's very end has h = 0: its velocity is left as it is. */
+  if (dt > 0.0f) {
+    const float by = left > dt ? left : dt;
+    *vx = dx / by;
+    *vy = dy / by;
+    *vz = dz / by;
+  }
   if (left <= 0.0f) {
     *px = hx;
     *py = hy;

@@ -1,17 +1,28 @@
-/* Deaths and births on the device, without the host waiting for anything.
+/* Deaths on the device, without the host waiting for anything.
  *
- * The act kernel leaves a kill code per particle (0: alive). Then, as on the CPU, newborns
- * take the dead's slots and only the holes no newborn fills are closed from the tail, so a
- * steady effect moves almost nothing. Which hole a newborn or a tail particle takes comes
+ * fl_birth (tail.cl) wrote the step's newborns behind the live particles and the act kernel
+ * left a kill code per particle, newborns included (0: alive). As on the CPU, the holes
+ * below the new size are then closed from the tail. Which hole a tail particle takes comes
  * from a prefix sum over tiles of FL_TILE particles:
  *   fl_count  per tile: its dead                      (one work item per tile)
  *   fl_scan   prefix over the tiles, the step's counts (one work item)
  *   fl_list   per tile: hole list (holes below the new size, ascending) and tail list
  *             (survivors at or above the new size, ascending); kills tallied per action
- *   fl_tail   (emit.cl) moves tail[j] into holes[born + j] and writes the newborns
+ *   fl_tail   (tail.cl) moves tail[low - 1 - j] into holes[j]
  * Small groups (up to kSmallTiles tiles) run fl_scan_list: those three in one launch.
- * n is the live count the device holds; the host only knows an upper bound (nBound), so
- * every kernel reads n from the state and ignores particles past it. */
+ * The state's size is the live count at the start of the step until fl_scan writes the new
+ * one; the host only knows an upper bound (nBound), so every kernel reads the count from
+ * the state (fl_step_range) and ignores particles past it. */
+
+/* The particles a step acts on: the live ones (n0, the state's size at the start of the
+ * step) and the newborns that fit behind them. Every kernel of the step before fl_scan
+ * computes it so (fl_scan then writes the state). */
+FL_INLINE uint fl_step_range(__global const uint* state, uint births, uint capacity) {
+  const uint n0 = state[FL_STATE_SIZE];
+  const uint room = capacity - n0;
+  return n0 + (births < room ? births : room);
+}
+
 
 /* Nonzero bytes of a word (no carries between bytes). */
 FL_INLINE uint fl_nonzero_bytes(uint w) {
@@ -35,9 +46,9 @@ FL_INLINE uint fl_count_range(__global const uchar* codes, uint begin, uint end)
 }
 
 __kernel void fl_count(__global const uchar* codes, __global uint* tileDead,
-                       __global const uint* state) {
+                       __global const uint* state, uint births, uint capacity) {
   const uint t = get_global_id(0);
-  const uint n = state[FL_STATE_SIZE];
+  const uint n = fl_step_range(state, births, capacity);
   const uint begin = t * FL_TILE;
   const uint end = min(n, begin + FL_TILE);
   tileDead[t] = begin < end ? fl_count_range(codes, begin, end) : 0u;
@@ -47,16 +58,14 @@ __kernel void fl_count(__global const uchar* codes, __global uint* tileDead,
 FL_INLINE void fl_scan_body(__global const uchar* codes, __global const uint* tileDead,
                             __global uint* tileOff, __global uint* state, uint tiles,
                             uint births, uint capacity) {
-  const uint n = state[FL_STATE_SIZE];
+  const uint n0 = state[FL_STATE_SIZE];
+  const uint n = fl_step_range(state, births, capacity), born = n - n0;
   uint dead = 0;
   for (uint t = 0; t < tiles; ++t) {
     tileOff[t] = dead;
     dead += tileDead[t];
   }
-  const uint live = n - dead;
-  const uint room = capacity - live;
-  const uint born = births < room ? births : room;
-  const uint m = live + born;
+  const uint m = n - dead;
   uint low = dead;
   if (m < n) { /* holes below m: those of the tiles before m's, and of its part before m */
     const uint t = m / FL_TILE;
@@ -121,7 +130,7 @@ FL_INLINE void fl_scan_list_body(__global const uchar* codes, __global uint* til
                                  __global uint* tileOff, __global uint* holes,
                                  __global uint* tail, __global uint* state, uint births,
                                  uint capacity, uint tiles) {
-  const uint n = state[FL_STATE_SIZE];
+  const uint n = fl_step_range(state, births, capacity);
   for (uint t = 0; t < tiles; ++t) {
     const uint begin = t * FL_TILE, end = min(n, begin + FL_TILE);
     tileDead[t] = begin < end ? fl_count_range(codes, begin, end) : 0u;
@@ -137,13 +146,14 @@ __kernel void fl_scan_list(__global const uchar* codes, __global uint* tileDead,
 }
 
 /* The fastest particle's |v|^2 into the state, for sub-steps by distance (fused_pass.cpp
- * makePlan). Non-negative floats order as their bits; NaN is left out, as std::max does. */
+ * makePlan), newborns included. Non-negative floats order as their bits; NaN is left out, as std::max does. */
 __kernel void fl_max_speed(__global const float* restrict vx, __global const float* restrict vy,
-                           __global const float* restrict vz, __global uint* state) {
+                           __global const float* restrict vz, __global uint* state,
+                           uint births, uint capacity) {
   __local uint best[64];
   const uint i = get_global_id(0), l = get_local_id(0);
   float m = 0.0f;
-  const uint n = state[FL_STATE_SIZE];
+  const uint n = fl_step_range(state, births, capacity);
   for (uint j = i; j < n; j += get_global_size(0)) {
     const float v2 = vx[j] * vx[j] + vy[j] * vy[j] + vz[j] * vz[j];
     m = v2 > m ? v2 : m;

@@ -1,5 +1,5 @@
-/* The tail of a step: close the holes no newborn fills, then write the newborns
- * (sdk/src/emission.cpp, draw for draw). Needs, from the generated prologue:
+/* A step's newborns (sdk/src/emission.cpp, draw for draw), written before the act kernel
+ * where they were born (tail.cl fl_birth). Needs, from the generated prologue:
  *   FL_LANE_PARAMS / FL_LANE_ARGS  the stored lanes as parameters (l_px, l_vx, ...) / names
  *   FL_COPY_LANES(dst, src)        copies every stored lane's element
  *   FL_HAS_<ATTRIBUTE>             for each stored attribute
@@ -57,7 +57,7 @@ FL_INLINE uint fl_choose_type(__global const FlEmitter* em, __global const FlPar
 /* One newborn of type `type`: the draws in emission.cpp's order, skipping what is not
  * stored. The kinds and modes are literals; normalMode is 0 without Emitter::normalSpeed,
  * else 1 + its fuzzy mode. */
-FL_INLINE void fl_newborn(FL_LANE_PARAMS, uint slot, uint id, float age, float3 at, int oneType,
+FL_INLINE void fl_newborn(FL_LANE_PARAMS, uint slot, uint id, float3 at,
                           __global const FlEmitter* em, __global const FlParticleType* type,
                           FlRandom* rng, __global const float* shapes, uint shapeKind,
                           uint velKind, uint colorKind, uint upKind, uint rotKind,
@@ -70,9 +70,8 @@ FL_INLINE void fl_newborn(FL_LANE_PARAMS, uint slot, uint id, float age, float3 
     const float speed = fl_fuzzy(&em->normalSpeed, normalMode - 1, rng);
     vel = vel + fl_normal_at(&em->shape, shapeKind, shape, shapes) * speed;
   }
-  /* Born where the emitter was at its birth time, carried on for the rest of the step. The
-   * CPU adds these in a different order for one type (emitBatch) and several (emitOneByOne). */
-  const float3 pos = oneType ? shape + (at + vel * age) : shape + at + vel * age;
+  /* Born where the emitter was at its birth time; the act kernel moves it on from there. */
+  const float3 pos = shape + at;
   l_px[slot] = pos.x;
   l_py[slot] = pos.y;
   l_pz[slot] = pos.z;
@@ -138,7 +137,7 @@ FL_INLINE void fl_newborn(FL_LANE_PARAMS, uint slot, uint id, float age, float3 
   }
 #endif
 #ifdef FL_HAS_AGE
-  l_age[slot] = age;
+  l_age[slot] = 0.0f;
 #endif
   l_id[slot] = id;
 #ifdef FL_HAS_VISIBLE

@@ -2,11 +2,15 @@
 // is a handful of kernel launches that the host never waits for (PoCL: 5-6 us per launch
 // queued back to back, 44-87 us if the host waits every step).
 //
-//   fl_act       the action list as one generated, fused kernel; leaves a kill code each
+//   fl_birth     writes the newborns behind the live particles, where they were born, with
+//                the part of the step each still has to live (issue #11)
+//   fl_act       the action list as one generated, fused kernel, over the live particles and
+//                the newborns (each for its own time); leaves a kill code each
 //   fl_count     dead per tile                \  only when the list can kill;
 //   fl_scan      prefix over tiles, counts     > one launch (fl_scan_list) for groups of
-//   fl_list      hole and tail lists           /  one tile
-//   fl_tail      closes holes from the tail, writes the newborns
+//   fl_list      hole and tail lists           /  a few tiles
+//   fl_tail      closes holes from the tail
+// A small group's step is one launch: fl_small does all of it in one work-group.
 //
 // The host does not know the live count while steps are in flight: every kernel reads it
 // from the device's state buffer, and the host sizes launches by an upper bound (the last
@@ -176,6 +180,7 @@ class ClGroup final : public DeviceMirror {
   AttributeSet laneSet_;
   bool allocated_ = false;
   Mem codes_, tileDead_, tileOff_, holes_, tailList_;
+  Mem tau_;  // per newborn of the step: the part of the step it still has to live
   GrowBuffer state_, params_, extra_, snap_, tables_;
   std::size_t tiles_ = 0;
 
@@ -189,7 +194,7 @@ class ClGroup final : public DeviceMirror {
   std::uint32_t lastHairAlive_ = 0;
   std::vector<LaneRef> actLanes_;
   bool neighbours_ = false, substepsByDistance_ = false;
-  Kernel act_, count_, scan_, list_, scanList_, tailKernel_, maxSpeed_;
+  Kernel act_, count_, scan_, list_, scanList_, tailKernel_, maxSpeed_, birth_;
   std::vector<cl::FlActionParams> params_host_, params_uploaded_;
   std::vector<float> extra_host_, extra_uploaded_;
 
@@ -242,6 +247,7 @@ void ClGroup::allocate(GroupImpl& g) {
     tileOff_ = make(tiles_ * 4);
     holes_ = make(g.capacity * 4);
     tailList_ = make(g.capacity * 4);
+    tau_ = make(g.capacity * 4);
   }
   lanes_ = std::move(lanes);
   laneSet_ = g.stored;
@@ -262,7 +268,7 @@ void ClGroup::buildProgram(GroupImpl& g) {
   };
   Kernel act = kernel("fl_act"), count = kernel("fl_count"), scan = kernel("fl_scan"),
          list = kernel("fl_list"), scanList = kernel("fl_scan_list"), tail = kernel("fl_tail"),
-         maxSpeed = kernel("fl_max_speed");
+         maxSpeed = kernel("fl_max_speed"), birth = kernel("fl_birth");
   Kernel hair = g.hair.enabled ? kernel("fl_hair") : Kernel();
   Kernel small = gen.small ? kernel("fl_small") : Kernel();
   program_ = std::move(p);
@@ -273,6 +279,7 @@ void ClGroup::buildProgram(GroupImpl& g) {
   scanList_ = std::move(scanList);
   tailKernel_ = std::move(tail);
   maxSpeed_ = std::move(maxSpeed);
+  birth_ = std::move(birth);
   hair_ = std::move(hair);
   small_ = std::move(small);
   hairProgram_ = g.hair.enabled;
@@ -295,6 +302,9 @@ void ClGroup::buildProgram(GroupImpl& g) {
   for (const auto& l : lanes_) setArg(tailKernel_.get(), i++, l.mem.get());
   setArg(tailKernel_.get(), i++, holes_.get());
   setArg(tailKernel_.get(), i++, tailList_.get());
+  i = 0;
+  for (const auto& l : lanes_) setArg(birth_.get(), i++, l.mem.get());
+  setArg(birth_.get(), i++, tau_.get());
   setArg(count_.get(), 0, codes_.get());
   setArg(count_.get(), 1, tileDead_.get());
   setArg(scan_.get(), 0, codes_.get());
@@ -404,6 +414,11 @@ void ClGroup::queueHair(GroupImpl& g, const StepParams& sp, std::size_t births) 
   strandC_.reserve(context(), vertices * 4 * 4);
   strandR_.reserve(context(), vertices * 4);
   strandCount_.reserve(context(), births * 4);
+  // Newborns that died in their birth step make no strand: their counts stay zero.
+  const cl_uint zero = 0;
+  check(clEnqueueFillBuffer(queue(), strandCount_.mem.get(), &zero, 4, 0, births * 4, 0, nullptr,
+                            nullptr),
+        "clEnqueueFillBuffer (strands)");
   cl_kernel k = hair_.get();
   cl_uint i = 0;
   for (const auto& l : lanes_) setArg(k, i++, l.mem.get());
@@ -518,9 +533,10 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   g.stats.droppedAtCapacity += total - births;  // the device sees at most `capacity`
   f.births = births;
 
+  // The step acts on the live particles and its newborns: an upper bound of both.
   std::size_t bound = size_;
   for (const auto& q : inFlight_) bound += q.births;
-  const std::size_t nBound = std::min(bound, g.capacity);
+  const std::size_t nBound = std::min(bound + births, g.capacity);
   const bool acts = !g.actions.empty() && nBound > 0;
   const bool kills = acts;           // the NaN guard can kill in any list
   if (!acts && births == 0) return;  // nothing on the device changes
@@ -529,6 +545,7 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   cl_mem state = state_.mem.get();
   const cl_uint seedLo = cl_uint(sp.seed), seedHi = cl_uint(sp.seed >> 32);
   const cl_uint cap = cl_uint(g.capacity);
+  const cl_ulong t1Bits = cl_ulong(doubleBits(sp.time + sp.dt));
   auto launch = [&](cl_kernel k, std::size_t global, std::size_t local, const char* what) {
     cl_event e = nullptr;
     check(clEnqueueNDRangeKernel(q, k, 1, nullptr, &global, &local, 0, nullptr,
@@ -560,9 +577,30 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   } else {
     tables_.reserve(context(), 64, CL_MEM_READ_ONLY);
   }
+  // fl_birth's arguments after its lanes and tau; fl_small takes the same from `tables` on.
+  auto birthArgs = [&](cl_kernel k, cl_uint i, bool withState) {
+    if (withState) {
+      setArg(k, i++, state);
+      setArg(k, i++, cl_uint(births));
+      setArg(k, i++, cap);
+    }
+    setArg(k, i++, tables_.mem.get());
+    for (int at = 1; at < 5; ++at) setArg(k, i++, cl_uint(off[at]));
+    setArg(k, i++, cl_uint(t.runs.size()));
+    if (withState) {
+      setArg(k, i++, t1Bits);
+      setArg(k, i++, seedLo);
+      setArg(k, i++, seedHi);
+    }
+    setArg(k, i++, cl_uint(g.index));
+  };
   // A small group's step is one launch (fl_small) when its program has it.
   const std::size_t tiles = (nBound + FL_TILE - 1) / FL_TILE;
   const bool oneLaunch = acts && small_ && tiles <= kSmallTiles && !g.hair.enabled;
+  if (births > 0 && !oneLaunch) {
+    birthArgs(birth_.get(), cl_uint(lanes_.size()) + 1, true);
+    launch(birth_.get(), roundUp(births, kSmallLocal), kSmallLocal, "fl_birth");
+  }
   if (acts) {
     cl_kernel k = act_.get();
     if (substepsByDistance_) {
@@ -571,12 +609,15 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
           clEnqueueFillBuffer(q, state, &zero, 4, FL_STATE_MAX_SPEED2 * 4, 4, 0, nullptr, nullptr),
           "clEnqueueFillBuffer (state)");
       setArg(maxSpeed_.get(), 3, state);
+      setArg(maxSpeed_.get(), 4, cl_uint(births));
+      setArg(maxSpeed_.get(), 5, cap);
       launch(maxSpeed_.get(), std::min(roundUp(nBound, 64), std::size_t(1) << 14), 64,
              "fl_max_speed");
     }
     cl_mem snap = extra_.mem.get();
     if (neighbours_) {
-      // Neighbours are read as they were at the start of the step (fused_pass.cpp).
+      // Neighbours are read as they were at the start of the step (fused_pass.cpp), the
+      // newborns where they were born.
       snap_.reserve(context(), 9 * g.capacity * 4);
       snap = snap_.mem.get();
       for (auto& l : lanes_) {
@@ -611,19 +652,17 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     setArg(k, i++, cl_uint(g.index << 16));
     setArg(k, i++, cl_uint(stepSubsteps(g.actions, sp.dt)));
     setArg(k, i++, cl_uint(g.capacity));
+    setArg(k, i++, tau_.get());
+    setArg(k, i++, cl_uint(births));
+    setArg(k, i++, cap);
+    setArg(k, i++, t1Bits);
     if (oneLaunch) {
       setArg(k, i++, tileDead_.get());
       setArg(k, i++, tileOff_.get());
       setArg(k, i++, holes_.get());
       setArg(k, i++, tailList_.get());
-      setArg(k, i++, cl_uint(births));
-      setArg(k, i++, cap);
       setArg(k, i++, cl_uint(tiles));
-      setArg(k, i++, tables_.mem.get());
-      for (int at = 1; at < 5; ++at) setArg(k, i++, cl_uint(off[at]));
-      setArg(k, i++, cl_uint(f.tables.runs.size()));
-      setArg(k, i++, cl_ulong(doubleBits(sp.time + sp.dt)));
-      setArg(k, i++, cl_uint(g.index));
+      birthArgs(k, i, false);
       launch(k, kActLocal, kActLocal, "fl_small");
     } else {
       launch(k, roundUp(nBound, kActLocal), kActLocal, "fl_act");
@@ -641,6 +680,8 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     } else {
       const std::size_t global = roundUp(tiles, kSmallLocal);
       setArg(count_.get(), 2, state);
+      setArg(count_.get(), 3, cl_uint(births));
+      setArg(count_.get(), 4, cap);
       launch(count_.get(), global, kSmallLocal, "fl_count");
       setArg(scan_.get(), 3, state);
       setArg(scan_.get(), 4, cl_uint(tiles));
@@ -650,27 +691,20 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
       setArg(list_.get(), 5, state);
       launch(list_.get(), global, kSmallLocal, "fl_list");
     }
-  } else if (births > 0) {
+  } else {
+    // No actions: the newborns only join the live particles.
     setArg(scan_.get(), 3, state);
     setArg(scan_.get(), 4, cl_uint(0));
     setArg(scan_.get(), 5, cl_uint(births));
     setArg(scan_.get(), 6, cap);
     launch(scan_.get(), 1, 1, "fl_scan");
   }
-  if (births > 0 || kills) {
-    cl_kernel k = tailKernel_.get();
-    cl_uint i = cl_uint(lanes_.size()) + 2;
-    setArg(k, i++, state);
-    setArg(k, i++, tables_.mem.get());
-    for (int at = 1; at < 5; ++at) setArg(k, i++, cl_uint(off[at]));
-    setArg(k, i++, cl_uint(t.runs.size()));
-    setArg(k, i++, cl_ulong(doubleBits(sp.time + sp.dt)));
-    setArg(k, i++, seedLo);
-    setArg(k, i++, seedHi);
-    setArg(k, i++, cl_uint(g.index));
-    const std::size_t fill = kills ? std::min(roundUp(nBound, kSmallLocal), kMaxFillItems) : 0;
-    if (!oneLaunch)
-      launch(k, roundUp(std::max<std::size_t>(births, fill), kSmallLocal), kSmallLocal, "fl_tail");
+  {
+    if (kills && !oneLaunch) {
+      cl_kernel k = tailKernel_.get();
+      setArg(k, cl_uint(lanes_.size()) + 2, state);
+      launch(k, std::min(roundUp(nBound, kSmallLocal), kMaxFillItems), kSmallLocal, "fl_tail");
+    }
     if (g.hair.enabled && births > 0) {
       queueHair(g, sp, births);
       f.births = 0;  // the group is empty again after the step

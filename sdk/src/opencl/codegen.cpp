@@ -289,7 +289,10 @@ std::uint32_t stepSubsteps(const ActionList& actions, double dt) {
 }
 
 // One step of the list for one particle: the sub-step count, the sub-steps, the NaN guard.
-// In scope: dtBits, t0 (the step's start time), nsubStep, state, and the lane registers.
+// In scope: dtBits (the step's length), nsubStep, state, the lane registers, and the
+// particle's own part of the step: fl_len (its length: the step's, or a newborn's time left)
+// and fl_t0 (its start time) as fl_real. Everything made from dt is made from the particle's
+// sub-step length, so a newborn runs the list for its own time (issue #11).
 std::string stepSource(const std::string& body, const Substeps& sub, bool byDistance,
                        AttributeSet stored, bool guarded) {
   std::ostringstream s;
@@ -312,13 +315,13 @@ std::string stepSource(const std::string& body, const Substeps& sub, bool byDist
       << "u;\n      if (m > (fl_real)nsub) nsub = (uint)(m < cap ? m : cap);\n    }\n  }\n";
   }
   if (sub.maxStep > 0 || byDistance)
-    s << "  const float dt = (float)(fl_real_from_bits(dtBits) / (fl_real)nsub);\n";
+    s << "  const float dt = (float)(fl_len / (fl_real)nsub);\n";
   else
-    s << "  const float dt = (float)fl_real_from_bits(dtBits);\n";
+    s << "  const float dt = (float)fl_len;\n";
   s << ""
        "  uint dead = 0u;\n"
        "  for (uint sub = 0u; sub < nsub; ++sub) {\n"
-       "    const fl_real time = t0 + (fl_real)sub * (fl_real)dt;\n"
+       "    const fl_real time = fl_t0 + (fl_real)sub * (fl_real)dt;\n"
        "    const uint streamSub = streamBase + (sub << 8);\n"
        "    (void)time; (void)streamSub;\n"
     << body << "  }\n";
@@ -333,10 +336,13 @@ std::string stepSource(const std::string& body, const Substeps& sub, bool byDist
   return s.str();
 }
 
-// Hair mode (hair.cpp simulateHair): each newborn runs the list to its death in one work
-// item, recording a strand vertex every `every` steps. The group is empty before the step's
-// emission, so newborn r is in slot r. Kills are counted into the state per kill code; those
-// that outlive their strand into FL_STATE_HAIR_ALIVE (the CPU counts them as killed by age).
+// Hair mode (hair.cpp simulateHair): after the birth step (fl_act, compaction) each survivor
+// runs the list to its death in one work item, recording a strand vertex every `every`
+// steps, the first where the birth step left it. The group was empty before the step's
+// emission, so the survivors are [0, m) and a strand's slot is its particle's id - firstId
+// (the host zeroes the counts: newborns that died in their birth step make no strand).
+// Kills are counted into the state per kill code; those that outlive their strand into
+// FL_STATE_HAIR_ALIVE (the CPU counts them as killed by age).
 std::string hairKernel(const std::string& stepCode, const std::vector<LaneRef>& all,
                        AttributeSet stored) {
   std::ostringstream s;
@@ -348,9 +354,9 @@ std::string hairKernel(const std::string& stepCode, const std::vector<LaneRef>& 
        "    __global float* restrict strandP, __global float* restrict strandC,\n"
        "    __global float* restrict strandR, __global uint* restrict strandCount) {\n"
        "  const uint i = get_global_id(0);\n"
-       "  const uint born = state[FL_STATE_BORN];\n"
+       "  const uint m = state[FL_STATE_OLD_SIZE] - state[FL_STATE_DEAD];\n"
        "  if (i == 0u) state[FL_STATE_SIZE] = 0u; /* a hair group keeps strands, not particles */\n"
-       "  if (i >= born) return;\n"
+       "  if (i >= m) return;\n"
        "  const uint n = 0u, snapN = 0u;\n"
        "  (void)extra; (void)snap; (void)snapN; (void)snapStride; (void)seedLo; (void)seedHi;\n"
        "  (void)n;\n";
@@ -358,8 +364,10 @@ std::string hairKernel(const std::string& stepCode, const std::vector<LaneRef>& 
     s << "  " << (info(l.attribute).isUint ? "uint " : "float ") << l.name << " = l_" << l.name
       << "[i];\n";
   const bool color = stored.has(Attribute::Color), size = stored.has(Attribute::Size);
-  s << "  uint count = 0u;\n"
-       "#define FL_RECORD() do { if (count < maxVertices) { const uint o = i * maxVertices + count;"
+  s << "  const uint strand = id - state[FL_STATE_FIRST_ID];\n"
+       "  uint count = 0u;\n"
+       "#define FL_RECORD() do { if (count < maxVertices) { const uint o = strand * maxVertices + "
+       "count;"
        " strandP[3u * o] = px; strandP[3u * o + 1u] = py; strandP[3u * o + 2u] = pz;"
     << (color ? " strandC[4u * o] = r; strandC[4u * o + 1u] = g; strandC[4u * o + 2u] = b;"
                 " strandC[4u * o + 3u] = a;"
@@ -374,6 +382,7 @@ std::string hairKernel(const std::string& stepCode, const std::vector<LaneRef>& 
        "    const uint step = step0 + (k - 1u);\n"
        "    uint killed;\n"
        "    {\n"
+       "      const fl_real fl_len = fl_real_from_bits(dtBits), fl_t0 = t0;\n"
     << stepCode
     << "      killed = dead;\n"
        "    }\n"
@@ -387,7 +396,7 @@ std::string hairKernel(const std::string& stepCode, const std::vector<LaneRef>& 
        "  }\n"
        "#undef FL_RECORD\n"
        "  if (alive) atomic_inc(&state[FL_STATE_HAIR_ALIVE]);\n"
-       "  strandCount[i] = count;\n"
+       "  strandCount[strand] = count;\n"
        "}\n";
   return s.str();
 }
@@ -522,8 +531,12 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   const AttributeSet touched = reads | writes;
   for (const auto& l : all)
     if (touched.has(l.attribute)) g.actLanes.push_back(l);
-  // The per-particle part, shared by fl_act and fl_small.
+  // The per-particle part, shared by fl_act and fl_small. A newborn (i >= n0) runs the list
+  // for the part of the step it still has to live, from its birth time on.
   std::ostringstream one;
+  one << "  fl_real fl_len = fl_real_from_bits(dtBits), fl_t0 = t0;\n"
+         "  if (i >= n0) {\n    const fl_real left = (fl_real)tau[i - n0];\n"
+         "    fl_len = left;\n    fl_t0 = t1 - left;\n  }\n";
   for (const auto& l : g.actLanes) {
     const char* type = info(l.attribute).isUint ? "uint" : "float";
     if (reads.has(l.attribute))
@@ -540,30 +553,40 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
       "__global uchar* restrict codes, __global const FlActionParams* restrict ap,\n"
       "    __global uint* state, __global const float* restrict extra,\n"
       "    __global const float* restrict snap, ulong dtBits, ulong timeBits, uint seedLo,\n"
-      "    uint seedHi, uint step, uint streamBase, uint nsubStep, uint snapStride";
+      "    uint seedHi, uint step, uint streamBase, uint nsubStep, uint snapStride,\n"
+      "    __global float* restrict tau, uint births, uint capacity, ulong t1Bits";
+  // [0, n0) lived before the step, [n0, n) are its newborns (fl_birth wrote them).
   const char* actPrologue =
-      "  const uint n = state[FL_STATE_SIZE];\n"
+      "  const uint n0 = state[FL_STATE_SIZE];\n"
+      "  const uint n = fl_step_range(state, births, capacity);\n"
       "  const uint snapN = n;\n"
       "  (void)extra; (void)snap; (void)snapN; (void)snapStride; (void)seedLo; (void)seedHi;\n"
       "  (void)step;\n"
-      "  const fl_real t0 = fl_real_from_bits(timeBits);\n";
+      "  const fl_real t0 = fl_real_from_bits(timeBits), t1 = fl_real_from_bits(t1Bits);\n";
   s << "/* ---- generated: the fused act kernel */\n__kernel void fl_act(";
   for (const auto& l : g.actLanes) s << laneDecl(l) << ", ";
   s << actArgs << ") {\n"
     << actPrologue << "  const uint i = get_global_id(0);\n  if (i >= n) return;\n"
     << one.str() << "}\n";
-  // A small group's whole step in one launch of one work-group: act, count-scan-list, tail.
-  // PoCL pays several microseconds per launch; this is one instead of three.
-  g.small = !g.substepsByDistance && !hair;
+  // A small group's whole step in one launch of one work-group: births, act,
+  // count-scan-list, tail. PoCL pays several microseconds per launch; this is one instead of
+  // four.
+  // Not for lists that read neighbours: their snapshot, copied before the act kernel, must
+  // hold the newborns where they were born, so fl_birth runs before the copy.
+  g.small = !g.substepsByDistance && !hair && !g.neighbours;
   if (g.small)
     s << "/* ---- generated: a small group's step */\n"
          "__kernel void fl_small(FL_LANE_PARAMS, "
       << actArgs
       << ",\n    __global uint* tileDead, __global uint* tileOff, __global uint* holes,\n"
-         "    __global uint* tail, uint births, uint capacity, uint tiles,\n"
+         "    __global uint* tail, uint tiles,\n"
          "    __global const uchar* tables, uint offEmitters, uint offTypes, uint offKeys,\n"
-         "    uint offShapes, uint runCount, ulong t1Bits, uint salt) {\n"
+         "    uint offShapes, uint runCount, uint salt) {\n"
          "  const uint lid = get_local_id(0), lsize = get_local_size(0);\n"
+         "  fl_birth_body(lid, lsize, FL_LANE_ARGS, tau, state, births, capacity, tables,\n"
+         "                offEmitters, offTypes, offKeys, offShapes, runCount, t1Bits, seedLo,\n"
+         "                seedHi, salt);\n"
+         "  barrier(CLK_GLOBAL_MEM_FENCE);\n"
          "  {\n"
       << actPrologue << "  for (uint i = lid; i < n; i += lsize) {\n"
       << one.str()
@@ -572,8 +595,7 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
          "  if (lid == 0u) fl_scan_list_body(codes, tileDead, tileOff, holes, tail, state, "
          "births, capacity, tiles);\n"
          "  barrier(CLK_GLOBAL_MEM_FENCE);\n"
-         "  fl_tail_body(lid, lsize, FL_LANE_ARGS, holes, tail, state, tables, offEmitters,\n"
-         "               offTypes, offKeys, offShapes, runCount, t1Bits, seedLo, seedHi, salt);\n"
+         "  fl_tail_body(lid, lsize, FL_LANE_ARGS, holes, tail, state);\n"
          "}\n";
   if (hair) {
     if (g.neighbours) notOnDevice("hair mode with actions that read neighbours");

@@ -45,24 +45,23 @@ std::size_t kindOf(const Domain& d) {
   return d.shape().index();
 }
 
-std::string newbornCall(const Emitter& e, std::size_t t, bool oneType) {
+std::string newbornCall(const Emitter& e, std::size_t t) {
   const ParticleType& p = e.types[t];
   std::ostringstream c;
-  c << "fl_newborn(FL_LANE_ARGS, slot, id, age, at, " << (oneType ? 1 : 0)
-    << ", em, types + em->typeFirst + " << t << "u, rng, shapes, " << kindOf(e.shape) << "u, "
-    << kindOf(p.velocity) << "u, " << kindOf(p.color) << "u, " << kindOf(p.up) << "u, "
-    << kindOf(p.rotVelocity) << "u, " << normalMode(e) << "u, " << fuzzyMode(p.lifetime) << "u, "
-    << fuzzyMode(p.alpha) << "u, " << fuzzyMode(p.size) << "u, " << fuzzyMode(p.mass) << "u, "
-    << fuzzyMode(p.charge) << "u);";
+  c << "fl_newborn(FL_LANE_ARGS, slot, id, at, em, types + em->typeFirst + " << t
+    << "u, rng, shapes, " << kindOf(e.shape) << "u, " << kindOf(p.velocity) << "u, "
+    << kindOf(p.color) << "u, " << kindOf(p.up) << "u, " << kindOf(p.rotVelocity) << "u, "
+    << normalMode(e) << "u, " << fuzzyMode(p.lifetime) << "u, " << fuzzyMode(p.alpha) << "u, "
+    << fuzzyMode(p.size) << "u, " << fuzzyMode(p.mass) << "u, " << fuzzyMode(p.charge) << "u);";
   return c.str();
 }
 
 // The statements of one emitter's case: what its kinds and modes make of fl_newborn.
 std::string variantCode(const Emitter& em) {
-  if (em.types.size() == 1) return "      " + newbornCall(em, 0, true) + "\n";
+  if (em.types.size() == 1) return "      " + newbornCall(em, 0) + "\n";
   std::string s = "      switch (fl_choose_type(em, types, rng)) {\n";
   for (std::size_t t = 0; t < em.types.size(); ++t)
-    s += "        case " + std::to_string(t) + "u: " + newbornCall(em, t, false) + " break;\n";
+    s += "        case " + std::to_string(t) + "u: " + newbornCall(em, t) + " break;\n";
   return s + "      }\n";
 }
 
@@ -111,7 +110,7 @@ void setDouble(std::vector<float>& d, std::size_t at, double x) {
   setWord(d[at + 1], std::uint32_t(b >> 32));
 }
 
-// One emitter as fl_tail and fl_newborn read it; returns its index in t.emitters.
+// One emitter as fl_birth and fl_newborn read it; returns its index in t.emitters.
 std::uint32_t packEmitter(const Emitter& em, std::uint32_t variant, StepTables& t,
                           ShapePacker& shapes) {
   cl::FlEmitter o{};
@@ -238,8 +237,8 @@ std::string emissionSource(const GroupImpl& g) {
   std::ostringstream s;
   // The newborns of each emitter code, with its kinds as literals.
   s << "/* ---- generated: emission per emitter code */\n"
-       "FL_INLINE void fl_emit(FL_LANE_PARAMS, uint variant, uint slot, uint id, float age,\n"
-       "                       float3 at, __global const FlEmitter* em,\n"
+       "FL_INLINE void fl_emit(FL_LANE_PARAMS, uint variant, uint slot, uint id, float3 at,\n"
+       "                       __global const FlEmitter* em,\n"
        "                       __global const FlParticleType* types, FlRandom* rng,\n"
        "                       __global const float* shapes) {\n"
        "  switch (variant) {\n";

@@ -2,7 +2,7 @@
 // when: emission.cpp's rules, run on a handful of emitters, prime and live emitters
 // included) into runs and tables; the generated fl_emit (one case per distinct emitter
 // code: domain kinds and fuzzy modes as literals) writes the newborns on the device, in
-// fl_tail.
+// fl_birth.
 #pragma once
 
 #include <array>
@@ -17,7 +17,7 @@
 
 namespace flurry::detail::ocl {
 
-/// One step's emission tables, read by fl_tail.
+/// One step's emission tables, read by fl_birth.
 struct StepTables {
   std::vector<cl::FlBirthRun> runs;
   std::vector<cl::FlEmitter> emitters;
