@@ -294,7 +294,9 @@ ActionList allForces(Integrator integrator) {
   f.falloff = kFalloff;
   ActionList l{Gravity{kDown, kFalloffPow},
                Damping{Vec3(0.3f, 0.1f, 0.6f), kFalloff},
-               OrbitPoint{Vec3(0.5f, 3.0f, 0.0f), 10.0f, 0.1f, 4.0f},
+               // A soft core (epsilon 0.5): explicit Euler near a hard one turns the device's
+               // one-ulp differences in exp/sqrt into a drift past the tolerance over 200 steps.
+               OrbitPoint{Vec3(0.5f, 3.0f, 0.0f), 10.0f, 0.5f, 4.0f},
                OrbitLine{Vec3(0.5f, 0.0f, 0.0f), Vec3(0.2f, 1.0f, 0.1f), 4.0f, 0.05f, 3.0f},
                Vortex{Vec3(0.0f), Vec3(0.1f, 1.0f, 0.0f), 3.0f, 0.5f, 0.8f, 1.0f, 0.5f, 2.0f, 4.0f},
                Jet{Vec3(0.0f, 3.0f, 0.0f), 1.5f, Domain::sphere(Vec3(0.0f, 3.0f, 0.0f), 4.0f)},

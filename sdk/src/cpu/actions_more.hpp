@@ -547,8 +547,9 @@ inline void apply(const Restore& a, const Lanes& L, std::size_t n, const BlockCo
   const float left = float(double(a.start) + a.duration - c.time);  // seconds to arrival
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3 p = at(L.p, i), home = at(L.posB, i);
-    // The velocity that arrives on time; in the last step, exactly.
-    put(L.v, i, left > c.dt ? (home - p) / left : (home - p) / c.dt);
+    // The velocity that arrives on time; in the last step, exactly. A newborn born at the
+    // step's very end (dt = 0) keeps its velocity.
+    if (c.dt > 0.0f) put(L.v, i, left > c.dt ? (home - p) / left : (home - p) / c.dt);
     if (left <= 0.0f) {
       put(L.p, i, home);
       put(L.v, i, Vec3(0.0f));
