@@ -484,3 +484,28 @@ TEST(RandomAccel, EachParticleDrawsItsOwnStream) {
     }
   }
 }
+
+// RandomVelocity, RandomRotVelocity and RandomDisplace draw in batches too: the same numbers
+// as one Random per particle and action.
+TEST(RandomActions, BatchesDrawEachParticlesOwnStream) {
+  const Domain d = Domain::cylinder(Vec3(0, -1, 0), Vec3(0, 2, 1), 3.0f, 1.0f);
+  ContextOptions o;
+  o.dt = 0.25;
+  o.threads = 2;
+  o.seed = 0xABCD'1234ull;
+  Context ctx(o);
+  Group& g = ctx.createGroup("g", 1000);
+  g.setActions({RandomVelocity{d}, RandomRotVelocity{d}, RandomDisplace{d}});
+  for (int i = 0; i < 1000; ++i) g.add(at(Vec3(float(i), 0, 0)));
+  ctx.step();
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const Particle p = g.particle(i);
+    auto draw = [&](std::uint32_t action) {
+      Random rng(o.seed, p.id, 0, action);
+      return d.sample(rng);
+    };
+    ASSERT_EQ(p.velocity, draw(0)) << "particle " << i;
+    ASSERT_EQ(p.rotVelocity, draw(1)) << "particle " << i;
+    ASSERT_EQ(p.position, Vec3(float(p.id), 0, 0) + draw(2) * 0.25f) << "particle " << i;
+  }
+}

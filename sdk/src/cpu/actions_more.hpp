@@ -101,10 +101,10 @@ inline void sampleFromActionStreams(const Domain& d, const Lanes& L, std::size_t
   }
 }
 
-// v += a·dt over a batch.
-inline void addScaledLoop(float* __restrict vx, float* __restrict vy, float* __restrict vz,
-                          const float* __restrict ax, const float* __restrict ay,
-                          const float* __restrict az, std::size_t n, float dt) {
+// v += a[i]·dt over a batch.
+inline void addVaryingLoop(float* __restrict vx, float* __restrict vy, float* __restrict vz,
+                           const float* __restrict ax, const float* __restrict ay,
+                           const float* __restrict az, std::size_t n, float dt) {
   for (std::size_t i = 0; i < n; ++i) {
     vx[i] = vx[i] + ax[i] * dt;
     vy[i] = vy[i] + ay[i] * dt;
@@ -320,28 +320,30 @@ inline void apply(const RandomAccel& a, const Lanes& L, std::size_t n, const Blo
                                 ay[k] *= s;
                                 az[k] *= s;
                               }
-                            addScaledLoop(L.v[0] + first, L.v[1] + first, L.v[2] + first, ax, ay,
-                                          az, m, weighted ? 1.0f : c.dt);
+                            addVaryingLoop(L.v[0] + first, L.v[1] + first, L.v[2] + first, ax, ay,
+                                           az, m, weighted ? 1.0f : c.dt);
                           });
 }
 inline void apply(const RandomDisplace& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  for (std::size_t i = 0; i < n; ++i) {
-    Random rng = actionRandom(c, L, i);
-    put(L.p, i, at(L.p, i) + a.displacement.sample(rng) * c.dt);
-  }
+  sampleFromActionStreams(
+      a.displacement, L, n, c, [&](std::size_t first, std::size_t m, float* x, float* y, float* z) {
+        addVaryingLoop(L.p[0] + first, L.p[1] + first, L.p[2] + first, x, y, z, m, c.dt);
+      });
+}
+// A batch of samples stored into a vector attribute.
+inline void storeSamples(const Domain& d, float* const* lane, const Lanes& L, std::size_t n,
+                         const BlockContext& c) {
+  sampleFromActionStreams(d, L, n, c,
+                          [&](std::size_t first, std::size_t m, float* x, float* y, float* z) {
+                            copyLoop(lane[0] + first, lane[1] + first, lane[2] + first, x, y, z, m);
+                          });
 }
 inline void apply(const RandomVelocity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  for (std::size_t i = 0; i < n; ++i) {
-    Random rng = actionRandom(c, L, i);
-    put(L.v, i, a.velocity.sample(rng));
-  }
+  storeSamples(a.velocity, L.v, L, n, c);
 }
 inline void apply(const RandomRotVelocity& a, const Lanes& L, std::size_t n,
                   const BlockContext& c) {
-  for (std::size_t i = 0; i < n; ++i) {
-    Random rng = actionRandom(c, L, i);
-    put(L.rot, i, a.rotVelocity.sample(rng));
-  }
+  storeSamples(a.rotVelocity, L.rot, L, n, c);
 }
 
 inline void apply(const Turbulence& a, const Lanes& L, std::size_t n, const BlockContext& c) {
