@@ -1,11 +1,8 @@
 /* Philox4x32-10 (Salmon et al., SC'11) in OpenCL C: the same function as flurry::Philox4x32
  * and flurry::Random in <flurry/random.hpp>, so the two backends draw the same numbers for
- * the same (seed, id, step, stream). Every helper is forced inline: PoCL made a kernel ~11x
- * slower when Philox was left as a call. */
+ * the same (seed, id, step, stream). */
 #ifndef FLURRY_KERNELS_PHILOX_H
 #define FLURRY_KERNELS_PHILOX_H
-
-#define FL_INLINE inline __attribute__((always_inline))
 
 FL_INLINE uint4 fl_philox(uint4 c, uint k0, uint k1) {
   const uint M0 = 0xD2511F53u, M1 = 0xCD9E8D57u;

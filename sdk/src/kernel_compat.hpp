@@ -1,0 +1,34 @@
+// The CPU side of the kernels' shared C subset: the files in kernels/ that hold math written
+// once for both backends (noise.h, ...) compile here as C++ with OpenCL C's names for what
+// they use (kernels/compat_opencl.h is the device's side), as Blender Cycles' kernels do.
+// Include a shared file with #include "../../kernels/file.h" inside namespace
+// flurry::detail::kernel: the namespace is inline-nested in the instruction set's
+// (isa_namespace.hpp), so each build keeps its own copy of every function.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#include "flurry/math.hpp"
+#include "isa_namespace.hpp"
+
+#ifndef FL_INLINE
+#define FL_INLINE inline
+#endif
+
+namespace flurry::detail {
+inline namespace FLURRY_ISA_NAMESPACE {
+namespace kernel {
+
+using uint = std::uint32_t;
+using float3 = Vec3;
+inline float3 make_float3(float x, float y, float z) {
+  return Vec3(x, y, z);
+}
+using std::fabs;
+using std::floor;
+using std::sqrt;
+
+}  // namespace kernel
+}  // namespace FLURRY_ISA_NAMESPACE
+}  // namespace flurry::detail
