@@ -7,6 +7,10 @@
 //
 //   build/release/bench/bench_fountain --benchmark_filter=Small --benchmark_repetitions=5
 //
+// Idle groups (100 groups of which 10 are alive, against the 10 alone):
+//
+//   build/release/bench/bench_fountain --benchmark_filter=Idle --benchmark_repetitions=5
+//
 // After the runs it prints a summary of ratios between the medians of this run.
 #include <benchmark/benchmark.h>
 
@@ -148,6 +152,24 @@ void SmallGroups(benchmark::State& state) {
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
+// `alive` small fountains among `groups` groups, the others idle (their emitter stopped
+// long ago and their particles are gone: a level's effects that have played), on one
+// thread; reports the time of a whole Context::step().
+void IdleGroups(benchmark::State& state) {
+  const auto groups = std::size_t(state.range(0)), alive = std::size_t(state.range(1));
+  ContextOptions o;
+  o.threads = 1;
+  Context ctx(o);
+  for (std::size_t k = 0; k < groups; ++k) {
+    Group& g = smallFountain(ctx, "group" + std::to_string(k));
+    if (k % (groups / alive) != 0) g.emitters()[0].stop = 0.5;  // played, gone by 3 s
+  }
+  ctx.run(90);
+  for (auto _ : state) ctx.step();
+  state.counters["us/step"] = benchmark::Counter(
+      double(state.iterations()) * 1e-6, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
 // One small group alone.
 void SmallGroupStep(benchmark::State& state) {
   SmallGroups(state);
@@ -171,8 +193,9 @@ class RatioReporter : public benchmark::ConsoleReporter {
       const auto items = r.counters.find("items_per_second");
       std::string name = r.run_name.function_name + "/" + r.run_name.args;
       if (it != r.counters.end()) bytes_[name] = it->second;
-      if (name.rfind("Small", 0) == 0) {
-        const auto per = r.counters.find("us/group-step");
+      if (name.rfind("Small", 0) == 0 || name.rfind("Idle", 0) == 0) {
+        auto per = r.counters.find("us/group-step");
+        if (per == r.counters.end()) per = r.counters.find("us/step");
         if (per != r.counters.end()) small_[name] = per->second;
       }
       if (items != r.counters.end()) items_[name] = items->second;
@@ -200,7 +223,13 @@ class RatioReporter : public benchmark::ConsoleReporter {
             step / 1e9, 100 * step / rmw);
       if (upd > 0 && unf > 0) std::printf("    fused / unfused: %.2fx\n", upd / unf);
     }
-    if (small_.empty()) return;
+    const double idle100 = small_["IdleGroups/groups:100/alive:10"];
+    const double idle10 = small_["IdleGroups/groups:10/alive:10"];
+    if (idle100 > 0 && idle10 > 0)
+      std::printf(
+          "  100 groups of which 10 alive: %.2f us/step, the 10 alone %.2f: %.2fx (goal <= 1.2)\n",
+          idle100, idle10, idle100 / idle10);
+    if (small_.find("SmallGroupStep/groups:1/threads:1") == small_.end()) return;
     std::printf("  small groups (%zu live particles each), us per group-step (goal <= 5):\n",
                 kSmallLive);
     for (const char* n : {"SmallGroupStep/groups:1", "SmallGroups/groups:100"}) {
@@ -240,6 +269,12 @@ BENCHMARK_CAPTURE(UpdatePass, unfused, false)
     ->UseRealTime();
 BENCHMARK(FountainStep)->Arg(1 << 20)->Arg(1 << 22)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(Emission)->Arg(1 << 18)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(IdleGroups)
+    ->ArgNames({"groups", "alive"})
+    ->Args({10, 10})
+    ->Args({100, 10})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
 BENCHMARK(SmallGroupStep)
     ->ArgNames({"groups", "threads"})
     ->Args({1, 1})

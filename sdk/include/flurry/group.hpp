@@ -79,6 +79,9 @@ struct GroupStats {
     double compact = 0.0;
   };
   StepSeconds stepSeconds;
+  /// Steps the CPU backend skipped because the group was idle: no live particles and no
+  /// emitter that would fire (such a step changes nothing and costs no pass).
+  std::uint64_t idleSteps = 0;
 };
 
 struct Bounds {

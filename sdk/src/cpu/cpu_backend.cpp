@@ -73,6 +73,15 @@ class CpuBackend final : public BackendImpl {
  public:
   const char* name() const override { return "cpu"; }
   void step(GroupImpl& group, const StepParams& params) override {
+    // Idle: nothing alive and no emitter that will fire. Such a step would change nothing
+    // (its emitters' state included), so it costs no pass, no clock and no worker.
+    if (group.size == 0 && !group.hair.enabled && !mayEmit(group, params)) {
+      // What a step's planning would have done: count generation 0 (see planBirths).
+      if (!group.emitters.empty() && group.stats.emittedByGeneration.empty())
+        group.stats.emittedByGeneration.assign(1, 0);
+      ++group.stats.idleSteps;
+      return;
+    }
     // Each part's time, for GroupStats::stepSeconds.
     using Clock = std::chrono::steady_clock;
     auto last = Clock::now();
