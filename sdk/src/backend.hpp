@@ -17,6 +17,7 @@ struct StepParams {
   std::uint64_t step = 0;
   std::size_t blockSize = 0;
   bool fused = true;
+  bool cull = true;
   ThreadPool* pool = nullptr;
 };
 
