@@ -248,3 +248,61 @@ TEST(Group, StepSecondsTimeTheCpuBackendsParts) {
   EXPECT_GT(g.stats().stepSeconds.compact, s.compact);
   EXPECT_GT(g.stats().stepSeconds.act, s.act);
 }
+
+// An idle group (nothing alive, no emitter that will fire) is skipped, and skipping changes
+// nothing: a later burst, a rate that starts later and a moving emitter's spacing still give
+// the same particles as in a group that is never idle (a live particle keeps it busy).
+TEST(Group, IdleStepsAreSkippedAndChangeNothing) {
+  auto build = [](Context& ctx, const char* name, bool keepBusy) -> Group& {
+    Group& g = ctx.createGroup(name, 1000);
+    Emitter e;
+    e.shape = Domain::point(Vec3(0.0f));
+    ParticleType t;
+    t.velocity = Domain::sphere(Vec3(0.0f, 2.0f, 0.0f), 1.0f);
+    t.lifetime = 0.1f;
+    e.types = {t};
+    e.bursts = {{0.5, 7, 0.6, 2}};  // at 0.5 s and 1.1 s
+    g.addEmitter(e);
+    Emitter rate = e;
+    rate.bursts.clear();
+    rate.rate = 30.0;
+    rate.start = 1.5;
+    rate.stop = 1.6;
+    g.addEmitter(rate);
+    Emitter moving;
+    moving.types = {t};
+    moving.spacing = 0.25f;
+    moving.start = 2.0;
+    moving.stop = 2.2;
+    moving.path = {{2.0, Vec3(0.0f)}, {2.2, Vec3(2.0f, 0.0f, 0.0f)}};
+    g.addEmitter(moving);
+    if (keepBusy) {
+      Particle p;
+      p.position = Vec3(100.0f);
+      p.lifetime = 1e30f;
+      g.add(p);
+    }
+    g.setActions({Gravity{}, Move{}, KillOld{}});
+    return g;
+  };
+  ContextOptions o;
+  o.threads = 1;
+  Context a(o), b(o);
+  Group& idle = build(a, "g", false);
+  Group& busy = build(b, "g", true);
+  std::size_t wasIdle = 0;
+  for (int s = 0; s < 90; ++s) {
+    a.step();
+    b.step();
+    ASSERT_EQ(idle.size() + 1, busy.size()) << "step " << s;
+    wasIdle += idle.size() == 0;
+  }
+  EXPECT_EQ(idle.stats().emitted + 1, busy.stats().emitted);  // add() counts in `emitted`
+  EXPECT_GT(idle.stats().emitted, 7u + 7u + 3u);  // and the spacing's
+  EXPECT_EQ(idle.stats().emittedByGeneration, busy.stats().emittedByGeneration);
+  EXPECT_EQ(busy.stats().idleSteps, 0u);
+  // Idle from the start to the first burst (15 steps), between the bursts, after the rate,
+  // after the spacing: more than half the 90 steps, but never a step whose emitters fire.
+  EXPECT_GE(idle.stats().idleSteps, 45u);
+  EXPECT_LE(idle.stats().idleSteps, wasIdle);
+}

@@ -7,6 +7,15 @@
 //
 //   build/release/bench/bench_fountain --benchmark_filter=Small --benchmark_repetitions=5
 //
+// Deflectors culled (1M particles, 32 deflectors against 2):
+//
+//   build/release/bench/bench_fountain --benchmark_filter='Deflectors|ReadModifyWrite6' \
+//       --benchmark_repetitions=5
+//
+// Idle groups (100 groups of which 10 are alive, against the 10 alone):
+//
+//   build/release/bench/bench_fountain --benchmark_filter=Idle --benchmark_repetitions=5
+//
 // After the runs it prints a summary of ratios between the medians of this run.
 #include <benchmark/benchmark.h>
 
@@ -148,6 +157,70 @@ void SmallGroups(benchmark::State& state) {
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
+// `alive` small fountains among `groups` groups, the others idle (their emitter stopped
+// long ago and their particles are gone: a level's effects that have played), on one
+// thread; reports the time of a whole Context::step().
+void IdleGroups(benchmark::State& state) {
+  const auto groups = std::size_t(state.range(0)), alive = std::size_t(state.range(1));
+  ContextOptions o;
+  o.threads = 1;
+  Context ctx(o);
+  for (std::size_t k = 0; k < groups; ++k) {
+    Group& g = smallFountain(ctx, "group" + std::to_string(k));
+    if (k % (groups / alive) != 0) g.emitters()[0].stop = 0.5;  // played, gone by 3 s
+  }
+  ctx.run(90);
+  for (auto _ : state) ctx.step();
+  state.counters["us/step"] = benchmark::Counter(
+      double(state.iterations()) * 1e-6, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+// 1M particles over 32 cells in a row, each cell a floor (a rectangle) the particles of
+// that cell bounce on under gravity; the group is in cell order, as a level's particles
+// are near their emitters. With `deflectors` = 32 every floor is in the list, with 2 only
+// two of them (without culling every particle tests both): spatial culling (`cull`)
+// should make the 32 cost about what 2 cost.
+void Deflectors(benchmark::State& state) {
+  const auto deflectors = int(state.range(0));
+  constexpr std::size_t n = std::size_t(1) << 20;
+  constexpr int kCells = 32;
+  ContextOptions o;
+  o.threads = threads();
+  o.cull = state.range(1) != 0;
+  Context ctx(o);
+  Group& g = ctx.createGroup("cells", n);
+  ActionList list;
+  list.add(Gravity{});
+  for (int j = 0; j < deflectors; ++j)
+    list.add(Bounce{Domain::rectangle(Vec3(4.0f * float(j), 0.0f, 0.0f), Vec3(4.0f, 0.0f, 0.0f),
+                                      Vec3(0.0f, 0.0f, 4.0f)),
+                    1.0f, 0.0f, 0.0f});
+  list.add(Move{});
+  g.setActions(list);
+  Random rng(7, 0, 0, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const float cell = float(i * kCells / n);
+    Particle p;
+    p.position = Vec3(4.0f * cell + 0.2f + 3.6f * rng.uniform(), 0.1f + 3.0f * rng.uniform(),
+                      0.2f + 3.6f * rng.uniform());
+    p.velocity = Vec3(0.0f, 4.0f * rng.uniform() - 2.0f, 0.0f);
+    g.add(p);
+  }
+  ctx.step();
+  const std::uint64_t culled = g.stats().blockActionsCulled;
+  for (auto _ : state) ctx.step();
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(n));
+  // Position and velocity read and written.
+  state.SetBytesProcessed(std::int64_t(double(state.iterations()) * double(n) * 48.0));
+  state.counters["culled/step"] =
+      double(g.stats().blockActionsCulled - culled) / double(state.iterations());
+}
+
+// The ceiling for it: the six lanes it reads and writes.
+void ReadModifyWrite6(benchmark::State& state) {
+  flurry::bench::readModifyWrite(state, 6, threads());
+}
+
 // One small group alone.
 void SmallGroupStep(benchmark::State& state) {
   SmallGroups(state);
@@ -171,11 +244,14 @@ class RatioReporter : public benchmark::ConsoleReporter {
       const auto items = r.counters.find("items_per_second");
       std::string name = r.run_name.function_name + "/" + r.run_name.args;
       if (it != r.counters.end()) bytes_[name] = it->second;
-      if (name.rfind("Small", 0) == 0) {
-        const auto per = r.counters.find("us/group-step");
+      if (name.rfind("Small", 0) == 0 || name.rfind("Idle", 0) == 0) {
+        auto per = r.counters.find("us/group-step");
+        if (per == r.counters.end()) per = r.counters.find("us/step");
         if (per != r.counters.end()) small_[name] = per->second;
       }
       if (items != r.counters.end()) items_[name] = items->second;
+      if (name.rfind("Deflectors", 0) == 0)
+        ms_[name] = r.GetAdjustedRealTime();  // in the benchmark's unit (ms)
     }
   }
   void Finalize() override {
@@ -200,7 +276,32 @@ class RatioReporter : public benchmark::ConsoleReporter {
             step / 1e9, 100 * step / rmw);
       if (upd > 0 && unf > 0) std::printf("    fused / unfused: %.2fx\n", upd / unf);
     }
-    if (small_.empty()) return;
+    const double idle100 = small_["IdleGroups/groups:100/alive:10"];
+    const double idle10 = small_["IdleGroups/groups:10/alive:10"];
+    if (idle100 > 0 && idle10 > 0)
+      std::printf(
+          "  100 groups of which 10 alive: %.2f us/step, the 10 alone %.2f: %.2fx (goal <= 1.2)\n",
+          idle100, idle10, idle100 / idle10);
+    const double d32 = ms_["Deflectors/deflectors:32/cull:1"];
+    const double d2 = ms_["Deflectors/deflectors:2/cull:0"];  // every particle tests both
+    const double d2c = ms_["Deflectors/deflectors:2/cull:1"];
+    const double d32off = ms_["Deflectors/deflectors:32/cull:0"];
+    if (d32 > 0 && d2 > 0) {
+      std::printf(
+          "  1M particles: 32 deflectors culled %.2f ms / 2 deflectors every particle tests "
+          "%.2f ms = %.2fx (goal <= 1.3)\n",
+          d32, d2, d32 / d2);
+      if (d2c > 0) std::printf("    2 deflectors culled too: %.2f ms\n", d2c);
+      if (d32off > 0)
+        std::printf("    32 deflectors without culling: %.2f ms = %.2fx\n", d32off, d32off / d2);
+      const double rmw = bytes_["ReadModifyWrite6/1048576"];
+      if (rmw > 0)
+        std::printf(
+            "    read-modify-write of its 6 lanes %.1f GB/s; 32 culled %.1f GB/s, 2 %.1f GB/s\n",
+            rmw / 1e9, bytes_["Deflectors/deflectors:32/cull:1"] / 1e9,
+            bytes_["Deflectors/deflectors:2/cull:0"] / 1e9);
+    }
+    if (small_.find("SmallGroupStep/groups:1/threads:1") == small_.end()) return;
     std::printf("  small groups (%zu live particles each), us per group-step (goal <= 5):\n",
                 kSmallLive);
     for (const char* n : {"SmallGroupStep/groups:1", "SmallGroups/groups:100"}) {
@@ -218,7 +319,7 @@ class RatioReporter : public benchmark::ConsoleReporter {
   }
 
  private:
-  std::map<std::string, double> bytes_, items_, small_;
+  std::map<std::string, double> bytes_, items_, small_, ms_;
 };
 
 }  // namespace
@@ -240,6 +341,21 @@ BENCHMARK_CAPTURE(UpdatePass, unfused, false)
     ->UseRealTime();
 BENCHMARK(FountainStep)->Arg(1 << 20)->Arg(1 << 22)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(Emission)->Arg(1 << 18)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(ReadModifyWrite6)->Arg(1 << 20)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(Deflectors)
+    ->ArgNames({"deflectors", "cull"})
+    ->Args({32, 1})
+    ->Args({2, 0})
+    ->Args({2, 1})
+    ->Args({32, 0})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(IdleGroups)
+    ->ArgNames({"groups", "alive"})
+    ->Args({10, 10})
+    ->Args({100, 10})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
 BENCHMARK(SmallGroupStep)
     ->ArgNames({"groups", "threads"})
     ->Args({1, 1})

@@ -17,6 +17,7 @@ struct StepParams {
   std::uint64_t step = 0;
   std::size_t blockSize = 0;
   bool fused = true;
+  bool cull = true;
   ThreadPool* pool = nullptr;
 };
 
@@ -49,6 +50,9 @@ const char* fusedPassIsa();
 /// born, each with the part of the step it still has to live (group.bornFirst, bornCount,
 /// bornRemaining): the act pass that follows runs them through the action list for it.
 void emitNewborns(GroupImpl& group, const StepParams& params);
+/// Whether the group's emitters (static, prime or live) could give birth, or change their
+/// state, over this step: false only when a step would leave them as they are.
+bool mayEmit(const GroupImpl& group, const StepParams& params);
 /// Fills the act pass's holes with the live particles at the tail, so [0, size) is dense
 /// again.
 void compact(GroupImpl& group, const StepParams& params);

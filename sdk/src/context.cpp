@@ -10,7 +10,9 @@
 
 namespace flurry {
 
-const char* versionString() { return "0.1.0"; }
+const char* versionString() {
+  return "0.1.0";
+}
 
 struct Context::Impl {
   ContextOptions options;
@@ -27,7 +29,8 @@ struct Context::Impl {
 namespace {
 void checkDt(double dt) {
   if (!std::isfinite(dt) || dt <= 0.0 || dt > 10.0)
-    throw InvalidArgument("dt", "must be finite, > 0 and <= 10 seconds (got " + std::to_string(dt) + ")");
+    throw InvalidArgument("dt",
+                          "must be finite, > 0 and <= 10 seconds (got " + std::to_string(dt) + ")");
 }
 }  // namespace
 
@@ -102,6 +105,7 @@ void Context::step() {
   sp.step = impl_->step;
   sp.blockSize = impl_->options.blockSize;
   sp.fused = impl_->options.fused;
+  sp.cull = impl_->options.cull;
   sp.pool = impl_->pool.get();
   for (auto& g : impl_->groups) {
     auto& gi = g->impl();
@@ -115,18 +119,32 @@ void Context::step() {
   impl_->time = impl_->timeAtDtChange + double(impl_->stepsSinceDtChange) * impl_->options.dt;
 }
 
-double Context::time() const { return impl_->time; }
-std::uint64_t Context::stepIndex() const { return impl_->step; }
-double Context::timeStep() const { return impl_->options.dt; }
+double Context::time() const {
+  return impl_->time;
+}
+std::uint64_t Context::stepIndex() const {
+  return impl_->step;
+}
+double Context::timeStep() const {
+  return impl_->options.dt;
+}
 void Context::setTimeStep(double dt) {
   checkDt(dt);
   impl_->timeAtDtChange = impl_->time;
   impl_->stepsSinceDtChange = 0;
   impl_->options.dt = dt;
 }
-unsigned Context::threads() const { return impl_->pool->size(); }
-std::uint64_t Context::seed() const { return impl_->options.seed; }
-Backend Context::backend() const { return impl_->backendKind; }
-const ContextOptions& Context::options() const { return impl_->options; }
+unsigned Context::threads() const {
+  return impl_->pool->size();
+}
+std::uint64_t Context::seed() const {
+  return impl_->options.seed;
+}
+Backend Context::backend() const {
+  return impl_->backendKind;
+}
+const ContextOptions& Context::options() const {
+  return impl_->options;
+}
 
 }  // namespace flurry

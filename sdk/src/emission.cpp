@@ -23,11 +23,14 @@ constexpr std::size_t kInlineMoves = 16384;     // lane elements compaction copi
 
 // Particles a rate has produced by time t: floor(rate·elapsed), with a relative guard so
 // that 10.5/s over 10 s gives 105 despite the rounding of the accumulated time.
-std::uint64_t producedBy(const Emitter& e, double t) {
-  const double elapsed = std::min(t, e.stop) - e.start;
+std::uint64_t producedByRate(double rate, double start, double stop, double t) {
+  const double elapsed = std::min(t, stop) - start;
   if (elapsed <= 0) return 0;
-  const double x = e.rate * elapsed;
+  const double x = rate * elapsed;
   return std::uint64_t(std::floor(x + 1e-9 * std::max(1.0, x)));
+}
+std::uint64_t producedBy(const Emitter& e, double t) {
+  return producedByRate(e.rate, e.start, e.stop, t);
 }
 
 std::size_t chooseType(const Emitter& e, Random& rng) {
@@ -550,6 +553,43 @@ std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, std::vector<BirthRu
     countGeneration(g, g.live[k].generation, n);
   }
   return plan.total;
+}
+
+namespace {
+// Whether planEmitter could plan a birth over (t0, t1] or change the emitter's state, for
+// an emitter (or a prime emitter counting like one) with these fields. Conservative: true
+// whenever in doubt.
+bool mayFire(double rate, const std::vector<Burst>& bursts, double start, double stop,
+             double spacing, const EmitterState& s, double t0, double t1) {
+  if (rate > 0) {
+    const double elapsed = std::min(t1, stop) - start;
+    if (elapsed > 0 && !(rate * elapsed < kExactCount)) return true;
+    if (producedByRate(rate, start, stop, t1) > s.emittedByRate) return true;
+  }
+  const double lo = std::max(t0, start);
+  for (const Burst& b : bursts) {
+    if (b.count == 0 || b.repeat == 0) continue;
+    const double last = b.time + double(b.repeat - 1) * b.interval;
+    if (!(std::max(b.time, last) < lo) && !(std::min(b.time, last) >= t1) && !(lo > stop))
+      return true;
+  }
+  return spacing > 0 && std::min(t1, stop) > lo;
+}
+}  // namespace
+
+bool mayEmit(const GroupImpl& g, const StepParams& sp) {
+  const double t0 = sp.time, t1 = sp.time + sp.dt;
+  if (!g.live.empty()) return true;
+  for (std::size_t e = 0; e < g.emitters.size(); ++e) {
+    const Emitter& em = g.emitters[e];
+    if (mayFire(em.rate, em.bursts, em.start, em.stop, em.spacing, g.emitterState[e], t0, t1))
+      return true;
+  }
+  for (std::size_t k = 0; k < g.primes.size(); ++k) {
+    const PrimeEmitter& p = g.primes[k];
+    if (mayFire(p.rate, p.bursts, p.start, p.stop, 0.0, g.primeState[k], t0, t1)) return true;
+  }
+  return false;
 }
 
 // Live emitters that died this step go after their last births are written.

@@ -119,6 +119,18 @@ struct ActionPlan {
   bool readsNeighbours = false;      ///< the pass reads a snapshot of the step's start
   std::uint32_t firstBlocker = ~0u;  ///< index of the list's first Block action
   std::vector<float> fastest;        ///< scratch: per chunk, the fastest squared speed
+  /// Per action: where it can act (planActions: actionReach). A block whose swept bounds
+  /// stay out of `lo`..`hi`, widened by the margin, is left bitwise as it was by the action.
+  struct Reach {
+    bool cullable = false;
+    float lo[3] = {}, hi[3] = {};
+    float scale = 0.0f;      ///< max |coordinate| of the box, for the rounding margin
+    float quadratic = 0.0f;  ///< margin term in scale² (a sphere's grazing roots)
+  };
+  std::vector<Reach> reach;
+  /// Per action: it may change positions or velocities (the bounds must be taken again).
+  std::vector<std::uint8_t> moves;
+  bool cullable = false;  ///< some action has a finite reach
 };
 
 struct GroupImpl;
@@ -150,10 +162,11 @@ struct GroupImpl {
   std::uint32_t nextId = 0;
 
   // Scratch reused every step (no allocation per step).
-  std::vector<std::uint32_t> deadIndex;  ///< per block: [block*B, block*B + deadCount[block])
-  std::vector<std::uint8_t> deadCode;    ///< 1 + index of the action that killed
-  std::vector<std::uint32_t> deadCount;  ///< per block
-  std::vector<std::uint32_t> holes;      ///< sorted dead indices of this step
+  std::vector<std::uint32_t> deadIndex;    ///< per block: [block*B, block*B + deadCount[block])
+  std::vector<std::uint8_t> deadCode;      ///< 1 + index of the action that killed
+  std::vector<std::uint32_t> deadCount;    ///< per block
+  std::vector<std::uint32_t> culledCount;  ///< per block: actions the fused pass skipped
+  std::vector<std::uint32_t> holes;        ///< sorted dead indices of this step
   /// This step's newborns, written before the act pass: [bornFirst, bornFirst + bornCount),
   /// each with the part of the step it still has to live (seconds, bornRemaining[r]), which
   /// the pass runs it through the action list for.

@@ -27,6 +27,11 @@ struct ContextOptions {
   /// false runs one pass over the whole group per action: the unfused baseline that the
   /// benchmarks compare against. Results are identical either way.
   bool fused = true;
+  /// CPU fused pass: skips an action with a finite reach (a deflector on a finite piece, an
+  /// absorber, a blocker, a force's falloff radius) for a block of particles that cannot
+  /// reach it this step. Exact: results are bitwise the same either way; false is for
+  /// comparisons.
+  bool cull = true;
 };
 
 class Context {

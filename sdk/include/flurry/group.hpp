@@ -79,6 +79,12 @@ struct GroupStats {
     double compact = 0.0;
   };
   StepSeconds stepSeconds;
+  /// Steps the CPU backend skipped because the group was idle: no live particles and no
+  /// emitter that would fire (such a step changes nothing and costs no pass).
+  std::uint64_t idleSteps = 0;
+  /// Blocks × actions the CPU fused pass skipped because no particle of the block could
+  /// reach the action this step (ContextOptions::cull; blocks of about 1024 particles).
+  std::uint64_t blockActionsCulled = 0;
 };
 
 struct Bounds {

@@ -1,4 +1,6 @@
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <utility>
 #include <vector>
 
@@ -17,6 +19,108 @@ bool isTimeFree(const Action& a) {
          std::holds_alternative<RandomRotVelocity>(a) || std::holds_alternative<SpeedClamp>(a) ||
          std::holds_alternative<ColorOverLife>(a) || std::holds_alternative<SizeOverLife>(a) ||
          std::holds_alternative<Constrain2D>(a) || std::holds_alternative<CopyVertexB>(a);
+}
+// The axis-aligned box a shape lies in; false for unbounded shapes (plane) and for those
+// whose tests are not confined to their bounds exactly enough to rely on (mesh, union).
+bool shapeBox(const Domain& d, Vec3& lo, Vec3& hi) {
+  const auto& s = d.shape();
+  auto points = [&](std::initializer_list<Vec3> ps, float r) {
+    lo = Vec3(kInfinity);
+    hi = Vec3(-kInfinity);
+    for (const Vec3& p : ps) {
+      lo = glm::min(lo, p);
+      hi = glm::max(hi, p);
+    }
+    lo -= Vec3(r);
+    hi += Vec3(r);
+    return true;
+  };
+  if (const auto* x = std::get_if<PointDomain>(&s)) return points({x->p}, 0.0f);
+  if (const auto* x = std::get_if<LineDomain>(&s)) return points({x->p0, x->p1}, 0.0f);
+  if (const auto* x = std::get_if<TriangleDomain>(&s)) return points({x->p0, x->p1, x->p2}, 0.0f);
+  if (const auto* x = std::get_if<RectangleDomain>(&s))
+    return points({x->origin, x->origin + x->u, x->origin + x->v, x->origin + x->u + x->v}, 0.0f);
+  if (const auto* x = std::get_if<DiscDomain>(&s)) return points({x->center}, x->outerRadius);
+  if (const auto* x = std::get_if<BoxDomain>(&s)) return points({x->min, x->max}, 0.0f);
+  if (const auto* x = std::get_if<SphereDomain>(&s)) return points({x->center}, x->outerRadius);
+  if (const auto* x = std::get_if<CylinderDomain>(&s))
+    return points({x->p0, x->p1}, x->outerRadius);
+  if (const auto* x = std::get_if<ConeDomain>(&s))
+    return points({x->apex, x->base}, x->outerRadius);
+  if (const auto* x = std::get_if<BlobDomain>(&s)) return points({x->center}, x->stddev);
+  return false;
+}
+
+bool finiteFalloff(const Falloff& f) {
+  return f.radius > 0.0f && f.radius < kInfinity && f.power > 0.0f;
+}
+
+// Where action k can change a particle, as a box: a particle whose path over the step (its
+// straight segment p .. p + v·dt) stays out of it, by the rounding margin, is left bitwise
+// as it was (each case below was checked against its loop in kernels.hpp and
+// actions_more.hpp). Actions that act everywhere, or whose untouched particles are not
+// bitwise untouched, have none.
+ActionPlan::Reach actionReach(const Action& a, const ActionPlan& plan, std::size_t k) {
+  ActionPlan::Reach r;
+  Vec3 lo, hi;
+  bool box = false;
+  if (const auto* b = std::get_if<Bounce>(&a)) {
+    // Pieces and closed shapes; not a box keeping particles in (it acts on those outside),
+    // nor one bounced on the curved path (its reach grows with the acceleration).
+    const auto& s = b->surface.shape();
+    const bool piece = std::holds_alternative<RectangleDomain>(s) ||
+                       std::holds_alternative<TriangleDomain>(s) ||
+                       std::holds_alternative<DiscDomain>(s);
+    const bool sphere = std::holds_alternative<SphereDomain>(s);
+    const bool outerBox = std::holds_alternative<BoxDomain>(s) && !b->inside;
+    if (!plan.curvedBy[k] && (piece || sphere || outerBox)) box = shapeBox(b->surface, lo, hi);
+    // A grazing path's root is found to about sqrt(eps)·|p - c|: the margin grows as
+    // scale²/R, not with the scale alone.
+    if (sphere && box)
+      r.quadratic = 1e-6f / std::max(std::get<SphereDomain>(s).outerRadius, 1e-30f);
+  } else if (const auto* s = std::get_if<Sink>(&a)) {
+    using M = Sink::Mode;
+    const bool killsOutside =
+        (s->mode == M::Inside && !s->killInside) || (s->mode == M::Outside && s->killInside);
+    if (!killsOutside) box = shapeBox(s->region, lo, hi);
+  } else if (const auto* b = std::get_if<Block>(&a)) {
+    box = shapeBox(b->region, lo, hi);  // the first blocker's reset is done when culled
+  } else if (const auto* g = std::get_if<Gravity>(&a)) {
+    // Outside the radius the weight is +0: v + a·(dt·0) (run when culled, for -0's sake).
+    if (finiteFalloff(g->falloff)) {
+      box = true;
+      lo = g->falloff.center - Vec3(g->falloff.radius);
+      hi = g->falloff.center + Vec3(g->falloff.radius);
+    }
+  } else if (const auto* d = std::get_if<Damping>(&a)) {
+    // Outside the radius v·exp(±0) = v, while rate·dt is finite.
+    const Vec3 rate = d->rate;
+    const bool finite = std::max({std::abs(rate.x), std::abs(rate.y), std::abs(rate.z)}) < 1e30f;
+    if (finiteFalloff(d->falloff) && finite) {
+      box = true;
+      lo = d->falloff.center - Vec3(d->falloff.radius);
+      hi = d->falloff.center + Vec3(d->falloff.radius);
+    }
+  }
+  if (!box) return r;
+  float scale = 0.0f;
+  for (int c = 0; c < 3; ++c) {
+    r.lo[c] = lo[c];
+    r.hi[c] = hi[c];
+    scale = std::max({scale, std::abs(lo[c]), std::abs(hi[c])});
+  }
+  r.scale = scale;
+  r.cullable = std::isfinite(scale);
+  return r;
+}
+
+// Whether action `a` may change positions or velocities.
+bool movesParticles(const Action& a) {
+  return !(std::holds_alternative<KillOld>(a) || std::holds_alternative<Sink>(a) ||
+           std::holds_alternative<SinkVelocity>(a) || std::holds_alternative<Block>(a) ||
+           std::holds_alternative<ColorOverLife>(a) || std::holds_alternative<SizeOverLife>(a) ||
+           std::holds_alternative<TargetColor>(a) || std::holds_alternative<TargetSize>(a) ||
+           std::holds_alternative<CopyVertexB>(a));
 }
 }  // namespace
 
@@ -64,6 +168,14 @@ const ActionPlan& planActions(GroupImpl& g) {
       plan.firstBlocker = std::uint32_t(k);
       break;
     }
+  plan.reach.assign(acts.size(), {});
+  plan.moves.assign(acts.size(), 0);
+  plan.cullable = false;
+  for (std::size_t k = 0; k < acts.size(); ++k) {
+    plan.reach[k] = actionReach(acts[k], plan, k);
+    plan.moves[k] = movesParticles(acts[k]);
+    plan.cullable |= plan.reach[k].cullable;
+  }
   plan.version = g.actionsVersion;
   return plan;
 }
@@ -73,6 +185,15 @@ class CpuBackend final : public BackendImpl {
  public:
   const char* name() const override { return "cpu"; }
   void step(GroupImpl& group, const StepParams& params) override {
+    // Idle: nothing alive and no emitter that will fire. Such a step would change nothing
+    // (its emitters' state included), so it costs no pass, no clock and no worker.
+    if (group.size == 0 && !group.hair.enabled && !mayEmit(group, params)) {
+      // What a step's planning would have done: count generation 0 (see planBirths).
+      if (!group.emitters.empty() && group.stats.emittedByGeneration.empty())
+        group.stats.emittedByGeneration.assign(1, 0);
+      ++group.stats.idleSteps;
+      return;
+    }
     // Each part's time, for GroupStats::stepSeconds.
     using Clock = std::chrono::steady_clock;
     auto last = Clock::now();

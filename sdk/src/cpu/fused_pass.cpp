@@ -100,13 +100,101 @@ void guard(const Bounce& b, const Lanes& L, const float* const* start, std::size
   }
 }
 
-// Runs actions [first, last) of the list over one block, as the plan says.
+// Spatial culling of one block over one sub-step: the block's swept bounds, taken when an
+// action with a finite reach is reached and kept until an action that moves particles runs.
+struct Culler {
+  bool valid = false;
+  bool finite = false;  // no NaN or infinity in the block: the bounds mean something
+  float lo[3], hi[3];
+  float scale = 0.0f;
+  std::uint32_t culled = 0;
+
+  // The box the block's straight paths p .. p + v·dt lie in.
+  void gather(const Lanes& L, std::size_t n, float dt) {
+    constexpr std::size_t W = 16;  // independent lanes: the loops vectorise without -ffast-math
+    float check = 0.0f;
+    scale = 0.0f;
+    for (int c = 0; c < 3; ++c) {
+      const float* __restrict p = L.p[c];
+      const float* __restrict v = L.v[c];
+      float mn[W], mx[W], sp[W], ck[W];
+      for (std::size_t j = 0; j < W; ++j)
+        mn[j] = kInfinity, mx[j] = -kInfinity, sp[j] = 0.0f, ck[j] = 0.0f;
+      std::size_t i = 0;
+      for (; i + W <= n; i += W)
+        for (std::size_t j = 0; j < W; ++j) {
+          const float x = p[i + j], s = std::abs(v[i + j]);
+          mn[j] = x < mn[j] ? x : mn[j];
+          mx[j] = x > mx[j] ? x : mx[j];
+          sp[j] = s > sp[j] ? s : sp[j];
+          ck[j] += (x - x) + (s - s);  // NaN if x or s is NaN or infinite
+        }
+      for (std::size_t j = 0; i < n; ++i, ++j) {
+        const float x = p[i], s = std::abs(v[i]);
+        mn[j] = x < mn[j] ? x : mn[j];
+        mx[j] = x > mx[j] ? x : mx[j];
+        sp[j] = s > sp[j] ? s : sp[j];
+        ck[j] += (x - x) + (s - s);
+      }
+      float a = kInfinity, b = -kInfinity, s = 0.0f;
+      for (std::size_t j = 0; j < W; ++j) {
+        a = std::min(a, mn[j]);
+        b = std::max(b, mx[j]);
+        s = std::max(s, sp[j]);
+        check += ck[j];
+      }
+      lo[c] = a - s * dt;
+      hi[c] = b + s * dt;
+      scale = std::max({scale, std::abs(lo[c]), std::abs(hi[c])});
+    }
+    finite = check == 0.0f && std::isfinite(scale);
+    valid = true;
+  }
+
+  // Whether no particle of the block can reach `r`: the boxes are apart by more than the
+  // rounding of the action's own tests, which is far below this margin.
+  bool apart(const ActionPlan::Reach& r) const {
+    if (!finite) return false;
+    const float s = scale + r.scale;
+    const float margin = 1e-4f * (1.0f + s) + r.quadratic * s * s;
+    bool out = false;
+    for (int c = 0; c < 3; ++c) out |= (lo[c] - margin > r.hi[c]) || (hi[c] + margin < r.lo[c]);
+    return out;
+  }
+};
+
+// What a culled action still does to particles out of its reach (to stay bitwise exact).
+void applyCulled(const Action& a, const Lanes& L, std::size_t n, const cpu::BlockContext& c) {
+  if (const auto* g = std::get_if<Gravity>(&a)) {
+    // The kernel's v + a·(dt·w) with w = +0: turns -0 into +0 where a's component is >= +0.
+    const float z = c.dt * 0.0f;
+    cpu::addLoop(L.v[0], L.v[1], L.v[2], n, g->acceleration.x * z, g->acceleration.y * z,
+                 g->acceleration.z * z);
+  } else if (std::holds_alternative<Block>(a) && c.action == c.firstBlocker) {
+    std::fill_n(L.visible, n, 1u);  // the first blocker starts from "visible"
+  }
+}
+
+// Runs actions [first, last) of the list over one block, as the plan says; skips those
+// that `cull` (null: never) finds out of the block's reach.
 void runActions(const std::vector<Action>& acts, const Plan& plan, std::size_t first,
-                std::size_t last, const Lanes& lanes, std::size_t n, cpu::BlockContext ctx) {
+                std::size_t last, const Lanes& lanes, std::size_t n, cpu::BlockContext ctx,
+                Culler* cull = nullptr) {
   thread_local cpu::IntegratorScratch scratchStore;
   for (std::size_t k = first; k < last; ++k) {
     ctx.action = std::uint32_t(k);
     if (plan.list.gathered[k]) continue;  // evaluated inside its Move
+    if (cull) {
+      if (plan.list.reach[k].cullable) {
+        if (!cull->valid) cull->gather(lanes, n, ctx.dt);
+        if (cull->apart(plan.list.reach[k])) {
+          applyCulled(acts[k], lanes, n, ctx);
+          ++cull->culled;
+          continue;
+        }
+      }
+      if (plan.list.moves[k]) cull->valid = false;  // taken again when next needed
+    }
     if (plan.list.integrator != Integrator::SemiImplicitEuler &&
         std::holds_alternative<Move>(acts[k])) {
       cpu::IntegratorScratch& scratch = scratchStore;
@@ -196,8 +284,10 @@ void runNewborns(const std::vector<Action>& acts, const Plan& plan, std::size_t 
 // particles from `old` on are this step's newborns.
 void runBlock(const std::vector<Action>& acts, const Plan& plan, std::size_t first,
               std::size_t last, const Lanes& lanes, std::size_t m, std::size_t old,
-              const cpu::BlockContext& ctx, const float* remaining, std::uint32_t sub, double t1) {
-  if (old > 0) runActions(acts, plan, first, last, lanes, old, ctx);
+              const cpu::BlockContext& ctx, const float* remaining, std::uint32_t sub, double t1,
+              Culler* cull = nullptr) {
+  // Newborns (the block's tail from `old` on) are never culled.
+  if (old > 0) runActions(acts, plan, first, last, lanes, old, ctx, cull);
   if (old == m) return;
   cpu::BlockContext c = ctx;
   c.base += old;
@@ -275,6 +365,7 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
   g.deadIndex.resize(n);
   g.deadCode.resize(n);
   g.deadCount.assign(blocks, 0);
+  g.culledCount.assign(blocks, 0);
   const Lanes lanes = g.lanePointers();
   Plan plan{planActions(g), substepCount(g, sp, *sp.pool)};
   if (plan.list.guarded) {
@@ -327,6 +418,8 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
     return c;
   };
 
+  // Culling needs velocities for the swept bounds (a list that moves nothing has none).
+  const bool cull = sp.cull && plan.list.cullable && lanes.v[0];
   if (sp.fused) {
     sp.pool->parallelFor(tasks, [&](std::size_t t) {
       thread_local std::vector<std::uint32_t> deadStore;
@@ -341,9 +434,12 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
         ctx.dead = dead.data();
         const Lanes blockLanes = lanes.offset(first);
         const std::size_t old = oldIn(first, m);
-        for (std::uint32_t s = 0; s < plan.substeps; ++s)
+        for (std::uint32_t s = 0; s < plan.substeps; ++s) {
+          Culler culler;  // the sub-step's own bounds
           runBlock(acts, plan, 0, acts.size(), blockLanes, m, old, atSubstep(ctx, s),
-                   remainingAt(first, old), s, t1);
+                   remainingAt(first, old), s, t1, cull ? &culler : nullptr);
+          g.culledCount[b] += culler.culled;
+        }
         guardFinite(blockLanes, m, dead.data());
         g.deadCount[b] = collectDead(g, first, m, dead.data());
       }
@@ -375,6 +471,7 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
   }
 
   for (std::size_t b = 0; b < blocks; ++b) {
+    g.stats.blockActionsCulled += g.culledCount[b];
     const std::uint32_t* idx = g.deadIndex.data() + b * B;
     const std::uint8_t* code = g.deadCode.data() + b * B;
     for (std::uint32_t j = 0; j < g.deadCount[b]; ++j) {
