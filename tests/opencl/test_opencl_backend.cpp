@@ -197,7 +197,7 @@ TEST(OpenCLBackend, TheGeneratedKernelTouchesOnlyTheListsAttributes) {
   AttributeSet stored{Attribute::Position, Attribute::Id, Attribute::Velocity, Attribute::Color,
                       Attribute::Age};
   const std::string src = detail::ocl::programSource(list, stored, true);
-  const auto act = src.substr(src.find("__kernel void fl_act("));
+  const auto act = src.substr(src.find("void fl_act_one("));  // the body fl_act calls
   EXPECT_NE(act.find("l_vx"), std::string::npos);
   EXPECT_NE(act.find("l_age"), std::string::npos);  // Move ages the stored age
   EXPECT_EQ(act.find("l_r["), std::string::npos);   // color: stored, but no action uses it
@@ -281,4 +281,16 @@ TEST(OpenCLBackend, HostLaneAccessDoesNotRebuildTheProgram) {
   EXPECT_EQ(after.diskHits, before.diskHits);
   EXPECT_EQ(after.memoryHits, before.memoryHits);
   EXPECT_GT(g.size(), 0u);
+}
+
+// fl_act and fl_small share one act function: the program holds the list's body once
+// (PoCL compiles less; issue #11).
+TEST(OpenCLBackend, TheActBodyIsInTheProgramOnce) {
+  const ActionList list{Gravity{Vec3(0.0f, -1.0f, 0.0f)}, Move{}, KillOld{}};
+  const std::string src = detail::ocl::programSource(
+      list, {Attribute::Position, Attribute::Id, Attribute::Velocity, Attribute::Age}, true);
+  ASSERT_NE(src.find("__kernel void fl_small("), std::string::npos);
+  const auto first = src.find("fl_gravity((ap + 0)");
+  ASSERT_NE(first, std::string::npos);
+  EXPECT_EQ(src.find("fl_gravity((ap + 0)", first + 1), std::string::npos);
 }
