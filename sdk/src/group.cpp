@@ -32,13 +32,16 @@ LaneBuffer::LaneBuffer(std::size_t count) : count_(count) {
   const std::size_t align = huge ? kHugePage : 64;
   bytes = (bytes + align - 1) / align * align;
   data_ = std::aligned_alloc(align, bytes);
-  if (!data_) throw Error("out of memory allocating " + std::to_string(bytes) + " bytes of particles");
+  if (!data_)
+    throw Error("out of memory allocating " + std::to_string(bytes) + " bytes of particles");
 #ifdef MADV_HUGEPAGE
   if (huge) madvise(data_, bytes, MADV_HUGEPAGE);  // a hint; failure only costs speed
 #endif
 }
 
-LaneBuffer::~LaneBuffer() { std::free(data_); }
+LaneBuffer::~LaneBuffer() {
+  std::free(data_);
+}
 
 LaneBuffer& LaneBuffer::operator=(LaneBuffer&& o) noexcept {
   if (this != &o) {
@@ -209,13 +212,19 @@ void GroupImpl::ensureStorage() {
 Group::Group(std::unique_ptr<detail::GroupImpl> impl) : impl_(std::move(impl)) {}
 Group::~Group() = default;
 
-const std::string& Group::name() const { return impl_->name; }
+const std::string& Group::name() const {
+  return impl_->name;
+}
 std::size_t Group::size() const {
   impl_->syncHost();
   return impl_->size;
 }
-std::size_t Group::capacity() const { return impl_->capacity; }
-AttributeSet Group::attributes() const { return impl_->wanted(); }
+std::size_t Group::capacity() const {
+  return impl_->capacity;
+}
+AttributeSet Group::attributes() const {
+  return impl_->wanted();
+}
 
 void Group::require(AttributeSet attributes) {
   impl_->syncHost();
@@ -234,26 +243,35 @@ Group& Group::setActions(ActionList actions) {
   return *this;
 }
 
-const ActionList& Group::actions() const { return impl_->actions; }
+const ActionList& Group::actions() const {
+  return impl_->actions;
+}
 
 Emitter& Group::addEmitter(Emitter emitter) {
   emitter.validate("emitters[" + std::to_string(impl_->emitters.size()) + "]");
   impl_->emitters.push_back(std::move(emitter));
   impl_->emitterState.emplace_back();
+  ++impl_->emittersVersion;
   return impl_->emitters.back();
 }
 
-std::span<Emitter> Group::emitters() { return impl_->emitters; }
+std::span<Emitter> Group::emitters() {
+  ++impl_->emittersVersion;  // the caller may edit through the span
+  return impl_->emitters;
+}
 
 PrimeEmitter& Group::addPrimeEmitter(PrimeEmitter prime) {
   prime.validate("primeEmitters[" + std::to_string(impl_->primes.size()) + "]");
   impl_->primes.push_back(std::move(prime));
   impl_->primeState.emplace_back();
   impl_->primeLive.push_back(0);
+  ++impl_->emittersVersion;
   return impl_->primes.back();
 }
 
-std::size_t Group::liveEmitterCount() const { return impl_->live.size(); }
+std::size_t Group::liveEmitterCount() const {
+  return impl_->live.size();
+}
 
 Group& Group::setHair(HairOptions options) {
   if (options.every == 0) throw InvalidArgument("hair.every", "must be >= 1");
@@ -265,12 +283,16 @@ Group& Group::setHair(HairOptions options) {
   return *this;
 }
 
-const HairOptions& Group::hair() const { return impl_->hair; }
+const HairOptions& Group::hair() const {
+  return impl_->hair;
+}
 const Strands& Group::strands() const {
   impl_->syncHost();
   return impl_->strands;
 }
-void Group::clearStrands() { impl_->strands.clear(); }
+void Group::clearStrands() {
+  impl_->strands.clear();
+}
 
 bool Group::add(const Particle& p) {
   auto& g = *impl_;
@@ -297,8 +319,8 @@ bool Group::add(const Particle& p) {
 Particle Group::particle(std::size_t i) const {
   impl_->syncHost();
   if (i >= impl_->size)
-    throw InvalidArgument("index", std::to_string(i) + " is past the live count " +
-                                       std::to_string(impl_->size));
+    throw InvalidArgument(
+        "index", std::to_string(i) + " is past the live count " + std::to_string(impl_->size));
   return impl_->read(i);
 }
 
@@ -311,8 +333,8 @@ void checkFloatLane(const detail::GroupImpl& g, Attribute a, int component) {
     throw InvalidArgument("component", "attribute " + std::string(attributeName(a)) + " has " +
                                            std::to_string(componentCount(a)) + " components");
   if (!g.stored.has(a))
-    throw Error("group '" + g.name + "' does not store attribute " +
-                std::string(attributeName(a)) + " (call require() first)");
+    throw Error("group '" + g.name + "' does not store attribute " + std::string(attributeName(a)) +
+                " (call require() first)");
 }
 }  // namespace
 

@@ -148,6 +148,9 @@ struct GroupImpl {
   ActionList actions;   ///< replace through Group::setActions, which bumps actionsVersion
   std::uint64_t actionsVersion = 0;
   std::vector<Emitter> emitters;
+  /// Bumped wherever the emitters or prime emitters may change (addEmitter, emitters(),
+  /// addPrimeEmitter): the OpenCL backend rebuilds what it derives from them only then.
+  std::uint64_t emittersVersion = 0;
   std::vector<EmitterState> emitterState;
   std::vector<PrimeEmitter> primes;
   std::vector<EmitterState> primeState;

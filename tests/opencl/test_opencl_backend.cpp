@@ -197,7 +197,7 @@ TEST(OpenCLBackend, TheGeneratedKernelTouchesOnlyTheListsAttributes) {
   AttributeSet stored{Attribute::Position, Attribute::Id, Attribute::Velocity, Attribute::Color,
                       Attribute::Age};
   const std::string src = detail::ocl::programSource(list, stored, true);
-  const auto act = src.substr(src.find("__kernel void fl_act("));
+  const auto act = src.substr(src.find("void fl_act_one("));  // the body fl_act calls
   EXPECT_NE(act.find("l_vx"), std::string::npos);
   EXPECT_NE(act.find("l_age"), std::string::npos);  // Move ages the stored age
   EXPECT_EQ(act.find("l_r["), std::string::npos);   // color: stored, but no action uses it
@@ -205,4 +205,92 @@ TEST(OpenCLBackend, TheGeneratedKernelTouchesOnlyTheListsAttributes) {
   EXPECT_NE(act.find("FL_NON_FINITE_CODE"), std::string::npos);
   EXPECT_NE(act.find("fl_gravity((ap + 0)"), std::string::npos);
   EXPECT_NE(act.find("fl_move("), std::string::npos);
+}
+
+// What the backend keeps between steps (packed constants, emitter codes, the emission
+// tables on the device) follows every edit between steps: a new action list of the same
+// shape, a new dt, emitters edited through emitters() and through a kept reference, a
+// prime emitter added (whose children need a new program: two programs in all, as each
+// costs seconds to compile cold). The device matches the CPU throughout (issue #11).
+TEST(OpenCLBackend, EditsBetweenStepsTakeEffect) {
+  FLURRY_REQUIRE_OPENCL();
+  auto run = [](Backend b) {
+    ContextOptions o = openclOptions();
+    o.backend = b;
+    Context ctx(o);
+    Group& g = ctx.createGroup("g", 4000);
+    Emitter e;
+    e.shape = Domain::sphere(Vec3(0.0f), 0.5f);
+    ParticleType t;
+    t.velocity = Domain::point(Vec3(0.0f, 1.0f, 0.0f));
+    t.lifetime = 100.0f;
+    e.types = {t};
+    e.rate = 120.0;
+    Emitter& kept = g.addEmitter(e);
+    g.setActions({Gravity{Vec3(0.0f, -1.0f, 0.0f)}, Move{}});
+    ctx.run(4);
+    g.setActions({Gravity{Vec3(0.0f, 3.0f, 0.0f)}, Move{}});  // same program, new constants
+    ctx.run(4);
+    ctx.setTimeStep(1.0 / 50.0);  // constants made with dt
+    ctx.run(4);
+    g.emitters()[0].shape = Domain::sphere(Vec3(5.0f, 0.0f, 0.0f), 0.5f);  // new numbers
+    ctx.run(4);
+    kept.position = Vec3(0.0f, 0.0f, -3.0f);  // through the reference addEmitter returned
+    kept.shape = Domain::sphere(Vec3(1.0f, 0.0f, 0.0f), 0.25f);
+    ctx.run(4);
+    PrimeEmitter prime;  // its children's code is new to the program
+    prime.rate = 20.0;
+    prime.child.lifetime = 0.2f;
+    prime.child.emitter.rate = 100.0;
+    prime.child.emitter.shape = Domain::box(Vec3(-1.0f), Vec3(1.0f));
+    prime.child.emitter.types = {t};
+    g.addPrimeEmitter(prime);
+    ctx.run(6);
+    std::map<std::uint32_t, std::pair<Vec3, Vec3>> out;
+    for (std::size_t i = 0; i < g.size(); ++i) {
+      const Particle p = g.particle(i);
+      out[p.id] = {p.position, p.velocity};
+    }
+    return out;
+  };
+  const auto cpu = run(Backend::Cpu);
+  const auto cl = run(Backend::OpenCL);
+  ASSERT_EQ(cpu.size(), cl.size());
+  for (const auto& [id, pv] : cpu) {
+    ASSERT_TRUE(cl.count(id)) << id;
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(pv.first[c], cl.at(id).first[c], 1e-4f) << id;
+      EXPECT_NEAR(pv.second[c], cl.at(id).second[c], 1e-4f) << id;
+    }
+  }
+}
+
+// The host writing particles between steps sends them to the device, and nothing more: the
+// program is neither built again nor fetched from the cache (issue #11).
+TEST(OpenCLBackend, HostLaneAccessDoesNotRebuildTheProgram) {
+  FLURRY_REQUIRE_OPENCL();
+  Context ctx(openclOptions());
+  Group& g = samples::buildFountain(ctx, 10000, 2000, 2.0f);
+  ctx.run(3);
+  auto y = g.lane(Attribute::Position, 1);  // writable: the device takes the host's copy
+  for (float& v : y) v += 1.0f;
+  const auto before = detail::ocl::Runtime::cacheStats();
+  ctx.run(3);
+  const auto after = detail::ocl::Runtime::cacheStats();
+  EXPECT_EQ(after.builds, before.builds);
+  EXPECT_EQ(after.diskHits, before.diskHits);
+  EXPECT_EQ(after.memoryHits, before.memoryHits);
+  EXPECT_GT(g.size(), 0u);
+}
+
+// fl_act and fl_small share one act function: the program holds the list's body once
+// (PoCL compiles less; issue #11).
+TEST(OpenCLBackend, TheActBodyIsInTheProgramOnce) {
+  const ActionList list{Gravity{Vec3(0.0f, -1.0f, 0.0f)}, Move{}, KillOld{}};
+  const std::string src = detail::ocl::programSource(
+      list, {Attribute::Position, Attribute::Id, Attribute::Velocity, Attribute::Age}, true);
+  ASSERT_NE(src.find("__kernel void fl_small("), std::string::npos);
+  const auto first = src.find("fl_gravity((ap + 0)");
+  ASSERT_NE(first, std::string::npos);
+  EXPECT_EQ(src.find("fl_gravity((ap + 0)", first + 1), std::string::npos);
 }

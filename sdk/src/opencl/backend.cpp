@@ -22,7 +22,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <deque>
 #include <limits>
 #include <map>
 
@@ -74,12 +73,40 @@ struct Shared {
 namespace {
 
 // A step queued on the device: its state is read back into `state` when `done` fires.
+// Slots are reused (a ring): their vectors keep their capacity, so a steady step allocates
+// nothing; a slot's blob and state stay untouched until its step retires, as the queued
+// non-blocking transfers read and write them.
 struct InFlight {
   Event done;
   std::vector<std::uint32_t> state;
   std::uint64_t births = 0;
   StepTables tables;
-  std::vector<std::uint64_t> blob;  // the tables back to back: the step's one write reads it
+  std::vector<std::uint64_t> blob;  // the tables back to back: the step's writes read it
+};
+
+// Steps in flight, oldest first, in slots that are reused.
+class InFlightRing {
+ public:
+  explicit InFlightRing(std::size_t slots) : slots_(slots) {}
+  bool empty() const { return count_ == 0; }
+  std::size_t size() const { return count_; }
+  InFlight& front() { return slots_[head_]; }
+  InFlight& operator[](std::size_t k) { return slots_[(head_ + k) % slots_.size()]; }
+  /// The next free slot; push() makes it the newest step.
+  InFlight& next() { return slots_[(head_ + count_) % slots_.size()]; }
+  void push() { ++count_; }
+  void pop() {
+    slots_[head_].done = Event();
+    head_ = (head_ + 1) % slots_.size();
+    --count_;
+  }
+  void clear() {
+    while (!empty()) pop();
+  }
+
+ private:
+  std::vector<InFlight> slots_;
+  std::size_t head_ = 0, count_ = 0;
 };
 
 struct DeviceLane {
@@ -188,6 +215,14 @@ class ClGroup final : public DeviceMirror {
   ActionList programActions_;
   bool programValid_ = false;
   std::string emitterSignature_;
+  EmitterCodes emitterCodes_;  // the program's emitter codes, and the planning's scratch
+  // The action constants as last packed: for actionsVersion and the step's dt (its bits).
+  std::uint64_t packedVersion_ = ~std::uint64_t(0);
+  std::uint32_t packedDt_ = 0;
+  // The emission tables' blob: runs first, in room for runsRoom_ runs, then the emitters'
+  // part, which is written only when it differs from what the device holds (staticUploaded_).
+  std::size_t runsRoom_ = 0;
+  std::vector<std::uint64_t> staticUploaded_;
   bool hairProgram_ = false;  // the program has fl_hair
   Kernel hair_, small_;
   GrowBuffer strandP_, strandC_, strandR_, strandCount_;
@@ -200,7 +235,7 @@ class ClGroup final : public DeviceMirror {
 
   std::vector<std::pair<std::string, Event>> profiled_;
   std::map<std::string, std::pair<double, std::uint64_t>> profile_;
-  std::deque<InFlight> inFlight_;
+  InFlightRing inFlight_{kMaxInFlight + 1};
   std::size_t size_ = 0;  // the device's live count at the last completed step
   std::uint32_t nextId_ = 0;
   std::uint32_t lastDropped_ = 0;
@@ -256,9 +291,10 @@ void ClGroup::allocate(GroupImpl& g) {
 }
 
 void ClGroup::buildProgram(GroupImpl& g) {
-  const GeneratedProgram gen =
-      generateProgram(g.actions, g.stored, shared_->fp64(), emissionSource(g), g.hair.enabled);
-  emitterSignature_ = emitterSignature(g);
+  // The emitter codes this step refreshed: the program and the planning agree on them.
+  const GeneratedProgram gen = generateProgram(
+      g.actions, g.stored, shared_->fp64(), emissionSource(emitterCodes_.variants), g.hair.enabled);
+  emitterSignature_ = emitterSignature(emitterCodes_.variants);
   Program p(shared_->runtime->program(gen.source, gen.options));
   cl_int err = CL_SUCCESS;
   auto kernel = [&](const char* name) {
@@ -326,6 +362,7 @@ void ClGroup::buildProgram(GroupImpl& g) {
   }
   params_uploaded_.clear();
   extra_uploaded_.clear();
+  packedVersion_ = ~std::uint64_t(0);
 }
 
 void ClGroup::upload(GroupImpl& g) {
@@ -405,7 +442,7 @@ void ClGroup::retire(GroupImpl& g, bool wait) {
   }
   if (status != CL_COMPLETE) return;
   apply(g, f.state);
-  inFlight_.pop_front();
+  inFlight_.pop();
 }
 
 void ClGroup::queueHair(GroupImpl& g, const StepParams& sp, std::size_t births) {
@@ -494,48 +531,58 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     allocate(g);
     hostDirty_ = true;
   }
-  if (hostDirty_) {
-    upload(g);
-    programValid_ = false;
-  }
+  // The host's particles go up; the program's buffers stay the same (no rebuild).
+  if (hostDirty_) upload(g);
   // Emitters may be edited at any time (Group::emitters()); the program follows their kinds.
-  if (programValid_ && (emitterSignature(g) != emitterSignature_ || g.hair.enabled != hairProgram_))
+  // Their codes are rebuilt only when the group says its emitters may have changed.
+  if (emitterCodes_.refresh(g) && programValid_ &&
+      emitterSignature(emitterCodes_.variants) != emitterSignature_)
     programValid_ = false;
+  if (g.hair.enabled != hairProgram_) programValid_ = false;
   if (!programValid_) buildProgram(g);
 
-  packActions(g.actions, float(sp.dt), params_host_, extra_host_);
-  const std::size_t paramBytes = params_host_.size() * sizeof(cl::FlActionParams);
-  if (params_uploaded_.size() != params_host_.size() ||
-      std::memcmp(params_uploaded_.data(), params_host_.data(), paramBytes) != 0) {
-    drain(g);  // steps in flight read the buffer
-    params_.reserve(context(), paramBytes, CL_MEM_READ_ONLY);
-    check(clEnqueueWriteBuffer(queue(), params_.mem.get(), CL_TRUE, 0, paramBytes,
-                               params_host_.data(), 0, nullptr, nullptr),
-          "clEnqueueWriteBuffer (action parameters)");
-    params_uploaded_ = params_host_;
-  }
-  // Compared as bytes: the floats hold integers and doubles as bit patterns (NaN patterns
-  // among them), so a comparison of values could never say equal, or miss a -0.
-  if (extra_uploaded_.size() != extra_host_.size() ||
-      std::memcmp(extra_uploaded_.data(), extra_host_.data(), extra_host_.size() * 4) != 0) {
-    drain(g);
-    const std::size_t bytes = extra_host_.size() * sizeof(float);
-    extra_.reserve(context(), bytes, CL_MEM_READ_ONLY);
-    check(clEnqueueWriteBuffer(queue(), extra_.mem.get(), CL_TRUE, 0, bytes, extra_host_.data(), 0,
-                               nullptr, nullptr),
-          "clEnqueueWriteBuffer (action data)");
-    extra_uploaded_ = extra_host_;
+  // The actions' constants: packed again only for a new list or a new dt (they hold
+  // products with dt), and uploaded only when their bytes changed.
+  const float dtf = float(sp.dt);
+  std::uint32_t dtBitsF;
+  std::memcpy(&dtBitsF, &dtf, sizeof dtBitsF);
+  if (packedVersion_ != g.actionsVersion || packedDt_ != dtBitsF) {
+    packActions(g.actions, dtf, params_host_, extra_host_);
+    packedVersion_ = g.actionsVersion;
+    packedDt_ = dtBitsF;
+    const std::size_t paramBytes = params_host_.size() * sizeof(cl::FlActionParams);
+    if (params_uploaded_.size() != params_host_.size() ||
+        std::memcmp(params_uploaded_.data(), params_host_.data(), paramBytes) != 0) {
+      drain(g);  // steps in flight read the buffer
+      params_.reserve(context(), paramBytes, CL_MEM_READ_ONLY);
+      check(clEnqueueWriteBuffer(queue(), params_.mem.get(), CL_TRUE, 0, paramBytes,
+                                 params_host_.data(), 0, nullptr, nullptr),
+            "clEnqueueWriteBuffer (action parameters)");
+      params_uploaded_ = params_host_;
+    }
+    // Compared as bytes: the floats hold integers and doubles as bit patterns (NaN patterns
+    // among them), so a comparison of values could never say equal, or miss a -0.
+    if (extra_uploaded_.size() != extra_host_.size() ||
+        std::memcmp(extra_uploaded_.data(), extra_host_.data(), extra_host_.size() * 4) != 0) {
+      drain(g);
+      const std::size_t bytes = extra_host_.size() * sizeof(float);
+      extra_.reserve(context(), bytes, CL_MEM_READ_ONLY);
+      check(clEnqueueWriteBuffer(queue(), extra_.mem.get(), CL_TRUE, 0, bytes, extra_host_.data(),
+                                 0, nullptr, nullptr),
+            "clEnqueueWriteBuffer (action data)");
+      extra_uploaded_ = extra_host_;
+    }
   }
 
-  InFlight f;
-  const std::uint64_t total = planBirths(g, sp, f.tables);
+  InFlight& f = inFlight_.next();
+  const std::uint64_t total = planBirths(g, sp, f.tables, emitterCodes_);
   const std::uint32_t births = std::uint32_t(std::min<std::uint64_t>(total, g.capacity));
   g.stats.droppedAtCapacity += total - births;  // the device sees at most `capacity`
   f.births = births;
 
   // The step acts on the live particles and its newborns: an upper bound of both.
   std::size_t bound = size_;
-  for (const auto& q : inFlight_) bound += q.births;
+  for (std::size_t k = 0; k < inFlight_.size(); ++k) bound += inFlight_[k].births;
   const std::size_t nBound = std::min(bound + births, g.capacity);
   const bool acts = !g.actions.empty() && nBound > 0;
   const bool kills = acts;           // the NaN guard can kill in any list
@@ -554,26 +601,47 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     if (e) profiled_.emplace_back(what, Event(e));
   };
 
-  // The emission tables travel in one buffer, at 64-byte aligned offsets: one write a
-  // step instead of five (each costs a few microseconds on PoCL).
+  // The emission tables travel in one buffer, at 64-byte aligned offsets: the runs first
+  // (they change every step), then the emitters' part, which is written only when it
+  // changed (a static emitter's does not). Each write costs a few microseconds on PoCL.
   auto& t = f.tables;
   std::uint32_t off[5] = {};
   if (births > 0) {
     auto& blob = f.blob;
+    bool layout = false;  // the runs outgrew their room: everything moves
+    if (t.runs.size() > runsRoom_) {
+      runsRoom_ = std::max<std::size_t>(2 * runsRoom_, std::max<std::size_t>(t.runs.size(), 4));
+      layout = true;
+    }
+    static_assert(sizeof(cl::FlBirthRun) == 64);
+    const std::size_t runsWords = runsRoom_ * 8;
+    blob.resize(runsWords);
+    if (!t.runs.empty()) std::memcpy(blob.data(), t.runs.data(), t.runs.size() * 64);
     auto append = [&](int at, const void* data, std::size_t bytes) {
       off[at] = std::uint32_t(blob.size() * 8);
-      blob.resize(blob.size() + (bytes + 63) / 64 * 8);
-      if (bytes) std::memcpy(reinterpret_cast<char*>(blob.data()) + off[at], data, bytes);
+      const std::size_t was = blob.size();
+      blob.resize(was + (bytes + 63) / 64 * 8);
+      if (bytes) std::memcpy(blob.data() + was, data, bytes);
     };
-    append(0, t.runs.data(), t.runs.size() * sizeof(cl::FlBirthRun));
     append(1, t.emitters.data(), t.emitters.size() * sizeof(cl::FlEmitter));
     append(2, t.types.data(), t.types.size() * sizeof(cl::FlParticleType));
     append(3, t.keys.data(), t.keys.size() * sizeof(cl::FlKeyframe));
     append(4, t.shapes.data(), t.shapes.size() * sizeof(float));
-    tables_.reserve(context(), blob.size() * 8, CL_MEM_READ_ONLY);
-    check(clEnqueueWriteBuffer(q, tables_.mem.get(), CL_FALSE, 0, blob.size() * 8, blob.data(), 0,
-                               nullptr, nullptr),
-          "clEnqueueWriteBuffer (emitters)");
+    // (resize zeroes the padding append rounds up to: equal tables compare equal)
+    const std::size_t staticWords = blob.size() - runsWords;
+    if (tables_.reserve(context(), blob.size() * 8, CL_MEM_READ_ONLY)) layout = true;
+    const bool same =
+        !layout && staticUploaded_.size() == staticWords &&
+        std::memcmp(staticUploaded_.data(), blob.data() + runsWords, staticWords * 8) == 0;
+    if (!same) {
+      check(clEnqueueWriteBuffer(q, tables_.mem.get(), CL_FALSE, runsWords * 8, staticWords * 8,
+                                 blob.data() + runsWords, 0, nullptr, nullptr),
+            "clEnqueueWriteBuffer (emitters)");
+      staticUploaded_.assign(blob.begin() + std::ptrdiff_t(runsWords), blob.end());
+    }
+    check(clEnqueueWriteBuffer(q, tables_.mem.get(), CL_FALSE, 0, t.runs.size() * 64, blob.data(),
+                               0, nullptr, nullptr),
+          "clEnqueueWriteBuffer (birth runs)");
   } else {
     tables_.reserve(context(), 64, CL_MEM_READ_ONLY);
   }
@@ -718,7 +786,7 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
                               &e),
           "clEnqueueReadBuffer (state)");
     f.done = Event(e);
-    inFlight_.push_back(std::move(f));
+    inFlight_.push();
   }
   check(clFlush(q), "clFlush");
   deviceNewer_ = true;

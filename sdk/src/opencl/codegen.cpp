@@ -563,11 +563,29 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
       "  (void)extra; (void)snap; (void)snapN; (void)snapStride; (void)seedLo; (void)seedHi;\n"
       "  (void)step;\n"
       "  const fl_real t0 = fl_real_from_bits(timeBits), t1 = fl_real_from_bits(t1Bits);\n";
+  // The per-particle part once, as a function both kernels call: PoCL compiles the action
+  // list's body once per program instead of once per kernel (cold start, issue #11).
+  s << "/* ---- generated: one particle's step */\nFL_INLINE void fl_act_one(";
+  for (const auto& l : g.actLanes) s << laneDecl(l) << ", ";
+  s << "__global uchar* restrict codes, __global const FlActionParams* restrict ap,\n"
+       "    __global uint* state, __global const float* restrict extra,\n"
+       "    __global const float* restrict snap, ulong dtBits, uint seedLo, uint seedHi,\n"
+       "    uint step, uint streamBase, uint nsubStep, uint snapStride,\n"
+       "    __global float* restrict tau, uint i, uint n0, uint n, uint snapN, fl_real t0,\n"
+       "    fl_real t1) {\n"
+       "  (void)state; (void)extra; (void)snap; (void)snapN; (void)snapStride; (void)seedLo;\n"
+       "  (void)seedHi; (void)step; (void)n;\n"
+    << one.str() << "}\n";
+  std::string call = "fl_act_one(";
+  for (const auto& l : g.actLanes) call += std::string("l_") + l.name + ", ";
+  call +=
+      "codes, ap, state, extra, snap, dtBits, seedLo, seedHi, step, streamBase, nsubStep,\n"
+      "      snapStride, tau, i, n0, n, snapN, t0, t1);\n";
   s << "/* ---- generated: the fused act kernel */\n__kernel void fl_act(";
   for (const auto& l : g.actLanes) s << laneDecl(l) << ", ";
   s << actArgs << ") {\n"
-    << actPrologue << "  const uint i = get_global_id(0);\n  if (i >= n) return;\n"
-    << one.str() << "}\n";
+    << actPrologue << "  const uint i = get_global_id(0);\n  if (i >= n) return;\n  " << call
+    << "}\n";
   // A small group's whole step in one launch of one work-group: births, act,
   // count-scan-list, tail. PoCL pays several microseconds per launch; this is one instead of
   // four.
@@ -588,8 +606,7 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
          "                seedHi, salt);\n"
          "  barrier(CLK_GLOBAL_MEM_FENCE);\n"
          "  {\n"
-      << actPrologue << "  for (uint i = lid; i < n; i += lsize) {\n"
-      << one.str()
+      << actPrologue << "  for (uint i = lid; i < n; i += lsize) {\n    " << call
       << "  }\n  }\n"
          "  barrier(CLK_GLOBAL_MEM_FENCE);\n"
          "  if (lid == 0u) fl_scan_list_body(codes, tileDead, tileOff, holes, tail, state, "

@@ -69,26 +69,6 @@ std::string variantCode(const Emitter& em) {
 // of its prime emitters' children (as given, and as the copies live emitters are spawned
 // from), then of its live emitters' (whose primes may be gone), so that the live emitters
 // a step spawns find theirs in the program built before it.
-struct Variants {
-  std::vector<std::string> code;
-  std::map<std::string, std::uint32_t> index;
-
-  void add(const Emitter& e) {
-    std::string c = variantCode(e);
-    if (index.emplace(c, std::uint32_t(code.size())).second) code.push_back(std::move(c));
-  }
-  void addChain(const EmitterSpec* s) {
-    std::set<const EmitterSpec*> seen;  // a `next` chain may loop back
-    for (; s && seen.insert(s).second; s = s->next.get()) add(s->emitter);
-  }
-  std::uint32_t of(const Emitter& e) const {
-    const auto it = index.find(variantCode(e));
-    if (it == index.end())
-      throw Error("OpenCL backend: an emitter's code is missing from the group's program");
-    return it->second;
-  }
-};
-
 Variants variantsOf(const GroupImpl& g) {
   Variants v;
   for (const Emitter& e : g.emitters) v.add(e);
@@ -96,6 +76,22 @@ Variants variantsOf(const GroupImpl& g) {
   for (const auto& spec : g.primeSpecs) v.addChain(spec.get());
   for (const LiveEmitter& e : g.live) v.addChain(e.spec);
   return v;
+}
+
+// What of each static emitter variantCode() depends on, as numbers: comparing them costs
+// no allocation, and catches edits through an Emitter& kept from addEmitter().
+void emitterKeys(const GroupImpl& g, std::vector<std::uint32_t>& out) {
+  out.clear();
+  for (const Emitter& e : g.emitters) {
+    out.insert(out.end(), {std::uint32_t(kindOf(e.shape)), std::uint32_t(normalMode(e)),
+                           std::uint32_t(e.types.size())});
+    for (const ParticleType& p : e.types)
+      out.insert(out.end(), {std::uint32_t(kindOf(p.velocity)), std::uint32_t(kindOf(p.color)),
+                             std::uint32_t(kindOf(p.up)), std::uint32_t(kindOf(p.rotVelocity)),
+                             std::uint32_t(fuzzyMode(p.lifetime)),
+                             std::uint32_t(fuzzyMode(p.alpha)), std::uint32_t(fuzzyMode(p.size)),
+                             std::uint32_t(fuzzyMode(p.mass)), std::uint32_t(fuzzyMode(p.charge))});
+  }
 }
 
 // ---- The step's tables -------------------------------------------------------------------
@@ -151,6 +147,36 @@ std::uint32_t packEmitter(const Emitter& em, std::uint32_t variant, StepTables& 
 }
 
 }  // namespace
+
+void Variants::add(const Emitter& e) {
+  std::string c = variantCode(e);
+  if (index.emplace(c, std::uint32_t(code.size())).second) code.push_back(std::move(c));
+}
+
+void Variants::addChain(const EmitterSpec* s) {
+  std::set<const EmitterSpec*> seen;  // a `next` chain may loop back
+  for (; s && seen.insert(s).second; s = s->next.get()) add(s->emitter);
+}
+
+std::uint32_t Variants::of(const Emitter& e) const {
+  const auto it = index.find(variantCode(e));
+  if (it == index.end())
+    throw Error("OpenCL backend: an emitter's code is missing from the group's program");
+  return it->second;
+}
+
+bool EmitterCodes::refresh(const GroupImpl& g) {
+  if (version == g.emittersVersion) {
+    emitterKeys(g, scratch);
+    if (scratch == keys) return false;
+  }
+  version = g.emittersVersion;
+  variants = variantsOf(g);
+  staticVariant.clear();
+  for (const Emitter& e : g.emitters) staticVariant.push_back(variants.of(e));
+  emitterKeys(g, keys);
+  return true;
+}
 
 // ---- Domains with data ------------------------------------------------------------------
 
@@ -226,14 +252,17 @@ cl::FlDomain ShapePacker::pack(const Domain& d) {
   return o;
 }
 
-std::string emitterSignature(const GroupImpl& g) {
+std::string emitterSignature(const Variants& v) {
   std::string s;
-  for (const std::string& c : variantsOf(g).code) s += c + '|';
+  for (const std::string& c : v.code) s += c + '|';
   return s;
 }
 
 std::string emissionSource(const GroupImpl& g) {
-  const Variants v = variantsOf(g);
+  return emissionSource(variantsOf(g));
+}
+
+std::string emissionSource(const Variants& v) {
   std::ostringstream s;
   // The newborns of each emitter code, with its kinds as literals.
   s << "/* ---- generated: emission per emitter code */\n"
@@ -253,37 +282,45 @@ void checkEmissionSupported(const GroupImpl& g) {
   (void)g;  // everything the CPU emits runs on the device (hair mode in backend.cpp)
 }
 
-std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, StepTables& t) {
-  // The codes as the program was built from them (the backend compared the signature just
-  // now): planning spawns emitters and may renew the primes' copies.
-  const Variants variants = variantsOf(g);
+std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, StepTables& t, EmitterCodes& codes) {
+  // The codes as the program was built from them (refreshed just now): planning spawns
+  // emitters and may renew the primes' copies.
+  const Variants& variants = codes.variants;
   thread_local std::vector<BirthRun> runsStore;
   auto& runs = runsStore;
   runs.clear();
   const std::uint64_t total = detail::planBirths(g, sp, runs);
   g.stats.emitted += total;
+  t.runs.clear();
+  t.emitters.clear();
+  t.types.clear();
+  t.keys.clear();
+  t.shapes.clear();
   if (total > 0) {
     ShapePacker shapes{t.shapes, {}, {}};
-    std::map<std::pair<bool, std::uint32_t>, std::uint32_t> entries;  // (live, index) -> entry
-    std::map<const EmitterSpec*, std::uint32_t> specVariant;  // live emitters share their spec's
+    constexpr std::uint32_t kNone = ~0u;
+    codes.entryOfStatic.assign(g.emitters.size(), kNone);
+    codes.entryOfLive.assign(g.live.size(), kNone);
+    codes.specVariant.clear();  // live emitters share their spec's code
     std::uint64_t start = 0;
     for (const BirthRun& run : runs) {
-      auto it = entries.find({run.live, run.index});
-      if (it == entries.end()) {
-        std::uint32_t variant;
+      std::uint32_t& entry =
+          run.live ? codes.entryOfLive[run.index] : codes.entryOfStatic[run.index];
+      if (entry == kNone) {
+        std::uint32_t variant = kNone;
         if (run.live) {
           const LiveEmitter& e = g.live[run.index];
-          auto sv = specVariant.find(e.spec);
-          if (sv == specVariant.end())
-            sv = specVariant.emplace(e.spec, variants.of(e.emitter)).first;
-          variant = sv->second;
+          for (const auto& [spec, v] : codes.specVariant)
+            if (spec == e.spec) variant = v;
+          if (variant == kNone) {
+            variant = variants.of(e.emitter);
+            codes.specVariant.emplace_back(e.spec, variant);
+          }
         } else {
-          variant = variants.of(g.emitters[run.index]);
+          variant = codes.staticVariant[run.index];
         }
         const Emitter& em = run.live ? g.live[run.index].emitter : g.emitters[run.index];
-        it = entries
-                 .emplace(std::make_pair(run.live, run.index), packEmitter(em, variant, t, shapes))
-                 .first;
+        entry = packEmitter(em, variant, t, shapes);
       }
       cl::FlBirthRun r{};
       r.first = run.first;
@@ -293,7 +330,7 @@ std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, StepTables& t) {
       r.spacing = doubleBits(run.spacing);
       r.span = doubleBits(run.span);
       r.dt = doubleBits(run.dt);
-      r.emitter = it->second;
+      r.emitter = entry;
       r.kind = run.kind == BirthRun::Rate    ? FL_RUN_RATE
                : run.kind == BirthRun::Burst ? FL_RUN_BURST
                                              : FL_RUN_DISTANCE;

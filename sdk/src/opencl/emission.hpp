@@ -49,15 +49,46 @@ struct ShapePacker {
 /// Refuses, naming it, what of the group's emission the device does not run.
 void checkEmissionSupported(const GroupImpl& g);
 
+/// The distinct emitter codes of a group's program (one fl_emit case each), in order.
+struct Variants {
+  std::vector<std::string> code;
+  std::map<std::string, std::uint32_t> index;
+
+  void add(const Emitter& e);
+  void addChain(const EmitterSpec* s);
+  /// Throws Error when e's code is not in the program.
+  std::uint32_t of(const Emitter& e) const;
+};
+
+/// What the backend derives from a group's emitters, kept between steps: rebuilt when
+/// GroupImpl::emittersVersion moves (or a static emitter's kinds were edited through a
+/// reference kept from before), so that a steady step builds no string and allocates
+/// nothing. Also the planning's scratch.
+struct EmitterCodes {
+  std::uint64_t version = ~std::uint64_t(0);  ///< the emittersVersion it was built for
+  Variants variants;                          ///< the program's emitter codes
+  std::vector<std::uint32_t> staticVariant;   ///< per static emitter: its code's index
+  std::vector<std::uint32_t> keys, scratch;   ///< the static emitters' kinds and modes
+  // Per step: each emitter's entry in the tables, and live emitters' specs' codes.
+  std::vector<std::uint32_t> entryOfStatic, entryOfLive;
+  std::vector<std::pair<const EmitterSpec*, std::uint32_t>> specVariant;
+
+  /// Brings the codes up to date with g; returns true when they changed (the program must
+  /// then be rebuilt if emitterSignature changed).
+  bool refresh(const GroupImpl& g);
+};
+
 /// This step's births into `t` (and the group's emitter state, live emitters and counts, as
-/// the CPU's planning does: spawns, motion, deaths); returns how many.
-std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, StepTables& t);
+/// the CPU's planning does: spawns, motion, deaths); returns how many. `codes` must be
+/// those the program was built from (refresh()ed this step).
+std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, StepTables& t, EmitterCodes& codes);
 
 /// The generated emission code: fl_emit(), dispatching on the emitter (and type).
 std::string emissionSource(const GroupImpl& g);
+std::string emissionSource(const Variants& v);
 
 /// What of the emitters shapes the program (domain kinds, type counts, which fuzzy values
 /// draw): a new program is needed when this changes.
-std::string emitterSignature(const GroupImpl& g);
+std::string emitterSignature(const Variants& v);
 
 }  // namespace flurry::detail::ocl
