@@ -227,6 +227,8 @@ int run(const RunOptions& o, std::vector<std::unique_ptr<flurry::cli::Plugin>>& 
                                        : flurry::Backend::Cpu;
   opts.device = o.device;
   flurry::Context ctx(opts);
+  if (!ctx.backendFallback().empty())
+    std::cerr << "flurry: " << ctx.backendFallback() << "; using the CPU backend\n";
   fx.build(ctx, o.capacity);
   if (!o.out.empty()) {  // PLY temporaries that a run killed before its rename left behind
     const std::vector<flurry::Group*> groups = ctx.groups();

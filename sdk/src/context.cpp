@@ -20,6 +20,7 @@ struct Context::Impl {
   std::unique_ptr<detail::ThreadPool> pool;
   std::unique_ptr<detail::BackendImpl> backend;
   Backend backendKind = Backend::Cpu;
+  std::string backendFallback;  // why Backend::Auto took the CPU
   double time = 0.0;
   std::uint64_t step = 0;
   double timeAtDtChange = 0.0;  // time = timeAtDtChange + stepsSinceDtChange·dt: no drift
@@ -57,7 +58,7 @@ Context::Context(ContextOptions options) : impl_(std::make_unique<Impl>()) {
         impl_->backend = detail::makeOpenCLBackend(options);
         impl_->backendKind = Backend::OpenCL;
       } catch (const Error& e) {
-        std::fprintf(stderr, "flurry: %s; using the CPU backend\n", e.what());
+        impl_->backendFallback = e.what();
       }
 #endif
       break;
@@ -142,6 +143,9 @@ std::uint64_t Context::seed() const {
 }
 Backend Context::backend() const {
   return impl_->backendKind;
+}
+const std::string& Context::backendFallback() const {
+  return impl_->backendFallback;
 }
 const ContextOptions& Context::options() const {
   return impl_->options;

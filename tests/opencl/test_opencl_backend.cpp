@@ -51,10 +51,14 @@ TEST(OpenCLBackend, AnUnknownDeviceNameThrowsNamingTheDevicesFound) {
     EXPECT_EQ(e.code(), CL_DEVICE_NOT_FOUND);
     EXPECT_NE(std::string(e.what()).find("no-such-device-xyz"), std::string::npos);
   }
-  // Auto falls back to the CPU instead, with a message.
+  // Auto falls back to the CPU instead, saying why through the context (never on stderr).
   o.backend = Backend::Auto;
+  ::testing::internal::CaptureStderr();
   Context fallback(o);
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
   EXPECT_EQ(fallback.backend(), Backend::Cpu);
+  EXPECT_NE(fallback.backendFallback().find("no-such-device-xyz"), std::string::npos)
+      << fallback.backendFallback();
 }
 
 TEST(OpenCLBackend, ABuildFailureCarriesTheLogAndTheSource) {

@@ -63,7 +63,11 @@ class Context {
   void setTimeStep(double dt);
   unsigned threads() const;
   std::uint64_t seed() const;
+  /// The backend the context runs: with Backend::Auto, OpenCL or the CPU.
   Backend backend() const;
+  /// Why Backend::Auto took the CPU backend (no OpenCL platform, no such device, ...);
+  /// empty when it did not. The library reports it here rather than printing it.
+  const std::string& backendFallback() const;
   const ContextOptions& options() const;
 
  private:
