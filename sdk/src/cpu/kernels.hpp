@@ -5,8 +5,10 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 #include "../group_impl.hpp"
 #include "../isa_namespace.hpp"
@@ -51,6 +53,13 @@ struct UniformDt {
 struct OwnDt {
   const float* h;
   float operator[](std::size_t i) const { return h[i]; }
+};
+/// A Dt seen from particle `first` on.
+template <class Dt>
+struct OffsetDt {
+  Dt dt;
+  std::size_t first;
+  float operator[](std::size_t i) const { return dt[first + i]; }
 };
 
 /// v += a·dt with each particle's own dt.
@@ -221,65 +230,110 @@ struct PlanarPath {
   bool reaches() const { return (side * d1 <= reach) & (side * vn < 0.0f); }
 };
 
+/// The hit and the reflection of a two-sided planar deflector, over particles [0, n) all of
+/// which may reach the plane: computed for every one and kept only on a hit.
+template <class Dt, class OnPiece>
+inline void bouncePlanarAll(float* __restrict px, float* __restrict py, float* __restrict pz,
+                            float* __restrict vxs, float* __restrict vys, float* __restrict vzs,
+                            std::size_t n, Dt dts, Vec3 P, Vec3 N, OnPiece onPiece,
+                            const Reflect& reflect) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const float dt = dts[i];
+    const float x = px[i], y = py[i], z = pz[i];
+    const float vx = vxs[i], vy = vys[i], vz = vzs[i];
+    const PlanarPath path(x, y, z, vx, vy, vz, dt, P, N);
+    const float d0 = path.d0, d1 = path.d1, side = path.side;
+    // Computed for every particle and kept only on a hit (one if-block: GCC 12 vectorises
+    // that, but not several selects on the same condition). Lanes that miss may hold inf.
+    const float tau = std::min(d0 / (d0 - d1), 1.0f) * dt;
+    const float hx = x + vx * tau, hy = y + vy * tau, hz = z + vz * tau;
+    // A crossing or an arrival, approaching the plane. A particle born or placed exactly on
+    // the plane (d0 = 0) belongs to neither side and leaves it freely, whichever way the
+    // piece's normal points: an emitter on a floor emits through it.
+    const bool hit = path.reaches() & (d0 != 0.0f) & onPiece(hx, hy, hz);
+    float nx = x, ny = y, nz = z, nvx = vx, nvy = vy, nvz = vz;
+    reflect(nx, ny, nz, nvx, nvy, nvz, hx, hy, hz, N.x, N.y, N.z, tau);
+    // Where Move will put it; push it out if rounding left it on or behind the plane.
+    const float qx = nx + nvx * dt, qy = ny + nvy * dt, qz = nz + nvz * dt;
+    const float qd = side * ((qx - P.x) * N.x + (qy - P.y) * N.y + (qz - P.z) * N.z);
+    // A few ulps of what decides the side: the coordinates along the normal, and the step
+    // Move adds to them (p + v·dt loses bits to cancellation when |v·dt| is large). Far from
+    // the origin along the plane this stays small, so bounces do not gain height.
+    const float margin =
+        1.2e-7f * (std::abs(N.x) * (std::abs(qx) + std::abs(P.x) + std::abs(nvx * dt)) +
+                   std::abs(N.y) * (std::abs(qy) + std::abs(P.y) + std::abs(nvy * dt)) +
+                   std::abs(N.z) * (std::abs(qz) + std::abs(P.z) + std::abs(nvz * dt))) +
+        1e-30f;
+    const float push = std::max(margin - qd, 0.0f) * side;
+    float ox = x, oy = y, oz = z, ovx = vx, ovy = vy, ovz = vz;
+    if (hit) {
+      ox = nx + push * N.x;
+      oy = ny + push * N.y;
+      oz = nz + push * N.z;
+      ovx = nvx;
+      ovy = nvy;
+      ovz = nvz;
+    }
+    px[i] = ox;
+    py[i] = oy;
+    pz[i] = oz;
+    vxs[i] = ovx;
+    vys[i] = ovy;
+    vzs[i] = ovz;
+  }
+}
+
 /// A two-sided planar deflector (plane, rectangle, disc, triangle): `onPiece` says whether a
-/// point of the plane belongs to the piece. Most particles are far from it: runs of 16 none
-/// of which reaches the plane are skipped after one vectorised test.
+/// point of the plane belongs to the piece. Most particles do not reach the plane in a step,
+/// and where some do (particles resting on a floor are spread through the group) they are
+/// few among many: a vectorised test marks who may reach it, those are packed into a small
+/// contiguous batch, the hit is computed over the batch (vectorised) and written back. Each
+/// particle's arithmetic is the same wherever it runs, so the result does not depend on how
+/// many were packed.
 template <class Dt, class OnPiece>
 inline void bouncePlanarLoop(float* __restrict px, float* __restrict py, float* __restrict pz,
                              float* __restrict vxs, float* __restrict vys, float* __restrict vzs,
                              std::size_t n, Dt dts, Vec3 P, Vec3 N, OnPiece onPiece,
                              const Bounce& b) {
-  constexpr std::size_t kRun = 16;
+  constexpr std::size_t kChunk = 256;
   const Reflect reflect{b.restitution, 1.0f - b.friction, b.cutoff * b.cutoff};
-  for (std::size_t i0 = 0; i0 < n; i0 += kRun) {
-    const std::size_t end = std::min(n, i0 + kRun);
-    std::uint32_t any = 0;
-    for (std::size_t i = i0; i < end; ++i)
-      any |= PlanarPath(px[i], py[i], pz[i], vxs[i], vys[i], vzs[i], dts[i], P, N).reaches();
-    if (any == 0u) continue;
-    for (std::size_t i = i0; i < end; ++i) {
-      const float dt = dts[i];
-      const float x = px[i], y = py[i], z = pz[i];
-      const float vx = vxs[i], vy = vys[i], vz = vzs[i];
-      const PlanarPath path(x, y, z, vx, vy, vz, dt, P, N);
-      const float d0 = path.d0, d1 = path.d1, side = path.side;
-      // Computed for every particle and kept only on a hit (one if-block: GCC 12 vectorises
-      // that, but not several selects on the same condition). Lanes that miss may hold inf.
-      const float tau = std::min(d0 / (d0 - d1), 1.0f) * dt;
-      const float hx = x + vx * tau, hy = y + vy * tau, hz = z + vz * tau;
-      // A crossing or an arrival, approaching the plane. A particle born or placed exactly on
-      // the plane (d0 = 0) belongs to neither side and leaves it freely, whichever way the
-      // piece's normal points: an emitter on a floor emits through it.
-      const bool hit = path.reaches() & (d0 != 0.0f) & onPiece(hx, hy, hz);
-      float nx = x, ny = y, nz = z, nvx = vx, nvy = vy, nvz = vz;
-      reflect(nx, ny, nz, nvx, nvy, nvz, hx, hy, hz, N.x, N.y, N.z, tau);
-      // Where Move will put it; push it out if rounding left it on or behind the plane.
-      const float qx = nx + nvx * dt, qy = ny + nvy * dt, qz = nz + nvz * dt;
-      const float qd = side * ((qx - P.x) * N.x + (qy - P.y) * N.y + (qz - P.z) * N.z);
-      // A few ulps of what decides the side: the coordinates along the normal, and the step
-      // Move adds to them (p + v·dt loses bits to cancellation when |v·dt| is large). Far from
-      // the origin along the plane this stays small, so bounces do not gain height.
-      const float margin =
-          1.2e-7f * (std::abs(N.x) * (std::abs(qx) + std::abs(P.x) + std::abs(nvx * dt)) +
-                     std::abs(N.y) * (std::abs(qy) + std::abs(P.y) + std::abs(nvy * dt)) +
-                     std::abs(N.z) * (std::abs(qz) + std::abs(P.z) + std::abs(nvz * dt))) +
-          1e-30f;
-      const float push = std::max(margin - qd, 0.0f) * side;
-      float ox = x, oy = y, oz = z, ovx = vx, ovy = vy, ovz = vz;
-      if (hit) {
-        ox = nx + push * N.x;
-        oy = ny + push * N.y;
-        oz = nz + push * N.z;
-        ovx = nvx;
-        ovy = nvy;
-        ovz = nvz;
+  alignas(32) std::uint8_t reaches[kChunk];
+  alignas(32) float g[7][kChunk];  // the packed candidates: x, y, z, vx, vy, vz, dt
+  std::uint16_t idx[kChunk];
+  for (std::size_t c0 = 0; c0 < n; c0 += kChunk) {
+    const std::size_t m = std::min(kChunk, n - c0);
+    float *x = px + c0, *y = py + c0, *z = pz + c0, *vx = vxs + c0, *vy = vys + c0, *vz = vzs + c0;
+    for (std::size_t i = 0; i < m; ++i)
+      reaches[i] = std::uint8_t(
+          PlanarPath(x[i], y[i], z[i], vx[i], vy[i], vz[i], dts[c0 + i], P, N).reaches());
+    // The candidates' indices, eight flags at a time (most words are zero).
+    std::size_t k = 0, i = 0;
+    for (; i + 8 <= m; i += 8) {
+      std::uint64_t w;
+      std::memcpy(&w, reaches + i, 8);
+      while (w) {
+        idx[k++] = std::uint16_t(i + std::size_t(std::countr_zero(w) / 8));
+        w &= w - 1;  // each flag is 0 or 1: one bit per byte
       }
-      px[i] = ox;
-      py[i] = oy;
-      pz[i] = oz;
-      vxs[i] = ovx;
-      vys[i] = ovy;
-      vzs[i] = ovz;
+    }
+    for (; i < m; ++i)
+      if (reaches[i]) idx[k++] = std::uint16_t(i);
+    if (k == 0) continue;
+    if (4 * k >= m) {  // many: packing would cost more than computing all of them
+      bouncePlanarAll(x, y, z, vx, vy, vz, m, OffsetDt<Dt>{dts, c0}, P, N, onPiece, reflect);
+      continue;
+    }
+    for (std::size_t j = 0; j < k; ++j) {
+      const std::size_t s = idx[j];
+      g[0][j] = x[s], g[1][j] = y[s], g[2][j] = z[s];
+      g[3][j] = vx[s], g[4][j] = vy[s], g[5][j] = vz[s];
+      g[6][j] = dts[c0 + s];
+    }
+    bouncePlanarAll(g[0], g[1], g[2], g[3], g[4], g[5], k, OwnDt{g[6]}, P, N, onPiece, reflect);
+    for (std::size_t j = 0; j < k; ++j) {
+      const std::size_t s = idx[j];
+      x[s] = g[0][j], y[s] = g[1][j], z[s] = g[2][j];
+      vx[s] = g[3][j], vy[s] = g[4][j], vz[s] = g[5][j];
     }
   }
 }
