@@ -216,7 +216,7 @@ const std::string& Group::name() const {
   return impl_->name;
 }
 std::size_t Group::size() const {
-  impl_->syncHost();
+  impl_->syncCount();
   return impl_->size;
 }
 std::size_t Group::capacity() const {
@@ -338,8 +338,12 @@ void checkFloatLane(const detail::GroupImpl& g, Attribute a, int component) {
 }
 }  // namespace
 
+void Group::fetch(AttributeSet attributes) const {
+  impl_->syncHost(attributes);
+}
+
 std::span<const float> Group::lane(Attribute a, int component) const {
-  impl_->syncHost();
+  impl_->syncHost({a});
   checkFloatLane(*impl_, a, component);
   return {impl_->lanes[std::size_t(a)][component].f(), impl_->size};
 }
@@ -352,12 +356,12 @@ std::span<float> Group::lane(Attribute a, int component) {
 }
 
 std::span<const std::uint32_t> Group::ids() const {
-  impl_->syncHost();
+  impl_->syncHost({Attribute::Id});
   return {impl_->lanes[std::size_t(Attribute::Id)][0].u(), impl_->size};
 }
 
 std::span<const std::uint32_t> Group::visible() const {
-  impl_->syncHost();
+  impl_->syncHost({Attribute::Visible});
   if (!impl_->stored.has(Attribute::Visible))
     throw Error("group '" + impl_->name + "' does not store attribute visible");
   return {impl_->lanes[std::size_t(Attribute::Visible)][0].u(), impl_->size};
@@ -370,7 +374,7 @@ const GroupStats& Group::stats() const {
 
 Bounds Group::bounds() const {
   Bounds b;
-  impl_->syncHost();
+  impl_->syncHost({Attribute::Position});
   const auto& g = *impl_;
   if (g.size == 0) return b;
   const detail::Lanes l = g.lanePointers();

@@ -92,8 +92,10 @@ struct GroupImpl;
 class DeviceMirror {
  public:
   virtual ~DeviceMirror() = default;
-  /// Copies the device's particles and live count into the host lanes, if the device's are newer.
-  virtual void pullToHost(GroupImpl& group) = 0;
+  /// Brings the live count and the host lanes of `attributes` (those stored) up to date
+  /// with the device's, reading back only lanes the device changed since the host last read
+  /// them.
+  virtual void pullToHost(GroupImpl& group, AttributeSet attributes) = 0;
   /// The host changed the particles or the storage: the device must take the host's copy.
   virtual void hostChanged(GroupImpl& group) = 0;
   /// Brings the group's statistics up to date (without reading particles back).
@@ -182,8 +184,14 @@ struct GroupImpl {
 
   std::unique_ptr<DeviceMirror> mirror;  ///< null on the CPU backend
 
-  void syncHost() {
-    if (mirror) mirror->pullToHost(*this);
+  /// Brings the live count and `attributes` (default: all; before the host writes, all) up
+  /// to date on the host.
+  void syncHost(AttributeSet attributes = AttributeSet::all()) {
+    if (mirror) mirror->pullToHost(*this, attributes);
+  }
+  /// The live count only.
+  void syncCount() {
+    if (mirror) mirror->pullToHost(*this, AttributeSet());
   }
   void hostChanged() {
     if (mirror) mirror->hostChanged(*this);

@@ -143,6 +143,11 @@ std::size_t packParticles(const Group& group, const PackLayout& layout, std::spa
     throw InvalidArgument("out", "holds " + std::to_string(out.size()) + " bytes, " +
                                      std::to_string(size * layout.stride) + " needed");
   const AttributeSet stored = group.attributes();
+  // What it reads, back from a device in one transfer: nothing else crosses.
+  AttributeSet reads{Attribute::Position};
+  if (options.skipHidden) reads.insert(Attribute::Visible);
+  for (const PackField& f : layout.fields) reads.insert(f.attribute);
+  group.fetch(reads);
   auto px = group.lane(Attribute::Position, 0);
   auto py = group.lane(Attribute::Position, 1);
   auto pz = group.lane(Attribute::Position, 2);

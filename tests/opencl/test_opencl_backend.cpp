@@ -298,3 +298,72 @@ TEST(OpenCLBackend, TheActBodyIsInTheProgramOnce) {
   ASSERT_NE(first, std::string::npos);
   EXPECT_EQ(src.find("fl_gravity((ap + 0)", first + 1), std::string::npos);
 }
+
+// A reader gets back only what it names: lane(), ids(), bounds() and fetch() copy their own
+// attributes once per step, size() and stats() none; the values are the device's latest
+// (the same as a full read), and the host's later writes still see every attribute.
+// (The list and attributes of HostReadsAndWritesBetweenSteps: one program for both.)
+TEST(OpenCLBackend, ReadsBackOnlyWhatIsAsked) {
+  FLURRY_REQUIRE_OPENCL();
+  auto run = [](Backend b) {
+    ContextOptions o = openclOptions();
+    o.backend = b;
+    Context ctx(o);
+    Group& g = ctx.createGroup("g", 1000);
+    g.setActions({Gravity{Vec3(0.0f, -1.0f, 0.0f)}, Move{}, KillOld{}});
+    for (int i = 0; i < 300; ++i) {
+      Particle p;
+      p.position = Vec3(float(i), 0.0f, 0.0f);
+      p.velocity = Vec3(0.0f, 1.0f, 0.01f * float(i));
+      p.lifetime = 0.01f * float(i);
+      g.add(p);
+    }
+    const Group& reader = g;
+    std::vector<float> seen;
+    const std::uint64_t lane = 4;  // bytes per particle per component
+    for (int s = 0; s < 20; ++s) {
+      ctx.step();
+      if (s % 3 == 0) {
+        const std::uint64_t before = g.stats().bytesReadBack;
+        const std::size_t n = reader.size();
+        EXPECT_EQ(g.stats().bytesReadBack, before) << "size() reads no particles";
+        const auto y = reader.lane(Attribute::Position, 1);
+        if (b == Backend::OpenCL) EXPECT_EQ(g.stats().bytesReadBack - before, 3 * lane * n);
+        reader.bounds();
+        reader.lane(Attribute::Position, 2);
+        if (b == Backend::OpenCL) EXPECT_EQ(g.stats().bytesReadBack - before, 3 * lane * n);
+        reader.fetch({Attribute::Position, Attribute::Velocity, Attribute::Color});  // no colour
+        if (b == Backend::OpenCL) EXPECT_EQ(g.stats().bytesReadBack - before, 6 * lane * n);
+        seen.insert(seen.end(), y.begin(), y.end());
+        const auto vz = reader.lane(Attribute::Velocity, 2);
+        seen.insert(seen.end(), vz.begin(), vz.end());
+      }
+      if (s % 3 == 1) {
+        // The engine's packer reads what its layout names: here positions and ages.
+        const std::uint64_t before = g.stats().bytesReadBack;
+        const auto layout = PackLayout::interleaved(
+            {{Attribute::Position, PackFormat::Float32}, {Attribute::Age, PackFormat::Float32}});
+        std::vector<std::byte> out(reader.size() * layout.stride);
+        const std::size_t n = packParticles(reader, layout, out);
+        if (b == Backend::OpenCL) EXPECT_EQ(g.stats().bytesReadBack - before, 4 * lane * n);
+      }
+      if (s == 10) {
+        // A write after a partial read: the device must take every attribute as it is.
+        auto vy = g.lane(Attribute::Velocity, 1);
+        for (float& v : vy) v += 1.0f;
+      }
+    }
+    for (std::size_t i = 0; i < reader.size(); ++i) {
+      const Particle p = reader.particle(i);
+      seen.insert(seen.end(), {p.position.x, p.position.y, p.velocity.y, p.age, p.lifetime});
+    }
+    if (b == Backend::Cpu) EXPECT_EQ(g.stats().bytesReadBack, 0u);
+    EXPECT_GT(reader.size(), 0u);
+    EXPECT_LT(reader.size(), 300u);
+    return seen;
+  };
+  const auto cpu = run(Backend::Cpu);
+  const auto cl = run(Backend::OpenCL);
+  ASSERT_EQ(cpu.size(), cl.size());
+  for (std::size_t i = 0; i < cpu.size(); ++i) EXPECT_NEAR(cpu[i], cl[i], 1e-4f) << i;
+}

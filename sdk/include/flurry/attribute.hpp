@@ -69,6 +69,12 @@ class AttributeSet {
     return *this;
   }
   constexpr bool contains(AttributeSet s) const { return (bits_ & s.bits_) == s.bits_; }
+  /// Every attribute.
+  static constexpr AttributeSet all() {
+    AttributeSet s;
+    s.bits_ = (1u << unsigned(Attribute::Count)) - 1u;
+    return s;
+  }
   constexpr std::uint32_t bits() const { return bits_; }
   friend constexpr AttributeSet operator|(AttributeSet a, AttributeSet b) { return a.insert(b); }
   friend constexpr bool operator==(AttributeSet, AttributeSet) = default;

@@ -85,6 +85,10 @@ struct GroupStats {
   /// Blocks × actions the CPU fused pass skipped because no particle of the block could
   /// reach the action this step (ContextOptions::cull; blocks of about 1024 particles).
   std::uint64_t blockActionsCulled = 0;
+  /// Bytes of particle attributes a device backend (OpenCL) copied back to the host because
+  /// a reader asked for them (lane(), particle(), bounds(), fetch(), an exporter): each stored
+  /// attribute crosses at most once per step, and only if read. The CPU backend leaves it 0.
+  std::uint64_t bytesReadBack = 0;
 };
 
 struct Bounds {
@@ -129,6 +133,13 @@ class Group {
   bool add(const Particle& p);
   /// Gathers particle i (0 <= i < size()); attributes not stored read as Particle's defaults.
   Particle particle(std::size_t i) const;
+
+  /// On a device backend (OpenCL), copies the named attributes of the live particles back to
+  /// the host now, in one transfer, if the device changed them since they were last read;
+  /// nothing else crosses. A reader that names what it needs (a renderer: positions and
+  /// colours) calls it once a frame; lane(a), ids(), visible() and bounds() read back only
+  /// their own attribute, particle() and a writable lane() everything. No-op on the CPU.
+  void fetch(AttributeSet attributes) const;
 
   /// The array of one component of a stored float attribute, size() long.
   /// Throws Error if the attribute is not stored (Id and Visible: use ids() / visible()).

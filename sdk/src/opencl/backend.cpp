@@ -159,20 +159,27 @@ class ClGroup final : public DeviceMirror {
     profiled_.clear();
   }
 
-  void pullToHost(GroupImpl& g) override {
+  void pullToHost(GroupImpl& g, AttributeSet want) override {
     if (!deviceNewer_) return;
     drain(g);
+    g.size = size_;
+    g.nextId = nextId_;
+    bool read = false;
     for (auto& lane : lanes_) {
       if (size_ == 0) break;
+      if (!want.has(lane.ref.attribute) || fresh_.has(lane.ref.attribute)) continue;
       void* dst = g.lanes[std::size_t(lane.ref.attribute)][lane.ref.component].data();
       check(clEnqueueReadBuffer(queue(), lane.mem.get(), CL_FALSE, 0, size_ * 4, dst, 0, nullptr,
                                 nullptr),
             "clEnqueueReadBuffer (particles)");
+      g.stats.bytesReadBack += size_ * 4;
+      read = true;
     }
-    check(clFinish(queue()), "clFinish");
-    g.size = size_;
-    g.nextId = nextId_;
-    deviceNewer_ = false;
+    if (read) check(clFinish(queue()), "clFinish");
+    for (auto& lane : lanes_)
+      if (want.has(lane.ref.attribute)) fresh_.insert(lane.ref.attribute);
+    // Every stored lane is the device's now (an empty group: nothing to read).
+    if (size_ == 0 || fresh_.contains(laneSet_)) deviceNewer_ = false;
   }
 
   void hostChanged(GroupImpl&) override { hostDirty_ = true; }
@@ -242,6 +249,8 @@ class ClGroup final : public DeviceMirror {
   std::vector<std::uint32_t> lastKills_;
   bool hostDirty_ = true;
   bool deviceNewer_ = false;
+  // While deviceNewer_: the attributes whose host lanes already hold the device's particles.
+  AttributeSet fresh_;
 };
 
 void ClGroup::allocate(GroupImpl& g) {
@@ -790,6 +799,7 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   }
   check(clFlush(q), "clFlush");
   deviceNewer_ = true;
+  fresh_ = AttributeSet();
   if (g.hair.enabled && births > 0) {
     // Strands are host data: the step's come back now.
     drain(g);

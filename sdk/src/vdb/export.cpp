@@ -101,6 +101,11 @@ Particles Particles::capture(const Group& group, const ExportOptions& o) {
   out.group = group.name();
   const std::size_t n = group.size();
   const AttributeSet stored = group.attributes();
+  // What it reads, back from a device in one transfer.
+  AttributeSet reads{Attribute::Position, Attribute::Id,   Attribute::Velocity,
+                     Attribute::Color,    Attribute::Size, Attribute::Visible};
+  if (o.points) reads.insert(Attribute::Age);
+  group.fetch(reads);
   // Which particles: all, or those no blocker hides. Visible not stored: none is hidden.
   std::vector<std::uint32_t> keep;
   const bool filter = !o.keepHidden && stored.has(Attribute::Visible);
