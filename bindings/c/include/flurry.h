@@ -17,10 +17,12 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#if defined(_WIN32)
-#define FLURRY_C_EXPORT __declspec(dllimport)
-#else
+/* The library is built with hidden visibility and a version script (flurry_c.map): only
+ * what is marked here is exported. */
+#if defined(__GNUC__)
 #define FLURRY_C_EXPORT __attribute__((visibility("default")))
+#else
+#define FLURRY_C_EXPORT
 #endif
 
 #ifdef __cplusplus
