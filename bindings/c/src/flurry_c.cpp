@@ -10,6 +10,7 @@
 #include <new>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -53,6 +54,16 @@ static_assert(int(FLURRY_ATTR_BIRTH_SIZE) == int(flurry::Attribute::BirthSize));
 static_assert(int(FLURRY_BACKEND_AUTO) == int(flurry::Backend::Auto));
 
 constexpr int kOpenCLDeviceNotFound = -1;  // CL_DEVICE_NOT_FOUND
+
+/// The integer a C caller stored in an enum. Read as bytes: in C++ an enum object holding a
+/// value outside its enumerators' range is undefined behaviour to load, and C allows it.
+template <class E>
+long long rawValue(const E& e) {
+  std::underlying_type_t<E> v;
+  static_assert(sizeof v == sizeof e);
+  std::memcpy(&v, &e, sizeof v);
+  return (long long)v;
+}
 
 /// A failure the C layer itself detects (a NULL handle, an index out of range, ...).
 struct Failure {
@@ -243,11 +254,11 @@ flurry::Emitter readEmitter(const flurry_emitter* e) {
   return flurry::detail::parseEffectEmitter(e->fields.dump(), "", "emitter", loadOptions());
 }
 
-flurry::Attribute attribute(flurry_attribute a) {
-  if (int(a) < 0 || int(a) >= int(FLURRY_ATTR_COUNT))
-    throw flurry::InvalidArgument("attribute",
-                                  std::to_string(int(a)) + " is not a flurry_attribute");
-  return flurry::Attribute(a);
+flurry::Attribute attribute(const flurry_attribute& a) {
+  const long long v = rawValue(a);
+  if (v < 0 || v >= FLURRY_ATTR_COUNT)
+    throw flurry::InvalidArgument("attribute", std::to_string(v) + " is not a flurry_attribute");
+  return flurry::Attribute(v);
 }
 
 /// Checks that `g` stores float attribute `a` and has component `c`.
@@ -280,8 +291,8 @@ int flurry_abi_version(void) {
 const char* flurry_last_error(void) {
   return t_outOfMemory ? "out of memory" : t_lastError.c_str();
 }
-const char* flurry_status_name(flurry_status s) {
-  switch (s) {
+const char* flurry_status_name(flurry_status status) {
+  switch (rawValue(status)) {
     case FLURRY_OK:
       return "FLURRY_OK";
     case FLURRY_ERROR_NULL_ARGUMENT:
@@ -332,13 +343,14 @@ flurry_status flurry_context_create(const flurry_context_options* options, flurr
     *out = nullptr;
     flurry::ContextOptions o;
     if (options) {
-      if (int(options->backend) < 0 || int(options->backend) > int(FLURRY_BACKEND_AUTO))
-        throw flurry::InvalidArgument(
-            "backend", std::to_string(int(options->backend)) + " is not a flurry_backend");
+      const long long backend = rawValue(options->backend);
+      if (backend < 0 || backend > FLURRY_BACKEND_AUTO)
+        throw flurry::InvalidArgument("backend",
+                                      std::to_string(backend) + " is not a flurry_backend");
       o.seed = options->seed;
       o.dt = options->dt;
       o.threads = options->threads;
-      o.backend = flurry::Backend(options->backend);
+      o.backend = flurry::Backend(backend);
       if (options->device) o.device = options->device;
     }
 #ifndef FLURRY_C_HAS_OPENCL
