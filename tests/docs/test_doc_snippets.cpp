@@ -1,5 +1,6 @@
-// The code blocks of README.md and docs/guide.md are the files under docs/snippets/, byte for
-// byte: a ```cpp block names its file on its first line (`// docs/snippets/NAME.cpp...`), a
+// The code blocks of README.md, docs/guide.md and docs/c-api.md are the files under docs/snippets/,
+// byte for byte: a ```cpp block names its file on its first line (`// docs/snippets/NAME.cpp...`),
+// a
 // ```json block on the line before its fence (`<!-- docs/snippets/NAME.json -->`). The files
 // themselves are built and run as tests (tests/docs/CMakeLists.txt), so a snippet that drifts
 // from its file, or a file that stops compiling or doing what the text says, fails.
@@ -40,7 +41,7 @@ std::vector<Block> codeBlocks(const std::string& markdown) {
     std::size_t j = i + 1;
     for (; j < lines.size() && lines[j] != "```"; ++j) b.body += lines[j] + "\n";
     const std::string prefix = "// docs/snippets/";
-    if (b.language == "cpp" && b.body.rfind(prefix, 0) == 0) {
+    if ((b.language == "cpp" || b.language == "c") && b.body.rfind(prefix, 0) == 0) {
       std::string first = b.body.substr(3, b.body.find('\n') - 3);
       b.file = first.substr(0, first.find_first_of(": "));
     }
@@ -54,13 +55,13 @@ std::vector<Block> codeBlocks(const std::string& markdown) {
   return blocks;
 }
 
-// The pages whose C++ and JSON blocks must all be snippet files.
-const char* const kPages[] = {"README.md", "docs/guide.md"};
+// The pages whose C, C++ and JSON blocks must all be snippet files.
+const char* const kPages[] = {"README.md", "docs/guide.md", "docs/c-api.md"};
 
 TEST(DocSnippets, EveryCppAndJsonBlockIsItsSnippetFile) {
   for (const char* page : kPages) {
     for (const Block& b : codeBlocks(readText(kRoot / page))) {
-      if (b.language != "cpp" && b.language != "json") continue;
+      if (b.language != "cpp" && b.language != "c" && b.language != "json") continue;
       SCOPED_TRACE(std::string(page) + ":" + std::to_string(b.line));
       ASSERT_FALSE(b.file.empty())
           << "a ```" << b.language << " block names no docs/snippets/ file (see "

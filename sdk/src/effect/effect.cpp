@@ -3,6 +3,8 @@
 // errors with a suggestion: a typo must not silently become a default.
 #include "flurry/effect.hpp"
 
+#include "effect/effect_parts.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -993,14 +995,19 @@ Action readActionBody(Obj& o, const std::string& type) {
   return a;
 }
 
+/// Fails at `typePath` unless `type` names an action an effect file can hold.
+void checkActionType(const std::string& type, const std::string& typePath, const Loader& L) {
+  if (type == "Callback")
+    L.fail(typePath, "a Callback runs C++ code and cannot be described in an effect file");
+  if (std::find(kActionTypes.begin(), kActionTypes.end(), type) == kActionTypes.end())
+    L.fail(typePath, "unknown action \"" + type + "\"" + suggestion(type, kActionTypes));
+}
+
 Action readAction(const json& j, const std::string& path, const Loader& L) {
   Obj o(j, path, L);
   std::string type;
   o.req("type", type, "the action's name, e.g. \"Gravity\"");
-  if (type == "Callback")
-    L.fail(o.at("type"), "a Callback runs C++ code and cannot be described in an effect file");
-  if (std::find(kActionTypes.begin(), kActionTypes.end(), type) == kActionTypes.end())
-    L.fail(o.at("type"), "unknown action \"" + type + "\"" + suggestion(type, kActionTypes));
+  checkActionType(type, o.at("type"), L);
   Action a = readActionBody(o, type);
   o.finish();
   return a;
@@ -1422,6 +1429,56 @@ Effect parseEffect(std::string_view text, const std::string& fileName,
     throw EffectError(fileName, "", std::string("malformed: ") + e.what());
   }
 }
+
+namespace detail {
+
+namespace {
+/// Parses one part's JSON text, reporting a syntax error at `path`.
+json parsePart(std::string_view text, const std::string& fileName, const std::string& path) {
+  try {
+    return json::parse(text.begin(), text.end(), nullptr, true, true);
+  } catch (const json::exception& e) {
+    std::string why = e.what();
+    if (const auto p = why.find("] "); p != std::string::npos) why = why.substr(p + 2);
+    throw EffectError(fileName, path, why);
+  }
+}
+}  // namespace
+
+void checkEffectActionType(const std::string& type, const std::string& fileName,
+                           const std::string& path) {
+  const EffectLoadOptions none;
+  const Loader L{fileName, &none, 0};
+  checkActionType(type, join(path, "type"), L);
+}
+
+ActionList parseEffectActions(std::string_view actions, const std::string& fileName,
+                              const std::string& path, const EffectLoadOptions& options) {
+  const json j = parsePart(actions, fileName, path);
+  const Loader L{fileName, &options, 0};
+  try {
+    arrayOf(j, path, L, 0, "an array of actions");
+    ActionList list;
+    for (std::size_t i = 0; i < j.size(); ++i)
+      addAction(list, readAction(j[i], index(path, i), L), index(path, i), L);
+    return list;
+  } catch (const json::exception& e) {
+    throw EffectError(fileName, path, std::string("malformed: ") + e.what());
+  }
+}
+
+Emitter parseEffectEmitter(std::string_view emitter, const std::string& fileName,
+                           const std::string& path, const EffectLoadOptions& options) {
+  const json j = parsePart(emitter, fileName, path);
+  const Loader L{fileName, &options, 0};
+  try {
+    return readEmitter(j, path, L);
+  } catch (const json::exception& e) {
+    throw EffectError(fileName, path, std::string("malformed: ") + e.what());
+  }
+}
+
+}  // namespace detail
 
 namespace {
 std::string byteCount(std::size_t n) {

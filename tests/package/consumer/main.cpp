@@ -10,6 +10,9 @@
 #ifdef CONSUMER_VDB
 #include <flurry/vdb.hpp>
 #endif
+#ifdef CONSUMER_C
+#include <flurry.h>
+#endif
 
 namespace fs = std::filesystem;
 
@@ -45,6 +48,15 @@ int main() {
   std::printf("consumer: vdb: %zu points, %llu bytes\n", st.points,
               static_cast<unsigned long long>(st.bytes));
   if (st.points != g.size() || st.bytes == 0 || !fs::exists(dir / "x.vdb")) ++bad;
+#endif
+#ifdef CONSUMER_C
+  // The C API, through flurry::c.
+  flurry_context* c = nullptr;
+  const bool cOk = flurry_abi_version() == FLURRY_C_ABI_VERSION &&
+                   flurry_context_create(nullptr, &c) == FLURRY_OK;
+  std::printf("consumer: c: flurry %s, ABI %d\n", flurry_version(), flurry_abi_version());
+  flurry_context_destroy(c);
+  if (!cOk) ++bad;
 #endif
   fs::remove_all(dir);
   return bad;

@@ -1,0 +1,319 @@
+/* Flurry's C API (C99): the SDK for game engines and other languages' bindings.
+ *
+ * Handles are opaque. Every call returns a flurry_status; FLURRY_OK is 0. On failure
+ * flurry_last_error() gives the message on the calling thread, worded as the C++ SDK's
+ * exceptions (an effect error reads "FILE: JSON.PATH: why"). No C++ exception crosses this
+ * interface.
+ *
+ * Ownership: what a *_create / *_load / *_parse call returns is the caller's, to be freed
+ * with the matching *_destroy. A group belongs to its context (valid until the context is
+ * destroyed). Pointers into a group's data (flurry_group_lane, flurry_group_ids, the stats
+ * arrays) stay valid until the next step, build or change of that group. Strings returned as
+ * `const char*` belong to the handle they came from. See docs/c-api.md.
+ */
+#ifndef FLURRY_H
+#define FLURRY_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* The library is built with hidden visibility and a version script (flurry_c.map): only
+ * what is marked here is exported. */
+#if defined(__GNUC__)
+#define FLURRY_C_EXPORT __attribute__((visibility("default")))
+#else
+#define FLURRY_C_EXPORT
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** The C interface's ABI number: raised when a struct, enum value or signature changes. */
+#define FLURRY_C_ABI_VERSION 1
+
+typedef enum flurry_status {
+  FLURRY_OK = 0,
+  FLURRY_ERROR_NULL_ARGUMENT = 1,    /**< a handle or pointer argument is NULL */
+  FLURRY_ERROR_INVALID_ARGUMENT = 2, /**< a value out of range, a bad field path */
+  FLURRY_ERROR_EFFECT = 3,           /**< an effect file, JSON text or fields set in code */
+  FLURRY_ERROR_IO = 4,               /**< a file could not be read or written */
+  FLURRY_ERROR_NO_DEVICE = 5,        /**< no OpenCL platform, or no device matching */
+  FLURRY_ERROR_OPENCL = 6,           /**< another OpenCL failure */
+  FLURRY_ERROR_NOT_BUILT = 7,        /**< the feature is not in this build (OpenCL, VDB) */
+  FLURRY_ERROR_NOT_FOUND = 8,        /**< no group of that name, an index out of range */
+  FLURRY_ERROR_NOT_STORED = 9,       /**< the group does not store that attribute */
+  FLURRY_ERROR_WRONG_TYPE = 10,      /**< e.g. a float array asked of a uint32 attribute */
+  FLURRY_ERROR_OUT_OF_MEMORY = 11,
+  FLURRY_ERROR_OTHER = 12 /**< any other failure (the message says what) */
+} flurry_status;
+
+typedef enum flurry_backend {
+  FLURRY_BACKEND_CPU = 0,
+  FLURRY_BACKEND_OPENCL = 1,
+  FLURRY_BACKEND_AUTO = 2 /**< OpenCL if a device is usable, else the CPU */
+} flurry_backend;
+
+/** The particle attributes (flurry::Attribute). Id and Visible are uint32, the rest float. */
+typedef enum flurry_attribute {
+  FLURRY_ATTR_POSITION = 0, /**< 3 components */
+  FLURRY_ATTR_VELOCITY,     /**< 3 */
+  FLURRY_ATTR_COLOR,        /**< 4: r, g, b, a */
+  FLURRY_ATTR_SIZE,         /**< radius */
+  FLURRY_ATTR_MASS,
+  FLURRY_ATTR_AGE,
+  FLURRY_ATTR_LIFETIME,
+  FLURRY_ATTR_ID, /**< uint32: flurry_group_ids */
+  FLURRY_ATTR_PREV_POSITION,
+  FLURRY_ATTR_UP,
+  FLURRY_ATTR_ROT_VELOCITY,
+  FLURRY_ATTR_CHARGE,
+  FLURRY_ATTR_VISIBLE, /**< uint32: flurry_group_visible */
+  FLURRY_ATTR_USER_DATA,
+  FLURRY_ATTR_POSITION_B,
+  FLURRY_ATTR_VELOCITY_B,
+  FLURRY_ATTR_BIRTH_COLOR,
+  FLURRY_ATTR_BIRTH_SIZE,
+  FLURRY_ATTR_COUNT
+} flurry_attribute;
+
+typedef struct flurry_context flurry_context;
+typedef struct flurry_group flurry_group;
+typedef struct flurry_effect flurry_effect;
+typedef struct flurry_action_list flurry_action_list;
+typedef struct flurry_emitter flurry_emitter;
+
+/* ---- version and errors ------------------------------------------------------------------ */
+
+/** "0.1.0": the SDK's version. */
+FLURRY_C_EXPORT const char* flurry_version(void);
+/** FLURRY_C_ABI_VERSION of the library loaded (compare with the header's). */
+FLURRY_C_EXPORT int flurry_abi_version(void);
+/** The message of the last failed call on this thread ("" if none). Valid until the next
+ * failing call on this thread. */
+FLURRY_C_EXPORT const char* flurry_last_error(void);
+/** A status's name: "FLURRY_ERROR_EFFECT", ... */
+FLURRY_C_EXPORT const char* flurry_status_name(flurry_status status);
+
+/* ---- context ----------------------------------------------------------------------------- */
+
+typedef struct flurry_context_options {
+  uint64_t seed;          /**< 1 */
+  double dt;              /**< seconds per step: 1/30 */
+  unsigned threads;       /**< 0: one per hardware thread */
+  flurry_backend backend; /**< FLURRY_BACKEND_CPU */
+  const char* device;     /**< OpenCL: a substring of the platform or device name; NULL: any */
+} flurry_context_options;
+
+/** Fills `options` with the defaults above. */
+FLURRY_C_EXPORT flurry_status flurry_context_options_init(flurry_context_options* options);
+/** Creates a context; `options` NULL takes the defaults. FLURRY_BACKEND_OPENCL fails with
+ * FLURRY_ERROR_NOT_BUILT (no OpenCL in this build) or FLURRY_ERROR_NO_DEVICE. */
+FLURRY_C_EXPORT flurry_status flurry_context_create(const flurry_context_options* options,
+                                                    flurry_context** out);
+FLURRY_C_EXPORT flurry_status flurry_context_destroy(flurry_context* ctx);
+/** Advances every group by one time step. */
+FLURRY_C_EXPORT flurry_status flurry_context_step(flurry_context* ctx);
+FLURRY_C_EXPORT flurry_status flurry_context_run(flurry_context* ctx, uint64_t steps);
+FLURRY_C_EXPORT flurry_status flurry_context_time(const flurry_context* ctx, double* seconds);
+FLURRY_C_EXPORT flurry_status flurry_context_step_index(const flurry_context* ctx, uint64_t* index);
+FLURRY_C_EXPORT flurry_status flurry_context_time_step(const flurry_context* ctx, double* dt);
+FLURRY_C_EXPORT flurry_status flurry_context_set_time_step(flurry_context* ctx, double dt);
+/** The backend it runs (FLURRY_BACKEND_AUTO resolves to CPU or OpenCL). */
+FLURRY_C_EXPORT flurry_status flurry_context_backend(const flurry_context* ctx,
+                                                     flurry_backend* backend);
+/** Why FLURRY_BACKEND_AUTO took the CPU ("" when it did not). */
+FLURRY_C_EXPORT flurry_status flurry_context_backend_fallback(const flurry_context* ctx,
+                                                              const char** why);
+/** A new empty group of fixed capacity, owned by the context. */
+FLURRY_C_EXPORT flurry_status flurry_context_create_group(flurry_context* ctx, const char* name,
+                                                          size_t capacity, flurry_group** out);
+/** The group of that name (FLURRY_ERROR_NOT_FOUND if none). */
+FLURRY_C_EXPORT flurry_status flurry_context_group(flurry_context* ctx, const char* name,
+                                                   flurry_group** out);
+FLURRY_C_EXPORT flurry_status flurry_context_group_count(const flurry_context* ctx, size_t* count);
+FLURRY_C_EXPORT flurry_status flurry_context_group_at(flurry_context* ctx, size_t index,
+                                                      flurry_group** out);
+
+/* ---- effects ----------------------------------------------------------------------------- */
+
+/** Loads and validates an effect file (FLURRY_ERROR_EFFECT: "FILE: JSON.PATH: why"). */
+FLURRY_C_EXPORT flurry_status flurry_effect_load(const char* path, flurry_effect** out);
+/** Parses an effect from JSON text; `name` names it in errors (NULL: "<effect>"). */
+FLURRY_C_EXPORT flurry_status flurry_effect_parse(const char* json, const char* name,
+                                                  flurry_effect** out);
+FLURRY_C_EXPORT flurry_status flurry_effect_destroy(flurry_effect* effect);
+FLURRY_C_EXPORT flurry_status flurry_effect_name(const flurry_effect* effect, const char** name);
+/** The steps `flurry run` takes by default. */
+FLURRY_C_EXPORT flurry_status flurry_effect_frames(const flurry_effect* effect, int* frames);
+/** The effect's seed and dt over the defaults (then choose the backend). */
+FLURRY_C_EXPORT flurry_status flurry_effect_context_options(const flurry_effect* effect,
+                                                            flurry_context_options* options);
+FLURRY_C_EXPORT flurry_status flurry_effect_warning_count(const flurry_effect* effect,
+                                                          size_t* count);
+/** Warning `index`: "JSON.PATH: why". */
+FLURRY_C_EXPORT flurry_status flurry_effect_warning(const flurry_effect* effect, size_t index,
+                                                    const char** message);
+/** The `render` object as JSON text ("{}" when absent). */
+FLURRY_C_EXPORT flurry_status flurry_effect_render_json(const flurry_effect* effect,
+                                                        const char** json);
+/** Creates the effect's groups in `ctx`; max_capacity > 0 caps each group's capacity. */
+FLURRY_C_EXPORT flurry_status flurry_effect_build(const flurry_effect* effect, flurry_context* ctx,
+                                                  size_t max_capacity);
+
+/* ---- action lists and emitters, by name and field ----------------------------------------
+ * Fields are those of the effect format (docs/effect-format.md), validated by the effect
+ * loader when the list or emitter is used (or checked with *_validate), so that an error
+ * names the field as an effect file would: "actions[1].restitution: must be in [0, 1]".
+ * A field path may go into objects and arrays: "surface.normal", "types[0].lifetime". A
+ * domain field is set with *_set_domain (its type) and then its own fields
+ * ("surface.normal"), or whole with *_set_json. A float field accepts +-INFINITY where the
+ * format accepts "inf"; NaN is refused. */
+
+FLURRY_C_EXPORT flurry_status flurry_action_list_create(flurry_action_list** out);
+FLURRY_C_EXPORT flurry_status flurry_action_list_destroy(flurry_action_list* list);
+/** Appends an action by name ("Gravity", "Bounce", ...); its index in *index (may be NULL).
+ * An unknown name is FLURRY_ERROR_EFFECT: "actions[2].type: unknown action ..." */
+FLURRY_C_EXPORT flurry_status flurry_action_list_add(flurry_action_list* list, const char* action,
+                                                     size_t* index);
+FLURRY_C_EXPORT flurry_status flurry_action_list_count(const flurry_action_list* list,
+                                                       size_t* count);
+FLURRY_C_EXPORT flurry_status flurry_action_set_float(flurry_action_list* list, size_t index,
+                                                      const char* field, double value);
+FLURRY_C_EXPORT flurry_status flurry_action_set_int(flurry_action_list* list, size_t index,
+                                                    const char* field, int64_t value);
+FLURRY_C_EXPORT flurry_status flurry_action_set_bool(flurry_action_list* list, size_t index,
+                                                     const char* field, int value);
+FLURRY_C_EXPORT flurry_status flurry_action_set_vec3(flurry_action_list* list, size_t index,
+                                                     const char* field, float x, float y, float z);
+FLURRY_C_EXPORT flurry_status flurry_action_set_vec4(flurry_action_list* list, size_t index,
+                                                     const char* field, float x, float y, float z,
+                                                     float w);
+FLURRY_C_EXPORT flurry_status flurry_action_set_string(flurry_action_list* list, size_t index,
+                                                       const char* field, const char* value);
+/** Sets `field` to a domain of type `domain` ("plane", "sphere", ...); its fields follow. */
+FLURRY_C_EXPORT flurry_status flurry_action_set_domain(flurry_action_list* list, size_t index,
+                                                       const char* field, const char* domain);
+/** Sets `field` to a JSON value given as text (a domain, a fuzzy value, keys, ...). */
+FLURRY_C_EXPORT flurry_status flurry_action_set_json(flurry_action_list* list, size_t index,
+                                                     const char* field, const char* json);
+/** Removes a field set before (its default applies again); nothing if it is not set. */
+FLURRY_C_EXPORT flurry_status flurry_action_unset(flurry_action_list* list, size_t index,
+                                                  const char* field);
+/** Reads the whole list as the loader would, without using it. */
+FLURRY_C_EXPORT flurry_status flurry_action_list_validate(const flurry_action_list* list);
+
+FLURRY_C_EXPORT flurry_status flurry_emitter_create(flurry_emitter** out);
+FLURRY_C_EXPORT flurry_status flurry_emitter_destroy(flurry_emitter* emitter);
+FLURRY_C_EXPORT flurry_status flurry_emitter_set_float(flurry_emitter* emitter, const char* field,
+                                                       double value);
+FLURRY_C_EXPORT flurry_status flurry_emitter_set_int(flurry_emitter* emitter, const char* field,
+                                                     int64_t value);
+FLURRY_C_EXPORT flurry_status flurry_emitter_set_bool(flurry_emitter* emitter, const char* field,
+                                                      int value);
+FLURRY_C_EXPORT flurry_status flurry_emitter_set_vec3(flurry_emitter* emitter, const char* field,
+                                                      float x, float y, float z);
+FLURRY_C_EXPORT flurry_status flurry_emitter_set_vec4(flurry_emitter* emitter, const char* field,
+                                                      float x, float y, float z, float w);
+FLURRY_C_EXPORT flurry_status flurry_emitter_set_string(flurry_emitter* emitter, const char* field,
+                                                        const char* value);
+FLURRY_C_EXPORT flurry_status flurry_emitter_set_domain(flurry_emitter* emitter, const char* field,
+                                                        const char* domain);
+FLURRY_C_EXPORT flurry_status flurry_emitter_set_json(flurry_emitter* emitter, const char* field,
+                                                      const char* json);
+FLURRY_C_EXPORT flurry_status flurry_emitter_unset(flurry_emitter* emitter, const char* field);
+FLURRY_C_EXPORT flurry_status flurry_emitter_validate(const flurry_emitter* emitter);
+
+/* ---- groups ------------------------------------------------------------------------------ */
+
+FLURRY_C_EXPORT flurry_status flurry_group_name(const flurry_group* group, const char** name);
+/** Live particles: indices [0, size). */
+FLURRY_C_EXPORT flurry_status flurry_group_size(const flurry_group* group, size_t* size);
+FLURRY_C_EXPORT flurry_status flurry_group_capacity(const flurry_group* group, size_t* capacity);
+/** Replaces the group's action list with `list` (read and validated; errors name
+ * "actions[i].field"). The list stays the caller's. */
+FLURRY_C_EXPORT flurry_status flurry_group_set_actions(flurry_group* group,
+                                                       const flurry_action_list* list);
+/** Adds a copy of `emitter` (read and validated; errors name "emitter.field"). */
+FLURRY_C_EXPORT flurry_status flurry_group_add_emitter(flurry_group* group,
+                                                       const flurry_emitter* emitter);
+/** Asks the group to store `attribute` although no action reads it (before stepping). */
+FLURRY_C_EXPORT flurry_status flurry_group_require(flurry_group* group, flurry_attribute attribute);
+/** Whether the group stores `attribute` (*stored 1 or 0). */
+FLURRY_C_EXPORT flurry_status flurry_group_stores(const flurry_group* group,
+                                                  flurry_attribute attribute, int* stored);
+/** Removes every particle (the statistics are kept). */
+FLURRY_C_EXPORT flurry_status flurry_group_clear(flurry_group* group);
+
+/** One component of a float attribute: particle i's value is at
+ * *(const float*)((const char*)*data + i * *stride) for i < *count; *stride in bytes.
+ * Valid until the next step. FLURRY_ERROR_NOT_STORED if the group does not store it,
+ * FLURRY_ERROR_WRONG_TYPE for Id and Visible. *data may be NULL when *count is 0. */
+FLURRY_C_EXPORT flurry_status flurry_group_lane(const flurry_group* group,
+                                                flurry_attribute attribute, int component,
+                                                const float** data, size_t* count, size_t* stride);
+/** The same array, writable (writing marks the particles changed for the backend). */
+FLURRY_C_EXPORT flurry_status flurry_group_lane_mut(flurry_group* group, flurry_attribute attribute,
+                                                    int component, float** data, size_t* count,
+                                                    size_t* stride);
+/** The particles' ids (always stored). */
+FLURRY_C_EXPORT flurry_status flurry_group_ids(const flurry_group* group, const uint32_t** data,
+                                               size_t* count, size_t* stride);
+/** 1 visible, 0 hidden by a blocker (FLURRY_ERROR_NOT_STORED without a Block action). */
+FLURRY_C_EXPORT flurry_status flurry_group_visible(const flurry_group* group, const uint32_t** data,
+                                                   size_t* count, size_t* stride);
+/** Axis-aligned bounds of the live particles (*empty 1 when there are none). */
+FLURRY_C_EXPORT flurry_status flurry_group_bounds(const flurry_group* group, float min[3],
+                                                  float max[3], int* empty);
+
+/** Where the particles went (flurry::GroupStats):
+ * emitted == size + killed_by_age + absorbed + dropped_at_capacity + killed_non_finite. */
+typedef struct flurry_group_stats {
+  uint64_t emitted;
+  uint64_t killed_by_age;
+  uint64_t absorbed;
+  uint64_t dropped_at_capacity;
+  uint64_t killed_non_finite;
+  uint64_t emitters_spawned;
+  uint64_t emitters_dropped;
+  uint64_t idle_steps;
+  uint64_t block_actions_culled;
+  double emit_seconds, act_seconds, compact_seconds; /**< CPU backend's cumulative times */
+} flurry_group_stats;
+
+FLURRY_C_EXPORT flurry_status flurry_group_stats_get(const flurry_group* group,
+                                                     flurry_group_stats* stats);
+/** Particles killed by each action-list entry (valid until the next step). */
+FLURRY_C_EXPORT flurry_status flurry_group_killed_by_action(const flurry_group* group,
+                                                            const uint64_t** data, size_t* count);
+/** Particles emitted by generation: 0 the group's own emitters, 1 spawned emitters, ... */
+FLURRY_C_EXPORT flurry_status flurry_group_emitted_by_generation(const flurry_group* group,
+                                                                 const uint64_t** data,
+                                                                 size_t* count);
+
+/* ---- packed vertex data for an engine's own draw (flurry/interop.hpp) -------------------- */
+
+/** Flurry's instance record, 32 bytes a particle, all float: x, y, z, radius, r, g, b, a. */
+#define FLURRY_INSTANCE_STRIDE 32
+/** Asks the group to store what flurry_group_pack_instances reads (call before stepping). */
+FLURRY_C_EXPORT flurry_status flurry_group_require_instances(flurry_group* group);
+/** Packs the visible live particles into `out` (`capacity_bytes` long: at least
+ * size * FLURRY_INSTANCE_STRIDE), nearest last to `eye` when it is not NULL (for blending
+ * without a depth buffer), the group's order otherwise; *written particles. */
+FLURRY_C_EXPORT flurry_status flurry_group_pack_instances(const flurry_group* group, void* out,
+                                                          size_t capacity_bytes, const float eye[3],
+                                                          size_t* written);
+
+/* ---- OpenVDB export (flurry/vdb.hpp) ----------------------------------------------------- */
+
+/** Whether this library was built with the OpenVDB exporter. */
+FLURRY_C_EXPORT int flurry_has_vdb(void);
+/** Writes the group's visible particles to `path` as a fog volume and a point cloud
+ * (atomically). FLURRY_ERROR_NOT_BUILT without OpenVDB; FLURRY_ERROR_IO naming the path. */
+FLURRY_C_EXPORT flurry_status flurry_group_write_vdb(const flurry_group* group, const char* path);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* FLURRY_H */
