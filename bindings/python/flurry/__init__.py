@@ -29,6 +29,7 @@ from ._flurry import (  # noqa: F401
     RenderError,
     __version__,
     builtin_effects,
+    load,
     has_render,
     has_vdb,
 )
@@ -111,13 +112,6 @@ def effect(groups: Iterable[dict], *, name: str = "python", **fields: Any) -> Ef
     """Builds an effect from group objects; the C++ loader validates it (EffectError)."""
     doc = {"version": 1, "name": name, **_jsonable(fields), "groups": list(groups)}
     return Effect.parse(_json.dumps(doc), name=f"<{name}>")
-
-
-def load(name_or_path: str) -> Effect:
-    """A built-in effect by name (see builtin_effects()) or an effect file by path."""
-    if name_or_path in builtin_effects():
-        return Effect.builtin(name_or_path)
-    return Effect.load(name_or_path)
 
 
 def simulate(effect: Effect, *, backend: str = "cpu", threads: int = 0, seed: int | None = None,

@@ -391,6 +391,14 @@ NB_MODULE(_flurry, m) {
           "Creates the effect's groups in `context`; max_capacity > 0 caps every group.");
 
   m.def(
+      "load",
+      [](const std::string& nameOrPath) {
+        return flurry::samples::loadEffectOrSample(nameOrPath, loadOptions());
+      },
+      "name_or_path"_a,
+      "An effect file by path (an existing file, or a name ending in .json or holding a /), "
+      "else a built-in effect by name (builtin_effects()).");
+  m.def(
       "builtin_effects",
       [] {
         std::vector<std::string> out;
