@@ -128,6 +128,14 @@ nb::object lane(const GroupRef& pg, const std::string& name, int component, bool
   return viewOf(pg, s.data(), s.size(), false, false);
 }
 
+// A numpy array that owns `values` (moved into its capsule): for copies the caller keeps.
+template <class T>
+nb::object owned(std::vector<T> values, std::initializer_list<std::size_t> shape) {
+  auto* v = new std::vector<T>(std::move(values));
+  nb::capsule cap(v, [](void* p) noexcept { delete static_cast<std::vector<T>*>(p); });
+  return nb::ndarray<nb::numpy, T>(v->data(), shape.size(), shape.begin(), cap).cast();
+}
+
 std::vector<std::string> attributeNames(flurry::AttributeSet set) {
   std::vector<std::string> out;
   for (int i = 0; i < int(flurry::Attribute::Count); ++i)
@@ -278,6 +286,26 @@ NB_MODULE(_flurry, m) {
             pg.g->require(set);
           },
           "attributes"_a, "Asks the group to store these attributes too (for a reader).")
+      .def(
+          "strands",
+          [](const GroupRef& pg) {
+            // Copies: a strand store grows (and reallocates) as steps add strands.
+            const flurry::Strands& s = pg.g->strands();
+            const std::size_t n = s.vertexCount();
+            std::vector<float> pos(n * 3), col(s.color.size() * 4);
+            for (std::size_t i = 0; i < n; ++i)
+              for (int c = 0; c < 3; ++c) pos[i * 3 + c] = s.position[i][c];
+            for (std::size_t i = 0; i < s.color.size(); ++i)
+              for (int c = 0; c < 4; ++c) col[i * 4 + c] = s.color[i][c];
+            nb::dict d;
+            d["position"] = owned(std::move(pos), {n, 3});
+            d["color"] = owned(std::move(col), {s.color.size(), 4});
+            d["radius"] = owned(s.radius, {s.radius.size()});
+            d["start"] = owned(s.start, {s.start.size()});
+            return d;
+          },
+          "Hair mode's strands, copied: position (v, 3), color (v, 4), radius (v,), and start "
+          "(strands + 1,): strand k is vertices start[k]:start[k+1].")
       .def(
           "sync", [](GroupRef& pg) { std::as_const(*pg.g).ids(); },
           "Brings the host copy up to date (OpenCL); Context.step does it for groups with views.")

@@ -231,3 +231,15 @@ def test_vdb_export(tmp_path):
     with pytest.raises(flurry.IoError) as info:
         flurry.write_vdb(tmp_path / "no" / "such" / "dir" / "f.vdb", g)
     assert isinstance(info.value, OSError) and "f.vdb" in str(info.value)
+
+
+def test_hair_strands_are_reproducible_across_threads():
+    runs = []
+    for threads in (1, 2):
+        ctx = flurry.simulate(flurry.load("hair"), threads=threads)
+        ctx.step(10)
+        runs.append(ctx.group(ctx.groups[0].name).strands())
+    a, b = runs
+    assert len(a["start"]) > 1 and a["position"].shape == (a["start"][-1], 3)
+    for key in a:
+        assert np.array_equal(a[key], b[key]), key
