@@ -243,3 +243,22 @@ def test_hair_strands_are_reproducible_across_threads():
     assert len(a["start"]) > 1 and a["position"].shape == (a["start"][-1], 3)
     for key in a:
         assert np.array_equal(a[key], b[key]), key
+
+
+@pytest.mark.skipif(not flurry.has_render, reason="built without the renderer")
+def test_render_to_a_numpy_image():
+    fx = flurry.load("fountain")
+    ctx = flurry.simulate(fx)
+    g = ctx.groups[0]
+    g.require(flurry.Renderer.attributes())
+    ctx.step(30)
+    r = flurry.Renderer(160, 90, settings=fx.render)
+    img = r.render([g])
+    assert img.shape == (90, 160, 4) and img.dtype == np.uint8
+    empty = r.render([])
+    # The particles change pixels (water is bluish: more blue than red where drawn).
+    drawn = np.any(img != empty, axis=-1)
+    assert drawn.mean() > 0.001
+    assert img[drawn][:, 2].mean() > img[drawn][:, 0].mean()
+    with pytest.raises(flurry.InvalidArgument, match="render.camera.pitch|pitch"):
+        flurry.Renderer(16, 16, settings='{"camera": {"pitch": 95}}')
