@@ -262,3 +262,24 @@ def test_render_to_a_numpy_image():
     assert img[drawn][:, 2].mean() > img[drawn][:, 0].mean()
     with pytest.raises(flurry.InvalidArgument, match="render.camera.pitch|pitch"):
         flurry.Renderer(16, 16, settings='{"camera": {"pitch": 95}}')
+
+
+@pytest.mark.opencl
+def test_opencl_views_follow_the_device():
+    # The device holds the particles: step() reads them back for groups with live views and
+    # sends writable views' edits before stepping.
+    ctx = fountain(backend="opencl")
+    assert ctx.backend == "opencl"
+    ctx.step(10)
+    g = ctx.groups[0]
+    y = g.lane("position", 1)
+    before = y.copy()
+    ctx.step()
+    again = g.lane("position", 1)
+    n = min(len(y), len(again))
+    assert data_pointer(again) == data_pointer(y)
+    assert np.array_equal(y[:n], again[:n]) and not np.array_equal(y, before)
+    x = g.lane("position", 0, writable=True)
+    x[:] = 100.0
+    ctx.step()
+    assert np.all(g.lane("position", 0)[: len(x) // 2] > 90.0)
