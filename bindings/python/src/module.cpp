@@ -268,7 +268,10 @@ NB_MODULE(_flurry, m) {
       .def_prop_ro(
           "live_views", [](const GroupRef& g) { return g.pc->views[g.g].first; },
           "numpy views of this group's lanes still alive.")
-      .def("lane", &lane, "attribute"_a, "component"_a = 0, "writable"_a = false,
+      .def("lane", &lane,
+           nb::sig("def lane(self, attribute: str, component: int = 0, writable: bool = False) "
+                   "-> numpy.ndarray"),
+           "attribute"_a, "component"_a = 0, "writable"_a = false,
            "A numpy view (no copy) of one component of an attribute, size() long: float32, or "
            "uint32 for id and visible (always read-only). writable=True allows writing; the "
            "next step sees what was written.")
