@@ -10,9 +10,9 @@ def source_dir() -> pathlib.Path:
 
 
 @pytest.fixture
-def tool() -> str:
-    """The flurry command-line tool (the C++ API's results), passed by CTest."""
-    path = os.environ.get("FLURRY_TOOL", "")
+def dump_tool() -> str:
+    """tests/dump_effect.cpp: the C++ API's results for an effect, passed by CTest."""
+    path = os.environ.get("FLURRY_DUMP", "")
     if not path:
-        pytest.skip("FLURRY_TOOL not set (the flurry tool is built with FLURRY_SAMPLES)")
+        pytest.skip("FLURRY_DUMP not set (CTest sets it to the flurry_py_dump helper)")
     return path
