@@ -13,6 +13,7 @@
 #include <nanobind/stl/vector.h>
 
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -47,10 +48,12 @@ PyObject* pyRenderError = nullptr;
 
 void raise(PyObject* type, const char* what,
            std::initializer_list<std::pair<const char*, std::string>> attrs) {
-  PyObject* exc = PyObject_CallFunction(type, "s", what);
+  // Messages name files: a path need not be UTF-8, so undecodable bytes are replaced.
+  PyObject* exc = PyObject_CallFunction(
+      type, "N", PyUnicode_DecodeUTF8(what, Py_ssize_t(std::strlen(what)), "replace"));
   if (!exc) return;  // the call set its own error
   for (const auto& [name, value] : attrs) {
-    PyObject* v = PyUnicode_FromStringAndSize(value.data(), Py_ssize_t(value.size()));
+    PyObject* v = PyUnicode_DecodeUTF8(value.data(), Py_ssize_t(value.size()), "replace");
     if (v) PyObject_SetAttrString(exc, name, v);
     Py_XDECREF(v);
   }
@@ -423,8 +426,8 @@ NB_MODULE(_flurry, m) {
 
   m.def(
       "load",
-      [](const std::string& nameOrPath) {
-        return flurry::samples::loadEffectOrSample(nameOrPath, loadOptions());
+      [](const fs::path& nameOrPath) {  // a path: any bytes the file system allows
+        return flurry::samples::loadEffectOrSample(nameOrPath.string(), loadOptions());
       },
       "name_or_path"_a,
       "An effect file by path (an existing file, or a name ending in .json or holding a /), "

@@ -278,3 +278,13 @@ def test_opencl_views_follow_the_device():
     x[:] = 100.0
     ctx.step()
     assert np.all(g.lane("position", 0)[: len(x) // 2] > 90.0)
+
+
+def test_a_file_name_that_is_not_utf8_still_gives_its_message(tmp_path):
+    import os
+    bad = os.path.join(os.fsencode(tmp_path), b"caf\xe9.json")
+    with open(bad, "wb") as f:
+        f.write(b"{")
+    with pytest.raises(flurry.EffectError) as info:
+        flurry.load(os.fsdecode(bad))
+    assert "caf" in str(info.value) and ".json" in str(info.value)
