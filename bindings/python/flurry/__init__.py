@@ -35,16 +35,17 @@ from ._flurry import (  # noqa: F401
 )
 from . import _flurry
 
-if has_vdb:
-    from ._flurry import write_vdb  # noqa: F401
-if has_render:
-    from ._flurry import Renderer  # noqa: F401
-
 __all__ = [
     "Context", "Effect", "EffectError", "Error", "Group", "GroupStats", "InvalidArgument",
     "IoError", "RenderError", "action", "actions", "builtin_effects", "domain", "domains",
     "effect", "emitter", "gather", "group", "load", "simulate",
 ]
+if has_vdb:
+    from ._flurry import write_vdb  # noqa: F401
+    __all__.append("write_vdb")
+if has_render:
+    from ._flurry import Renderer  # noqa: F401
+    __all__.append("Renderer")
 
 
 def _camel(key: str) -> str:
