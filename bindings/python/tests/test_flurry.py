@@ -1,0 +1,290 @@
+import gc
+import json
+import re
+import subprocess
+
+import numpy as np
+import pytest
+
+import flurry
+
+
+def data_pointer(a: np.ndarray) -> int:
+    return a.__array_interface__["data"][0]
+
+
+def fountain(**kw) -> flurry.Context:
+    return flurry.simulate(flurry.load("fountain"), threads=1, **kw)
+
+
+# --- zero copy -------------------------------------------------------------------------------
+
+def test_views_are_the_group_storage_and_see_the_next_step():
+    ctx = fountain()
+    ctx.step(20)
+    g = ctx.group("fountain")
+    y = g.lane("position", 1)
+    assert y.dtype == np.float32 and y.shape == (len(g),) and not y.flags.owndata
+    before = y.copy()
+    ctx.step()
+    # The same memory, updated in place by the step: no copy anywhere.
+    again = g.lane("position", 1)
+    assert data_pointer(again) == data_pointer(y)
+    n = min(len(y), len(again))
+    assert np.array_equal(y[:n], again[:n])
+    assert not np.array_equal(y, before)
+
+
+def test_views_are_read_only_unless_asked_and_writes_reach_the_step():
+    ctx = fountain()
+    ctx.step(5)
+    g = ctx.groups[0]
+    with pytest.raises(ValueError):
+        g.lane("position", 0)[0] = 1.0
+    with pytest.raises(ValueError):
+        g.lane("id")[0] = 7
+    with pytest.raises(flurry.InvalidArgument, match="id is maintained by the group"):
+        g.lane("id", writable=True)
+    x = g.lane("position", 0, writable=True)
+    vx = g.lane("velocity", 0)
+    x[:] = 100.0
+    ctx.step()
+    # Particles alive before the step moved on from where Python put them.
+    assert np.all(g.lane("position", 0)[: len(x) // 2] > 90.0)
+    assert vx.dtype == np.float32
+
+
+def test_ids_are_uint32_and_unique():
+    ctx = fountain()
+    ctx.step(10)
+    ids = ctx.groups[0].lane("id")
+    assert ids.dtype == np.uint32 and len(np.unique(ids)) == len(ids)
+
+
+def test_gather_is_an_n_by_3_copy():
+    ctx = fountain()
+    ctx.step(3)
+    g = ctx.groups[0]
+    p = flurry.gather(g, "position")
+    assert p.shape == (len(g), 3)
+    assert np.array_equal(p[:, 2], g.lane("position", 2))
+
+
+# --- lifetime --------------------------------------------------------------------------------
+
+def test_a_view_keeps_the_context_alive():
+    ctx = fountain()
+    ctx.step(10)
+    z = ctx.groups[0].lane("position", 2)
+    expected = z.copy()
+    del ctx
+    gc.collect()
+    # Allocate and free a lot: freed lanes would be overwritten.
+    for _ in range(5):
+        junk = np.full(1 << 20, 123.0, dtype=np.float32)
+        del junk
+        fountain().step(2)
+    gc.collect()
+    assert np.array_equal(z, expected)
+
+
+def test_group_objects_keep_the_context_alive():
+    g = fountain().groups[0]
+    gc.collect()
+    assert g.name == "fountain" and g.capacity == 20000
+
+
+def test_require_refuses_while_views_are_alive():
+    ctx = fountain()
+    ctx.step(2)
+    g = ctx.groups[0]
+    y = g.lane("position", 1)
+    assert g.live_views == 1
+    with pytest.raises(flurry.Error, match="1 live attribute views"):
+        g.require(["color"])
+    g.require(["position"])  # already stored: nothing changes, allowed
+    del y
+    gc.collect()
+    assert g.live_views == 0
+    g.require(["color"])
+    ctx.step()
+    assert "color" in g.attributes
+    assert np.all(g.lane("color", 3) >= 0)
+
+
+def test_a_view_keeps_its_length_and_stays_in_bounds():
+    # A view is size() long when taken; a later step that changes the count leaves it
+    # looking at the same (still allocated, capacity-long) storage.
+    e = flurry.effect([flurry.group("g", 1000, emitters=[flurry.emitter(
+        shape=flurry.domains.point(point=(0, 0, 0)), rate=300)],
+        actions=[flurry.actions.Move(), flurry.actions.KillOld()])], dt=0.1)
+    ctx = flurry.simulate(e)
+    ctx.step(2)
+    a = ctx.groups[0].lane("age")
+    ctx.step(5)
+    assert len(a) < len(ctx.groups[0]) and len(ctx.groups[0].lane("age")) == len(ctx.groups[0])
+
+
+# --- exceptions ------------------------------------------------------------------------------
+
+def test_loader_errors_carry_the_json_path():
+    with pytest.raises(flurry.EffectError) as info:
+        flurry.effect([flurry.group("g", 10, actions=[
+            flurry.actions.Gravity(acceleration=(0, -9.8, 0)),
+            flurry.actions.Bounce(surface=flurry.domains.plane(point=(0, 0, 0), normal=(0, 1, 0)),
+                                  restitution=-1)])])
+    e = info.value
+    assert isinstance(e, ValueError) and isinstance(e, flurry.Error)
+    assert e.path.startswith("groups[0].actions[1]") and "restitution" in e.path
+    assert str(e).startswith("<python>: " + e.path + ": ") and e.why in str(e)
+
+
+def test_unknown_action_suggests_the_nearest():
+    with pytest.raises(flurry.EffectError, match='unknown action "Gravty"; did you mean "Gravity"'):
+        flurry.effect([flurry.group("g", 10, actions=[flurry.actions.Gravty()])])
+
+
+def test_snake_case_fields_reach_the_loader():
+    e = flurry.effect([flurry.group("g", 10, emitters=[flurry.emitter(
+        shape=flurry.domains.disc(center=(0, 0, 0), normal=(0, 1, 0), outer_radius=0.5), rate=10)],
+        actions=[flurry.actions.Move()])])
+    assert e.group_names == ["g"]
+
+
+def test_other_errors():
+    with pytest.raises(flurry.EffectError, match="no such file and no built-in effect"):
+        flurry.load("nonexistent-effect")
+    with pytest.raises(flurry.EffectError, match="did you mean \"fountain\""):
+        flurry.Effect.builtin("fountian")
+    with pytest.raises(flurry.InvalidArgument, match="backend"):
+        flurry.Context(backend="gpu")
+    with pytest.raises(flurry.InvalidArgument, match="^dt: "):
+        flurry.Context().dt = -1
+    with pytest.raises(flurry.InvalidArgument, match="capacity"):
+        flurry.Context().create_group("g", 0)
+    with pytest.raises(flurry.Error, match="no attribute|does not store attribute color"):
+        fountain().groups[0].lane("color")
+    with pytest.raises(flurry.InvalidArgument, match="unknown attribute \"colour\""):
+        fountain().groups[0].lane("colour")
+    with pytest.raises(flurry.EffectError, match=r"^\{: "):
+        flurry.Effect.parse("{", name="{")
+
+
+def test_stats_account_for_every_particle():
+    ctx = fountain()
+    ctx.step(150)
+    g = ctx.groups[0]
+    s = g.stats
+    assert s.killed_by_age > 0
+    assert s.emitted == len(g) + s.killed_by_age + s.absorbed + s.dropped_at_capacity + s.killed_non_finite
+
+
+# --- parity with the C++ API ----------------------------------------------------------------
+
+@pytest.mark.parametrize("name", flurry.builtin_effects())
+def test_parity_with_the_cpp_api(name, dump_tool, tmp_path):
+    # Every stored attribute, the strands and the statistics of every group, bitwise: the
+    # same seed gives the same numbers from Python as from C++.
+    frames, threads = 24, 2
+    subprocess.run([dump_tool, name, str(frames), str(threads), str(tmp_path)], check=True)
+    ctx = flurry.simulate(flurry.load(name), threads=threads)
+    ctx.step(frames)
+    assert ctx.step_index == frames
+    for g in ctx.groups:
+        def cpp(suffix, dtype):
+            return np.fromfile(tmp_path / f"{g.name}.{suffix}", dtype=dtype)
+
+        s = g.stats
+        assert list(cpp("stats", np.uint64)) == [s.emitted, s.killed_by_age, s.absorbed,
+                                                s.dropped_at_capacity, s.killed_non_finite]
+        compared = 0
+        for attribute in g.attributes:
+            for c in range(4):
+                path = tmp_path / f"{g.name}.{attribute}.{c}"
+                if not path.exists():
+                    break
+                mine = g.lane(attribute, c)
+                assert np.array_equal(np.fromfile(path, dtype=mine.dtype), mine), (attribute, c)
+                compared += 1
+        assert compared >= 4
+        strands = g.strands()
+        assert np.array_equal(cpp("strands.start", np.uint32), strands["start"])
+        assert np.array_equal(cpp("strands.position", np.float32).reshape(-1, 3),
+                              strands["position"])
+
+
+# --- export and rendering --------------------------------------------------------------------
+
+@pytest.mark.skipif(not flurry.has_vdb, reason="built without OpenVDB")
+def test_vdb_export(tmp_path):
+    ctx = fountain()
+    ctx.step(30)
+    g = ctx.groups[0]
+    out = flurry.write_vdb(tmp_path / "f.vdb", g)
+    assert out["points"] == len(g) and out["bytes"] == (tmp_path / "f.vdb").stat().st_size
+    assert out["fog_voxels"] > 0 and out["mass"] > 0
+    with pytest.raises(flurry.IoError) as info:
+        flurry.write_vdb(tmp_path / "no" / "such" / "dir" / "f.vdb", g)
+    assert isinstance(info.value, OSError) and "f.vdb" in str(info.value)
+
+
+def test_hair_strands_are_reproducible_across_threads():
+    runs = []
+    for threads in (1, 2):
+        ctx = flurry.simulate(flurry.load("hair"), threads=threads)
+        ctx.step(10)
+        runs.append(ctx.group(ctx.groups[0].name).strands())
+    a, b = runs
+    assert len(a["start"]) > 1 and a["position"].shape == (a["start"][-1], 3)
+    for key in a:
+        assert np.array_equal(a[key], b[key]), key
+
+
+@pytest.mark.skipif(not flurry.has_render, reason="built without the renderer")
+def test_render_to_a_numpy_image():
+    fx = flurry.load("fountain")
+    ctx = flurry.simulate(fx)
+    g = ctx.groups[0]
+    g.require(flurry.Renderer.attributes())
+    ctx.step(30)
+    r = flurry.Renderer(160, 90, settings=fx.render)
+    img = r.render([g])
+    assert img.shape == (90, 160, 4) and img.dtype == np.uint8
+    empty = r.render([])
+    # The particles change pixels (water is bluish: more blue than red where drawn).
+    drawn = np.any(img != empty, axis=-1)
+    assert drawn.mean() > 0.001
+    assert img[drawn][:, 2].mean() > img[drawn][:, 0].mean()
+    with pytest.raises(flurry.InvalidArgument, match="render.camera.pitch|pitch"):
+        flurry.Renderer(16, 16, settings='{"camera": {"pitch": 95}}')
+
+
+@pytest.mark.opencl
+def test_opencl_views_follow_the_device():
+    # The device holds the particles: step() reads them back for groups with live views and
+    # sends writable views' edits before stepping.
+    ctx = fountain(backend="opencl")
+    assert ctx.backend == "opencl"
+    ctx.step(10)
+    g = ctx.groups[0]
+    y = g.lane("position", 1)
+    before = y.copy()
+    ctx.step()
+    again = g.lane("position", 1)
+    n = min(len(y), len(again))
+    assert data_pointer(again) == data_pointer(y)
+    assert np.array_equal(y[:n], again[:n]) and not np.array_equal(y, before)
+    x = g.lane("position", 0, writable=True)
+    x[:] = 100.0
+    ctx.step()
+    assert np.all(g.lane("position", 0)[: len(x) // 2] > 90.0)
+
+
+def test_a_file_name_that_is_not_utf8_still_gives_its_message(tmp_path):
+    import os
+    bad = os.path.join(os.fsencode(tmp_path), b"caf\xe9.json")
+    with open(bad, "wb") as f:
+        f.write(b"{")
+    with pytest.raises(flurry.EffectError) as info:
+        flurry.load(os.fsdecode(bad))
+    assert "caf" in str(info.value) and ".json" in str(info.value)
