@@ -367,3 +367,39 @@ TEST(OpenCLBackend, ReadsBackOnlyWhatIsAsked) {
   ASSERT_EQ(cpu.size(), cl.size());
   for (std::size_t i = 0; i < cpu.size(); ++i) EXPECT_NEAR(cpu[i], cl[i], 1e-4f) << i;
 }
+
+// A group with nothing alive and no emitter costs no launch on the device either: its steps
+// are counted idle, as on the CPU (a few later at most: the host learns the device's count
+// of a step when that step has finished), and particles the host adds end the idling.
+// (The list and attributes of HostReadsAndWritesBetweenSteps: one program for both.)
+TEST(OpenCLBackend, IdleGroupsCostNoLaunch) {
+  FLURRY_REQUIRE_OPENCL();
+  auto run = [](Backend b) {
+    ContextOptions o = openclOptions();
+    o.backend = b;
+    Context ctx(o);
+    Group& g = ctx.createGroup("g", 1000);
+    g.setActions({Gravity{Vec3(0.0f, -1.0f, 0.0f)}, Move{}, KillOld{}});
+    auto addSome = [&](int n) {
+      for (int i = 0; i < n; ++i) {
+        Particle p;
+        p.position = Vec3(float(i), 0.0f, 0.0f);
+        p.lifetime = 0.02f * float(i % 7);
+        g.add(p);
+      }
+    };
+    addSome(100);
+    ctx.run(30);
+    EXPECT_EQ(g.size(), 0u);
+    addSome(50);
+    ctx.run(30);
+    return std::make_pair(g.stats().idleSteps, g.stats().killedByAge);
+  };
+  const auto cpu = run(Backend::Cpu);
+  const auto cl = run(Backend::OpenCL);
+  EXPECT_EQ(cpu.second, 150u);
+  EXPECT_EQ(cl.second, cpu.second);
+  EXPECT_GT(cpu.first, 40u);
+  EXPECT_LE(cl.first, cpu.first);
+  EXPECT_GE(cl.first + 2 * 5, cpu.first);  // each of the two idle spells a few steps late
+}

@@ -535,6 +535,20 @@ void ClGroup::readStrands(GroupImpl& g, std::size_t births) {
 
 void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   checkEmissionSupported(g);
+  // Idle, as on the CPU: nothing alive (at most: the last count read plus the births queued
+  // since; the host's own count if it changed the particles) and no emitter that will fire.
+  // Such a step changes nothing: no planning, no upload, no launch.
+  {
+    std::size_t live = size_;
+    for (std::size_t k = 0; k < inFlight_.size(); ++k) live += inFlight_[k].births;
+    if (hostDirty_) live = g.size;
+    if (live == 0 && !g.hair.enabled && !mayEmit(g, sp)) {
+      if (!g.emitters.empty() && g.stats.emittedByGeneration.empty())
+        g.stats.emittedByGeneration.assign(1, 0);
+      ++g.stats.idleSteps;
+      return;
+    }
+  }
   if (!allocated_ || laneSet_ != g.stored) {
     drain(g);
     allocate(g);
