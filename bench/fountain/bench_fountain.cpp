@@ -20,6 +20,7 @@
 #include <benchmark/benchmark.h>
 
 #include "common/read_modify_write.hpp"
+#include "common/scenes.hpp"
 
 #include <cstdio>
 #include <cstdlib>
@@ -117,23 +118,8 @@ void Emission(benchmark::State& state) {
       born / threads() * 1e-9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
-// A fountain-like group of about 1000 live particles at steady state: rate × lifetime =
-// 500/s × 2 s, gravity, a plane bounce, KillOld, Move (about 17 born and dying per step).
-constexpr std::size_t kSmallLive = 1000;
-
-Group& smallFountain(Context& ctx, const std::string& name) {
-  Group& g = ctx.createGroup(name, kSmallLive + kSmallLive / 2);
-  Emitter e;
-  e.shape = Domain::disc(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f), 0.1f);
-  ParticleType t;
-  t.velocity = Domain::cone(Vec3(0.0f), Vec3(0.0f, 8.0f, 0.0f), 1.5f);
-  t.lifetime = Fuzzy::percent(2.0f, 10.0f);
-  e.types = {t};
-  e.rate = double(kSmallLive) / 2.0;
-  g.addEmitter(e);
-  g.setActions(fountainActions());
-  return g;
-}
+using flurry::bench::kSmallLive;
+using flurry::bench::smallFountain;
 
 // The whole Context::step() of `groups` small groups, on `threads` threads; reports the
 // time per group-step.
@@ -165,47 +151,23 @@ void IdleGroups(benchmark::State& state) {
   ContextOptions o;
   o.threads = 1;
   Context ctx(o);
-  for (std::size_t k = 0; k < groups; ++k) {
-    Group& g = smallFountain(ctx, "group" + std::to_string(k));
-    if (k % (groups / alive) != 0) g.emitters()[0].stop = 0.5;  // played, gone by 3 s
-  }
+  flurry::bench::levelOfEffects(ctx, groups, alive);
   ctx.run(90);
   for (auto _ : state) ctx.step();
   state.counters["us/step"] = benchmark::Counter(
       double(state.iterations()) * 1e-6, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
-// 1M particles over 32 cells in a row, each cell a floor (a rectangle) the particles of
-// that cell bounce on under gravity; the group is in cell order, as a level's particles
-// are near their emitters. With `deflectors` = 32 every floor is in the list, with 2 only
-// two of them (without culling every particle tests both): spatial culling (`cull`)
-// should make the 32 cost about what 2 cost.
+// 1M particles bouncing on 32 floors of which each reaches one (bench/common/scenes.hpp),
+// with `deflectors` floors in the list, culling on or off.
 void Deflectors(benchmark::State& state) {
   const auto deflectors = int(state.range(0));
   constexpr std::size_t n = std::size_t(1) << 20;
-  constexpr int kCells = 32;
   ContextOptions o;
   o.threads = threads();
   o.cull = state.range(1) != 0;
   Context ctx(o);
-  Group& g = ctx.createGroup("cells", n);
-  ActionList list;
-  list.add(Gravity{});
-  for (int j = 0; j < deflectors; ++j)
-    list.add(Bounce{Domain::rectangle(Vec3(4.0f * float(j), 0.0f, 0.0f), Vec3(4.0f, 0.0f, 0.0f),
-                                      Vec3(0.0f, 0.0f, 4.0f)),
-                    1.0f, 0.0f, 0.0f});
-  list.add(Move{});
-  g.setActions(list);
-  Random rng(7, 0, 0, 0);
-  for (std::size_t i = 0; i < n; ++i) {
-    const float cell = float(i * kCells / n);
-    Particle p;
-    p.position = Vec3(4.0f * cell + 0.2f + 3.6f * rng.uniform(), 0.1f + 3.0f * rng.uniform(),
-                      0.2f + 3.6f * rng.uniform());
-    p.velocity = Vec3(0.0f, 4.0f * rng.uniform() - 2.0f, 0.0f);
-    g.add(p);
-  }
+  Group& g = flurry::bench::deflectorCells(ctx, n, deflectors);
   ctx.step();
   const std::uint64_t culled = g.stats().blockActionsCulled;
   for (auto _ : state) ctx.step();

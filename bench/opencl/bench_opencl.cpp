@@ -13,6 +13,7 @@
 #include <benchmark/benchmark.h>
 
 #include "common/read_modify_write.hpp"
+#include "common/scenes.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -156,6 +157,43 @@ void SmallStep(benchmark::State& state, Backend backend) {
   timedSteps(state, ctx, g, 200);
 }
 
+// Skip what a scene doesn't need (issue #17), on both backends: 1M particles bouncing on
+// floors of which each reaches one, with 32 floors in the list against 2
+// (bench/common/scenes.hpp; the CPU backend culls per block of particles, the OpenCL backend
+// does not cull: every particle tests every floor)...
+void Deflectors(benchmark::State& state, Backend backend) {
+  if (backend == Backend::OpenCL && !haveDevice()) return state.SkipWithError("no OpenCL device");
+  const auto deflectors = int(state.range(0));
+  constexpr std::size_t n = std::size_t(1) << 20;
+  Context ctx(options(backend));
+  Group& g = flurry::bench::deflectorCells(ctx, n, deflectors);
+  ctx.run(2);
+  finish(g);
+  const int steps = 5;
+  timedSteps(state, ctx, g, steps);
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * steps * std::int64_t(n));
+}
+
+// ... and a level of 100 small effects of which 10 are alive, against the 10 alone: an idle
+// group costs no pass and no launch.
+void IdleGroups(benchmark::State& state, Backend backend) {
+  if (backend == Backend::OpenCL && !haveDevice()) return state.SkipWithError("no OpenCL device");
+  const auto groups = std::size_t(state.range(0)), alive = std::size_t(state.range(1));
+  ContextOptions o = options(backend);
+  o.threads = 1;
+  Context ctx(o);
+  flurry::bench::levelOfEffects(ctx, groups, alive);
+  ctx.run(90);
+  const int steps = 20;
+  for (auto _ : state) {
+    for (int s = 0; s < steps; ++s) ctx.step();
+    for (Group* g : ctx.groups()) finish(*g);
+  }
+  state.counters["us/step"] =
+      benchmark::Counter(double(state.iterations()) * steps * 1e-6,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
 // The ceiling, measured the same way in every benchmark (bench/common).
 void ReadModifyWrite(benchmark::State& state) {
   flurry::bench::readModifyWrite(state, kLanes, threads());
@@ -213,6 +251,7 @@ class SummaryReporter : public benchmark::ConsoleReporter {
       bytes_[name] = get("bytes_per_second");
       items_[name] = get("items_per_second");
       usPerStep_[name] = get("us/step");
+      if (name.rfind("Deflectors", 0) == 0) ms_[name] = r.GetAdjustedRealTime();
     }
   }
   void Finalize() override {
@@ -254,6 +293,21 @@ class SummaryReporter : public benchmark::ConsoleReporter {
           "  small group (~1k particles): cpu %.1f us/step, opencl %.1f us/step "
           "(aim: opencl <= 20)\n",
           sc, so);
+    for (const char* b : {"cpu", "opencl"}) {
+      const std::string B = b;
+      const double d32 = ms_["Deflectors/" + B + "/deflectors:32"];
+      const double d2 = ms_["Deflectors/" + B + "/deflectors:2"];
+      if (d32 > 0 && d2 > 0)
+        std::printf("  %-6s 1M particles, 32 floors in the list / 2: %.2fx the time (aim <= 1.3)\n",
+                    b, d32 / d2);
+      const double i100 = usPerStep_["IdleGroups/" + B + "/groups:100/alive:10"];
+      const double i10 = usPerStep_["IdleGroups/" + B + "/groups:10/alive:10"];
+      if (i100 > 0 && i10 > 0)
+        std::printf(
+            "  %-6s 100 groups of which 10 alive / the 10 alone: %.2fx (%.1f / %.1f us a step; "
+            "aim <= 1.2)\n",
+            b, i100 / i10, i100, i10);
+    }
     if (gCompile.measured)
       std::printf(
           "  kernel program build, first step of a new Context: cold %.0f ms, cached in "
@@ -262,7 +316,7 @@ class SummaryReporter : public benchmark::ConsoleReporter {
   }
 
  private:
-  std::map<std::string, double> bytes_, items_, usPerStep_;
+  std::map<std::string, double> bytes_, items_, usPerStep_, ms_;
 };
 
 }  // namespace
@@ -301,6 +355,30 @@ BENCHMARK_CAPTURE(HeavyStep, opencl, Backend::OpenCL)
     ->Arg(1 << 20)
     ->Arg(1 << 22)
     ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(Deflectors, cpu, Backend::Cpu)
+    ->ArgName("deflectors")
+    ->Arg(2)
+    ->Arg(32)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(Deflectors, opencl, Backend::OpenCL)
+    ->ArgName("deflectors")
+    ->Arg(2)
+    ->Arg(32)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(IdleGroups, cpu, Backend::Cpu)
+    ->ArgNames({"groups", "alive"})
+    ->Args({10, 10})
+    ->Args({100, 10})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(IdleGroups, opencl, Backend::OpenCL)
+    ->ArgNames({"groups", "alive"})
+    ->Args({10, 10})
+    ->Args({100, 10})
+    ->Unit(benchmark::kMicrosecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(SmallStep, cpu, Backend::Cpu)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(SmallStep, opencl, Backend::OpenCL)->Unit(benchmark::kMillisecond)->UseRealTime();

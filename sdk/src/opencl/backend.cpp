@@ -187,6 +187,8 @@ class ClGroup final : public DeviceMirror {
   void syncStats(GroupImpl& g) override { finish(g); }
 
   void finish(GroupImpl& g) {
+    // Nothing of this group's in flight (an idle group): no wait for the others' work.
+    if (inFlight_.empty() && !shared_->profile) return;
     check(clFinish(queue()), "clFinish");
     drain(g);
     if (shared_->profile) collectProfile();
