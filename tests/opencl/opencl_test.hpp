@@ -14,7 +14,14 @@
 namespace flurry::test {
 
 /// Why OpenCL tests cannot run here, or empty when they can.
+/// How many times openclUnavailable() ran in this process (the first loads the driver).
+inline int& openclChecks() {
+  static int n = 0;
+  return n;
+}
+
 inline std::string openclUnavailable() {
+  ++openclChecks();
   try {
     if (openclDevices().empty()) return "no OpenCL platform or device (install pocl-opencl-icd)";
   } catch (const std::exception& e) {

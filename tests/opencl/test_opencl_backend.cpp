@@ -404,3 +404,20 @@ TEST(OpenCLBackend, IdleGroupsCostNoLaunch) {
   EXPECT_LE(cl.first, cpu.first);
   EXPECT_GE(cl.first + 2 * 5, cpu.first);  // each of the two idle spells a few steps late
 }
+
+// PoCL's own kernel cache lives inside Flurry's (one folder to keep or clear), unless the
+// user chose PoCL's folder. PoCL reads its folder when it loads: this checks what Flurry
+// tells it, in a process where nothing loaded it before (ctest runs each test alone).
+TEST(OpenCLBackend, PoclCacheLivesInFlurrysCache) {
+  if (std::getenv("POCL_CACHE_DIR"))
+    GTEST_SKIP() << "POCL_CACHE_DIR is set: the user's choice is kept";
+  const auto dir = std::filesystem::temp_directory_path() / "flurry-test-pocl-cache";
+  ::setenv("FLURRY_OPENCL_CACHE", dir.c_str(), 1);
+  const std::string why = test::openclUnavailable();  // lists the devices: the driver loads
+  ::unsetenv("FLURRY_OPENCL_CACHE");
+  if (!why.empty()) GTEST_SKIP() << "OpenCL test skipped: " << why;
+  if (test::openclChecks() > 1) GTEST_SKIP() << "the driver was loaded earlier in this process";
+  const char* pocl = std::getenv("POCL_CACHE_DIR");
+  ASSERT_NE(pocl, nullptr);
+  EXPECT_EQ(std::filesystem::path(pocl), dir / "pocl");
+}

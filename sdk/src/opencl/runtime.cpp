@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <sstream>
 #include <vector>
 
@@ -94,7 +95,34 @@ T deviceValue(cl_device_id d, cl_device_info what) {
   return v;
 }
 
+std::filesystem::path diskCacheDir() {
+  if (const char* e = std::getenv("FLURRY_OPENCL_CACHE")) {
+    const std::string v = e;
+    if (v == "off" || v == "0" || v.empty()) return {};
+    return v;
+  }
+  if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x)
+    return std::filesystem::path(x) / "flurry" / "opencl";
+  if (const char* h = std::getenv("HOME"); h && *h)
+    return std::filesystem::path(h) / ".cache" / "flurry" / "opencl";
+  return {};
+}
+
+// PoCL keeps its own cache of compiled kernels, in POCL_CACHE_DIR as the driver reads it when
+// it loads (the first clGetPlatformIDs): put it inside Flurry's cache, so that one folder
+// holds both and clearing it clears both. Not when the user chose PoCL's folder, nor when
+// Flurry's cache is off.
+void placePoclCache() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    if (std::getenv("POCL_CACHE_DIR")) return;
+    const std::filesystem::path dir = diskCacheDir();
+    if (!dir.empty()) ::setenv("POCL_CACHE_DIR", (dir / "pocl").c_str(), 0);
+  });
+}
+
 std::vector<cl_platform_id> platforms() {
+  placePoclCache();
   cl_uint n = 0;
   const cl_int err = clGetPlatformIDs(0, nullptr, &n);
   if (err == -1001 /* CL_PLATFORM_NOT_FOUND_KHR: the ICD loader found no platform */ || n == 0)
@@ -204,19 +232,6 @@ std::mutex gRegistryMutex;
 auto& gRuntimes = *new std::map<cl_device_id, std::shared_ptr<Runtime>>;
 std::mutex gStatsMutex;
 CacheStats gStats;
-
-std::filesystem::path diskCacheDir() {
-  if (const char* e = std::getenv("FLURRY_OPENCL_CACHE")) {
-    const std::string v = e;
-    if (v == "off" || v == "0" || v.empty()) return {};
-    return v;
-  }
-  if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x)
-    return std::filesystem::path(x) / "flurry" / "opencl";
-  if (const char* h = std::getenv("HOME"); h && *h)
-    return std::filesystem::path(h) / ".cache" / "flurry" / "opencl";
-  return {};
-}
 
 std::string buildLog(cl_program p, cl_device_id d) {
   std::size_t n = 0;
