@@ -298,11 +298,71 @@ TEST(Group, IdleStepsAreSkippedAndChangeNothing) {
     wasIdle += idle.size() == 0;
   }
   EXPECT_EQ(idle.stats().emitted + 1, busy.stats().emitted);  // add() counts in `emitted`
-  EXPECT_GT(idle.stats().emitted, 7u + 7u + 3u);  // and the spacing's
+  EXPECT_GT(idle.stats().emitted, 7u + 7u + 3u);              // and the spacing's
   EXPECT_EQ(idle.stats().emittedByGeneration, busy.stats().emittedByGeneration);
   EXPECT_EQ(busy.stats().idleSteps, 0u);
   // Idle from the start to the first burst (15 steps), between the bursts, after the rate,
   // after the spacing: more than half the 90 steps, but never a step whose emitters fire.
   EXPECT_GE(idle.stats().idleSteps, 45u);
   EXPECT_LE(idle.stats().idleSteps, wasIdle);
+}
+
+// A game's effects come and go: an effect is built as many instances as wanted, each group
+// named GROUP@INSTANCE with its own random numbers; a destroyed group leaves the others as
+// they would have been, and a group created after takes its place and its streams.
+TEST(Context, EffectInstancesAndDestroyedGroups) {
+  const Effect fx = parseEffect(R"({
+    "name": "puff", "dt": 0.05,
+    "groups": [{"name": "puff", "capacity": 500,
+      "emitters": [{"shape": {"type": "sphere", "center": [0, 0, 0], "outerRadius": 0.5},
+                    "rate": 400, "types": [{"lifetime": 1, "velocity": {"type": "sphere",
+                    "center": [0, 1, 0], "outerRadius": 1}}]}],
+      "actions": [{"type": "Gravity"}, {"type": "Move"}, {"type": "KillOld"}]}]})");
+  auto positions = [](const Group& g) {
+    std::vector<float> out;
+    for (int c = 0; c < 3; ++c) {
+      const auto lane = g.lane(Attribute::Position, c);
+      out.insert(out.end(), lane.begin(), lane.end());
+    }
+    return out;
+  };
+  ContextOptions o = fx.contextOptions();
+  o.threads = 1;
+  Context ctx(o), alone(o);
+  Group& a = *fx.build(ctx, 0, "a").at(0);
+  Group& b = *fx.build(ctx, 0, "b").at(0);
+  EXPECT_EQ(a.name(), "puff@a");
+  EXPECT_EQ(&ctx.group("puff@b"), &b);
+  EXPECT_THROW(fx.build(ctx, 0, "a"), EffectError);  // the same instance twice
+  Group& c = *fx.build(ctx, 0, "c").at(0);
+  Group& a2 = *fx.build(alone, 0, "a").at(0);  // `a` in a context of its own
+  fx.build(alone, 0, "x");
+  Group& c2 = *fx.build(alone, 0, "c").at(0);
+  ctx.run(10);
+  alone.run(10);
+  EXPECT_NE(positions(a), positions(b));  // instances differ
+  EXPECT_EQ(positions(a), positions(a2));
+  // Destroying b leaves a and c as they were.
+  ctx.destroyGroup(b);
+  EXPECT_THROW(ctx.group("puff@b"), Error);
+  alone.destroyGroup(alone.group("puff@x"));
+  EXPECT_THROW(ctx.destroyGroup(c2), InvalidArgument);  // not ctx's
+  ctx.run(10);
+  alone.run(10);
+  EXPECT_EQ(positions(a), positions(a2));
+  EXPECT_EQ(positions(c), positions(c2));
+  // A new group takes the free index: the same streams as in the other context.
+  Group& d = *fx.build(ctx, 0, "d").at(0);
+  Group& d2 = *fx.build(alone, 0, "d").at(0);
+  ctx.run(5);
+  alone.run(5);
+  EXPECT_GT(d.size(), 0u);
+  EXPECT_EQ(positions(d), positions(d2));
+  // An emitter removed emits no more.
+  d.removeEmitter(0);
+  EXPECT_THROW(d.removeEmitter(0), InvalidArgument);
+  const std::uint64_t emitted = d.stats().emitted;
+  ctx.run(5);
+  EXPECT_EQ(d.stats().emitted, emitted);
+  EXPECT_EQ(ctx.groups().size(), 3u);
 }

@@ -1,5 +1,6 @@
 #include "flurry/context.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <thread>
@@ -80,10 +81,27 @@ Group& Context::createGroup(std::string name, std::size_t capacity) {
   auto gi = std::make_unique<detail::GroupImpl>();
   gi->name = std::move(name);
   gi->capacity = capacity;
-  gi->index = std::uint32_t(impl_->groups.size());
+  // The lowest index no group holds: a group created where one was destroyed draws that
+  // one's random streams, so the same sequence of calls gives the same particles.
+  std::uint32_t index = 0;
+  for (bool taken = true; taken; ++index) {
+    taken = false;
+    for (auto& g : impl_->groups) taken |= g->impl().index == index;
+    if (!taken) break;
+  }
+  gi->index = index;
   gi->ensureStorage();
   impl_->groups.push_back(std::unique_ptr<Group>(new Group(std::move(gi))));
   return *impl_->groups.back();
+}
+
+void Context::destroyGroup(Group& group) {
+  auto& all = impl_->groups;
+  const auto it =
+      std::find_if(all.begin(), all.end(), [&](const auto& g) { return g.get() == &group; });
+  if (it == all.end())
+    throw InvalidArgument("group", "'" + group.name() + "' is not a group of this context");
+  all.erase(it);  // its device buffers go after the work queued on them (the mirror waits)
 }
 
 Group& Context::group(std::string_view name) {

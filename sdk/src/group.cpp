@@ -260,6 +260,16 @@ std::span<Emitter> Group::emitters() {
   return impl_->emitters;
 }
 
+void Group::removeEmitter(std::size_t i) {
+  auto& g = *impl_;
+  if (i >= g.emitters.size())
+    throw InvalidArgument("index", std::to_string(i) + " is past the " +
+                                       std::to_string(g.emitters.size()) + " emitters");
+  g.emitters.erase(g.emitters.begin() + std::ptrdiff_t(i));
+  g.emitterState.erase(g.emitterState.begin() + std::ptrdiff_t(i));
+  ++g.emittersVersion;
+}
+
 PrimeEmitter& Group::addPrimeEmitter(PrimeEmitter prime) {
   prime.validate("primeEmitters[" + std::to_string(impl_->primes.size()) + "]");
   impl_->primes.push_back(std::move(prime));

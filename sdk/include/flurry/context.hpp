@@ -43,6 +43,11 @@ class Context {
 
   /// Creates a group of fixed capacity (> 0; throws InvalidArgument "capacity").
   Group& createGroup(std::string name, std::size_t capacity);
+  /// Destroys a group of this context, its particles and its emitters (on a device, after
+  /// the work queued for it); references to it are invalid after. The others are untouched.
+  /// A group created later takes the lowest free index, and with it the destroyed group's
+  /// random streams. Throws InvalidArgument "group" for a group of another context.
+  void destroyGroup(Group& group);
   /// The group of that name; throws Error if there is none.
   Group& group(std::string_view name);
   std::vector<Group*> groups();

@@ -98,9 +98,9 @@ struct UnionDomain {
 
 class Domain {
  public:
-  using Shape = std::variant<PointDomain, LineDomain, TriangleDomain, PlaneDomain,
-                             RectangleDomain, DiscDomain, BoxDomain, SphereDomain,
-                             CylinderDomain, ConeDomain, BlobDomain, MeshDomain, UnionDomain>;
+  using Shape = std::variant<PointDomain, LineDomain, TriangleDomain, PlaneDomain, RectangleDomain,
+                             DiscDomain, BoxDomain, SphereDomain, CylinderDomain, ConeDomain,
+                             BlobDomain, MeshDomain, UnionDomain>;
 
   Domain() : shape_(PointDomain{Vec3(0.0f)}) {}
 

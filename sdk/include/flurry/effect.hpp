@@ -79,9 +79,13 @@ struct Effect {
   /// ContextOptions with this effect's seed and dt (the rest default).
   ContextOptions contextOptions() const;
   /// Creates the groups in `ctx` with their emitters, actions, hair options and required
-  /// attributes. maxCapacity > 0 caps every group's capacity. Returns the groups created.
-  /// Errors raised by the core are rethrown as EffectError naming the group.
-  std::vector<Group*> build(Context& ctx, std::size_t maxCapacity = 0) const;
+  /// attributes. maxCapacity > 0 caps every group's capacity. A non-empty `instance` names
+  /// the groups "GROUP@INSTANCE", so that one effect can be built many times in a Context
+  /// (each instance draws its own random numbers; Context::destroyGroup removes one).
+  /// Returns the groups created. Errors raised by the core are rethrown as EffectError
+  /// naming the group.
+  std::vector<Group*> build(Context& ctx, std::size_t maxCapacity = 0,
+                            std::string_view instance = {}) const;
 };
 
 /// Reads a sampled vector field kept outside the effect file (`{"vdb": "file.vdb", "grid":

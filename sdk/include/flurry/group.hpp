@@ -118,6 +118,9 @@ class Group {
   /// Adds an emitter (validated: throws InvalidArgument naming the bad field).
   Emitter& addEmitter(Emitter emitter);
   std::span<Emitter> emitters();
+  /// Removes emitter i (0 <= i < emitters().size(); throws InvalidArgument "index"): it emits
+  /// no more, and the emitters after it move down by one.
+  void removeEmitter(std::size_t i);
   /// Adds an emitter of emitters (validated).
   PrimeEmitter& addPrimeEmitter(PrimeEmitter prime);
   /// Emitters spawned by prime emitters and still alive.

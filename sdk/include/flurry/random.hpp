@@ -45,7 +45,10 @@ inline float uniformFloat(std::uint32_t bits) noexcept {
 class Random {
  public:
   Random(std::uint64_t seed, std::uint32_t id, std::uint32_t step, std::uint32_t stream) noexcept
-      : k0_(std::uint32_t(seed)), k1_(std::uint32_t(seed >> 32)), id_(id), step_(step),
+      : k0_(std::uint32_t(seed)),
+        k1_(std::uint32_t(seed >> 32)),
+        id_(id),
+        step_(step),
         stream_(stream) {}
 
   std::uint32_t bits() noexcept {

@@ -1307,7 +1307,8 @@ ContextOptions Effect::contextOptions() const {
   return o;
 }
 
-std::vector<Group*> Effect::build(Context& ctx, std::size_t maxCapacity) const {
+std::vector<Group*> Effect::build(Context& ctx, std::size_t maxCapacity,
+                                  std::string_view instance) const {
   const std::string where = file.empty() ? name : file.string();
   std::vector<Group*> made;
   for (std::size_t i = 0; i < groups.size(); ++i) {
@@ -1315,7 +1316,8 @@ std::vector<Group*> Effect::build(Context& ctx, std::size_t maxCapacity) const {
     const std::string path = index("groups", i);
     try {
       const std::size_t cap = maxCapacity > 0 ? std::min(eg.capacity, maxCapacity) : eg.capacity;
-      Group& g = ctx.createGroup(eg.name, cap);
+      Group& g =
+          ctx.createGroup(instance.empty() ? eg.name : eg.name + "@" + std::string(instance), cap);
       g.setActions(eg.actions);
       if (eg.hair.enabled) g.setHair(eg.hair);
       g.require(eg.require);
