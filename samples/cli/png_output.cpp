@@ -43,8 +43,9 @@ void addLookOptions(CLI::App& cmd, Look& look) {
         int w, h;
         return parseSize(s, w, h) ? std::string() : "expected WxH, e.g. 1280x720";
       });
-  cmd.add_option("--sprite", look.sprite,
-                 "point, disc, spark, snowflake, or a PNG file drawn for each particle");
+  cmd.add_option(
+      "--sprite", look.sprite,
+      "point, disc, spark, snowflake, glow, puff, or a PNG file drawn for each particle");
   cmd.add_option("--blend", look.blend, "alpha or additive")
       ->check(CLI::IsMember({"alpha", "additive"}));
   cmd.add_flag("--unlit", look.unlit, "draw particles in their own color, without the lights");
@@ -78,6 +79,10 @@ RenderSettings settingsFrom(const std::string& render, const fs::path& effectFil
     s.sprite = Sprite::Spark;
   else if (look.sprite == "snowflake")
     s.sprite = Sprite::Snowflake;
+  else if (look.sprite == "glow")
+    s.sprite = Sprite::Glow;
+  else if (look.sprite == "puff")
+    s.sprite = Sprite::Puff;
   else if (!look.sprite.empty()) {
     s.sprite = Sprite::Image;
     s.spriteImage = look.sprite;

@@ -376,8 +376,16 @@ TEST(RenderImage, Sprites) {
   EXPECT_GT(nSpark, 0.02 * disc);
   EXPECT_LT(nFlake, 0.6 * disc);
   EXPECT_GT(nFlake, 0.1 * disc);
-  EXPECT_NEAR(nPoint, square, 0.05 * square);
+  // GL rasterises a wide point as a square, MSAA or not: the shader cuts it round.
+  EXPECT_NEAR(nPoint, disc, 0.05 * disc);
   EXPECT_NEAR(nImage, square, 0.05 * square);
+  const auto [nGlow, iGlow] = coverage(Sprite::Glow, "glow");
+  const auto [nPuff, iPuff] = coverage(Sprite::Puff, "puff");
+  EXPECT_LT(nGlow, 0.6 * disc);  // a gaussian: bright core, faint wide halo
+  EXPECT_GT(nGlow, 0.2 * disc);
+  EXPECT_GT(iGlow.pixel(kSize / 2, kSize / 2)[0], 240);
+  EXPECT_LT(nPuff, 0.9 * disc);
+  EXPECT_GT(nPuff, 0.3 * disc);
   const int q = int(rpx / 2);
   EXPECT_GT(iImage.pixel(kSize / 2 - q, kSize / 2 - q)[0], 200);  // top left: red
   EXPECT_GT(iImage.pixel(kSize / 2 + q, kSize / 2 - q)[1], 200);  // top right: green
@@ -418,6 +426,140 @@ TEST(RenderImage, BlendModes) {
   EXPECT_NEAR(p[0], 0, 2);
   EXPECT_NEAR(p[1], 51, 2);
   EXPECT_NEAR(p[2], 102, 2);
+}
+
+// Glow and puff sprites are shaded flat: one normal towards the eye, so a lit puff of smoke is
+// not a ball with a bright and a dark side (the disc, shaded as a sphere, is).
+TEST(RenderImage, GlowAndPuffAreShadedFlat) {
+  RenderSettings s;
+  s.camera = front(30.0f, 6.0f);
+  s.background = Vec3(0.0f);
+  s.lighting.ambient = Vec3(0.1f);
+  s.lighting.lights = {Light{Light::Type::Directional, Vec3(1.0f, 0.0f, 0.3f), Vec3(1.0f)}};
+  s.lighting.material = Material{Vec3(1.0f), Vec3(0.8f), Vec3(0.0f), 20.0f};
+  Context ctx;
+  Group& g = particles(ctx);
+  add(g, Vec3(0.0f), 1.0f, Vec4(1.0f));
+  OffscreenRenderer r(small(), s);
+  const int dx = int(0.3f * pixelsPerUnit(s.camera));
+  auto sides = [&](Sprite kind) {
+    r.settings().sprite = kind;
+    const Image img = r.render(g);
+    return std::pair{int(img.pixel(kSize / 2 - dx, kSize / 2)[0]),
+                     int(img.pixel(kSize / 2 + dx, kSize / 2)[0])};
+  };
+  const auto [discLeft, discRight] = sides(Sprite::Disc);
+  EXPECT_GT(discRight, discLeft + 40);  // the sphere: lit from +x
+  for (Sprite kind : {Sprite::Glow, Sprite::Puff}) {
+    const auto [left, right] = sides(kind);
+    EXPECT_NEAR(left, right, 12) << int(kind);
+    EXPECT_GT(left, 20) << int(kind);
+  }
+}
+
+// The tone map: overlapping additive particles that sum far above 1 keep their hue instead
+// of clipping to white; without it they clip.
+TEST(RenderImage, ToneMapKeepsAdditiveCoresFromClipping) {
+  RenderSettings s;
+  s.camera = front(30.0f, 6.0f);
+  s.shading = false;
+  s.background = Vec3(0.0f);
+  s.blend = BlendMode::Additive;
+  Context ctx;
+  Group& g = particles(ctx);
+  for (int i = 0; i < 8; ++i)
+    add(g, Vec3(0.0f, 0.0f, 0.01f * float(i)), 0.5f, Vec4(1.0f, 0.5f, 0.2f, 1.0f));
+  OffscreenRenderer r(small(), s);
+  const std::uint8_t* p = nullptr;
+  Image img = r.render(g);
+  p = img.pixel(kSize / 2, kSize / 2);
+  EXPECT_EQ(p[0], 255);
+  EXPECT_EQ(p[1], 255);
+  EXPECT_GE(p[2], 254);  // 8 x 0.2 = 1.6: white
+  for (ToneMap t : {ToneMap::Aces, ToneMap::Reinhard}) {
+    r.settings().toneMap = t;
+    img = r.render(g);
+    p = img.pixel(kSize / 2, kSize / 2);
+    EXPECT_GT(p[0], p[1] + 5) << int(t);  // still orange: red > green > blue
+    EXPECT_GT(p[1], p[2] + 5) << int(t);
+    EXPECT_LT(p[2], 250) << int(t);
+    EXPECT_EQ(img.pixel(2, 2)[0], 0) << int(t);  // black stays black
+  }
+  // The curves themselves, at the centre: 8 x (1, 0.5, 0.2) = (8, 4, 1.6).
+  r.settings().toneMap = ToneMap::Reinhard;
+  img = r.render(g);
+  p = img.pixel(kSize / 2, kSize / 2);
+  EXPECT_NEAR(p[0], 255.0 * 8 / 9, 3);
+  EXPECT_NEAR(p[1], 255.0 * 4 / 5, 3);
+  EXPECT_NEAR(p[2], 255.0 * 1.6 / 2.6, 3);
+}
+
+// A transparent background: alpha 0 where nothing is drawn, the particle's colour (straight,
+// not premultiplied) and coverage where it is; with and without a tone map.
+TEST(RenderImage, TransparentBackground) {
+  RenderSettings s;
+  s.camera = front(30.0f, 6.0f);
+  s.shading = false;
+  s.background = Vec3(0.5f);  // unused when transparent
+  s.transparent = true;
+  Context ctx;
+  Group& g = particles(ctx);
+  add(g, Vec3(0.0f), 1.0f, Vec4(0.2f, 0.6f, 1.0f, 0.5f));
+  OffscreenRenderer r(small(), s);
+  for (ToneMap t : {ToneMap::None, ToneMap::Aces}) {
+    r.settings().toneMap = t;
+    const Image img = r.render(g);
+    const std::uint8_t* corner = img.pixel(2, 2);
+    EXPECT_EQ(corner[3], 0) << int(t);
+    const std::uint8_t* c = img.pixel(kSize / 2, kSize / 2);
+    EXPECT_NEAR(c[3], 128, 3) << int(t);
+    EXPECT_GT(c[2], c[1]) << int(t);
+    EXPECT_GT(c[1], c[0]) << int(t);
+    if (t == ToneMap::None) {
+      EXPECT_NEAR(c[0], 51, 3);  // straight: 0.2, not 0.2 x 0.5
+      EXPECT_NEAR(c[1], 153, 3);
+      EXPECT_NEAR(c[2], 255, 3);
+    }
+  }
+  r.settings().transparent = false;
+  r.settings().toneMap = ToneMap::None;
+  const Image opaque = r.render(g);
+  EXPECT_EQ(opaque.pixel(2, 2)[3], 255);
+  EXPECT_NEAR(opaque.pixel(2, 2)[0], 128, 1);
+}
+
+// The scene geometry: a group's Bounce, Sink and Block surfaces drawn faintly when asked, an
+// `outside` absorber (a bound) not; nothing when not asked.
+TEST(RenderImage, SceneGeometry) {
+  RenderSettings s;
+  s.camera = front(30.0f, 10.0f);
+  s.background = Vec3(0.0f);
+  Context ctx;
+  Group& g = particles(ctx);
+  add(g, Vec3(100.0f), 0.01f, Vec4(1.0f));  // out of view: only geometry is drawn
+  OffscreenRenderer r(small(), s);
+  auto drawn = [&](ActionList actions, int x0, int x1) {
+    g.setActions(std::move(actions));
+    const Image img = r.render(g);
+    int n = 0;
+    for (int y = 0; y < kSize; ++y)
+      for (int x = x0; x < x1; ++x) n += img.pixel(x, y)[2] > 10;
+    return n;
+  };
+  const ActionList scene{
+      Bounce{Domain::line(Vec3(-2, -1, 0), Vec3(-0.5f, -1, 0)), 0.5f},           // left
+      Sink{Domain::box(Vec3(0.5f, -0.5f, -0.5f), Vec3(2, 0.5f, 0.5f))},          // right
+      Sink{Domain::sphere(Vec3(0.0f), 1.0f), false, 0.0f, Sink::Mode::Outside},  // a bound
+      Move{}};
+  EXPECT_EQ(drawn(scene, 0, kSize), 0);  // off by default
+  r.settings().geometry.show = true;
+  EXPECT_GT(drawn(scene, 0, kSize / 2 - 20), 40);            // the deflector's segment
+  EXPECT_GT(drawn(scene, kSize / 2 + 20, kSize), 400);       // the absorber's box
+  EXPECT_EQ(drawn(scene, kSize / 2 - 8, kSize / 2 + 8), 0);  // no bounding sphere
+  r.settings().geometry.sink = false;
+  EXPECT_EQ(drawn(scene, kSize / 2 + 20, kSize), 0);
+  g.setActions({Block{Domain::box(Vec3(-1.0f), Vec3(1.0f))}, Move{}});
+  EXPECT_GT(drawn(g.actions(), kSize / 2 - 8, kSize / 2 + 8), 100);  // a blocker's faces
 }
 
 // With no display and no Xvfb there is no OpenGL: a clear RenderError, nothing else breaks.

@@ -131,6 +131,29 @@ TEST(RenderSettingsJson, ReadsEveryField) {
   const RenderSettings d = parseRenderSettings("{}");
   EXPECT_EQ(d.sprite, Sprite::Disc);
   EXPECT_EQ(d.lighting.lights.size(), 1u);
+  EXPECT_EQ(d.toneMap, ToneMap::None);
+  EXPECT_FALSE(d.transparent);
+  EXPECT_FALSE(d.geometry.show);
+}
+
+TEST(RenderSettingsJson, ReadsTheLookOptions) {
+  const RenderSettings s = parseRenderSettings(R"({"sprite": "glow", "toneMap": "aces",
+    "exposure": 1.5, "transparent": true,
+    "geometry": {"color": [0.1, 0.2, 0.3], "opacity": 0.5, "sink": false}})");
+  EXPECT_EQ(s.sprite, Sprite::Glow);
+  EXPECT_EQ(s.toneMap, ToneMap::Aces);
+  EXPECT_EQ(s.exposure, 1.5f);
+  EXPECT_TRUE(s.transparent);
+  EXPECT_TRUE(s.geometry.show);  // an object turns it on unless it says "show": false
+  EXPECT_EQ(s.geometry.color, Vec3(0.1f, 0.2f, 0.3f));
+  EXPECT_EQ(s.geometry.opacity, 0.5f);
+  EXPECT_FALSE(s.geometry.sink);
+  EXPECT_TRUE(s.geometry.bounce);
+  EXPECT_EQ(parseRenderSettings(R"({"sprite": "puff", "toneMap": "reinhard"})").toneMap,
+            ToneMap::Reinhard);
+  EXPECT_EQ(parseRenderSettings(R"({"sprite": "puff"})").sprite, Sprite::Puff);
+  EXPECT_TRUE(parseRenderSettings(R"({"geometry": true})").geometry.show);
+  EXPECT_FALSE(parseRenderSettings(R"({"geometry": {"show": false}})").geometry.show);
 }
 
 TEST(RenderSettingsJson, ErrorsNameTheField) {
@@ -149,4 +172,11 @@ TEST(RenderSettingsJson, ErrorsNameTheField) {
   EXPECT_EQ(pathOf(R"({"material": {"kd": [1, 2]}})"), "render.material.kd");
   EXPECT_EQ(pathOf(R"({"ambient": "bright"})"), "render.ambient");
   EXPECT_EQ(pathOf("{not json"), "render");
+  EXPECT_EQ(pathOf(R"({"toneMap": "filmic"})"), "render.toneMap");
+  EXPECT_EQ(pathOf(R"({"exposure": 0})"), "render.exposure");
+  EXPECT_EQ(pathOf(R"({"transparent": 1})"), "render.transparent");
+  EXPECT_EQ(pathOf(R"({"geometry": "yes"})"), "render.geometry");
+  EXPECT_EQ(pathOf(R"({"geometry": {"opacity": 2}})"), "render.geometry.opacity");
+  EXPECT_EQ(pathOf(R"({"geometry": {"colour": [1, 1, 1]}})"), "render.geometry.colour");
+  EXPECT_EQ(pathOf(R"({"geometry": {"sink": "no"}})"), "render.geometry.sink");
 }

@@ -42,6 +42,25 @@ enum class Sprite {
   Spark,      ///< ... of a built-in spark (a glowing core with four rays)
   Snowflake,  ///< ... of a built-in six-armed snowflake
   Image,      ///< ... of the PNG named by RenderSettings::spriteImage
+  Glow,       ///< ... of a soft round glow (gaussian), shaded flat: sparks, fire, stars
+  Puff,       ///< ... of a soft, lumpy puff, shaded flat (no lit ball): smoke, mist, dust
+};
+
+/// How the accumulated (HDR) colour becomes an 8-bit one. With a tone map the renderer draws
+/// into a floating-point buffer first, so additive cores keep their hue instead of clipping.
+enum class ToneMap {
+  None,      ///< draw straight into the target; colours above 1 clip
+  Reinhard,  ///< c / (1 + c) per channel, after `exposure`
+  Aces,      ///< Narkowicz's fit of the ACES film curve, after `exposure`
+};
+
+/// The scene's surfaces drawn as faint geometry: deflectors (Bounce), absorbers (Sink, not
+/// the `outside` / `leave` bounds) and blockers (Block) of each drawn group's action list.
+struct SceneGeometry {
+  bool show = false;
+  Vec3 color{0.55f, 0.6f, 0.7f};
+  float opacity = 0.35f;  ///< of the outlines; faces are drawn at a third of it
+  bool bounce = true, sink = true, block = true;
 };
 
 /// How strands are drawn in hair mode.
@@ -81,6 +100,12 @@ struct RenderSettings {
   /// Render-time blockers: particles (and strand vertices) inside any of these regions are
   /// not drawn. Particles whose stored Visible attribute is 0 are never drawn either.
   std::vector<Domain> blockers;
+  ToneMap toneMap = ToneMap::None;
+  float exposure = 1.0f;  ///< scales the HDR colour before the tone map
+  /// Clears to alpha 0 and keeps the particles' coverage in alpha (straight, not
+  /// premultiplied, in images): for compositing. `background` is then unused.
+  bool transparent = false;
+  SceneGeometry geometry;
 };
 
 /// Reads an effect file's `render` object (JSON text, docs/rendering.md) over `defaults`:
@@ -126,6 +151,9 @@ class Renderer {
   void draw(const Group& group);
   /// Hair mode: strands as ribbons or lines.
   void draw(const Strands& strands);
+  /// Ends the frame: with a tone map, resolves the HDR image into the framebuffer that was
+  /// bound at begin(). Without one it does nothing; call it anyway after the last draw.
+  void end();
   /// Particles drawn by the last draw(Group) (after Visible and blockers).
   std::size_t lastDrawn() const;
 

@@ -104,6 +104,7 @@ Image OffscreenRenderer::render(std::span<const Group* const> groups, const Stra
   // Strands first: they write depth, so particles behind them are hidden.
   if (strands) d.renderer->draw(*strands);
   for (const Group* g : groups) d.renderer->draw(*g);
+  d.renderer->end();
   if (d.samples > 0) {
     glBindFramebuffer(GL_READ_FRAMEBUFFER, d.msFbo);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, d.fbo);
@@ -126,6 +127,16 @@ Image OffscreenRenderer::render(std::span<const Group* const> groups, const Stra
     std::swap_ranges(img.rgba.begin() + std::ptrdiff_t(y * row),
                      img.rgba.begin() + std::ptrdiff_t((y + 1) * row),
                      img.rgba.begin() + std::ptrdiff_t((d.height - 1 - y) * row));
+  // Images hold straight alpha; blending on a transparent background left it premultiplied
+  // (the tone map already divides it out).
+  const RenderSettings& rs = d.renderer->settings();
+  if (rs.transparent && rs.toneMap == ToneMap::None)
+    for (std::size_t i = 0; i < img.rgba.size(); i += 4) {
+      const unsigned a = img.rgba[i + 3];
+      for (std::size_t c = 0; c < 3; ++c)
+        img.rgba[i + c] =
+            a == 0 ? 0 : std::uint8_t(std::min(255u, (img.rgba[i + c] * 255u + a / 2) / a));
+    }
   return img;
 }
 

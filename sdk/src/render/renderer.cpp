@@ -2,6 +2,9 @@
 #include <cmath>
 #include <cstring>
 #include <string>
+#include <utility>
+#include <variant>
+#include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
@@ -69,11 +72,177 @@ GLint loc(GLuint program, const char* name) {
   return glGetUniformLocation(program, name);
 }
 
+// Scene geometry as line and triangle vertices: x y z r g b a each.
+struct GeometryBuilder {
+  std::vector<float>& lines;
+  std::vector<float>& faces;
+  Vec4 line, face;
+  float extent;  // half-size of an infinite plane's drawn square
+
+  static void put(std::vector<float>& out, Vec3 p, Vec4 c) {
+    const float v[7] = {p.x, p.y, p.z, c.r, c.g, c.b, c.a};
+    out.insert(out.end(), v, v + 7);
+  }
+  void segment(Vec3 a, Vec3 b) {
+    put(lines, a, line);
+    put(lines, b, line);
+  }
+  void triangle(Vec3 a, Vec3 b, Vec3 c) {
+    put(faces, a, face);
+    put(faces, b, face);
+    put(faces, c, face);
+  }
+  void quad(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
+    triangle(a, b, c);
+    triangle(a, c, d);
+  }
+  // Two unit vectors spanning the plane of unit normal n.
+  static void basis(Vec3 n, Vec3& u, Vec3& v) {
+    const Vec3 helper = std::abs(n.y) < 0.9f ? Vec3(0, 1, 0) : Vec3(1, 0, 0);
+    u = glm::normalize(glm::cross(helper, n));
+    v = glm::cross(n, u);
+  }
+  void circle(Vec3 c, Vec3 n, float r, int segments = 48) {
+    Vec3 u, v;
+    basis(n, u, v);
+    for (int k = 0; k < segments; ++k) {
+      const float a0 = 6.2831853f * float(k) / float(segments);
+      const float a1 = 6.2831853f * float(k + 1) / float(segments);
+      segment(c + r * (std::cos(a0) * u + std::sin(a0) * v),
+              c + r * (std::cos(a1) * u + std::sin(a1) * v));
+    }
+  }
+  void annulus(Vec3 c, Vec3 n, float outer, float inner, int segments = 48) {
+    Vec3 u, v;
+    basis(n, u, v);
+    for (int k = 0; k < segments; ++k) {
+      const float a0 = 6.2831853f * float(k) / float(segments);
+      const float a1 = 6.2831853f * float(k + 1) / float(segments);
+      const Vec3 d0 = std::cos(a0) * u + std::sin(a0) * v, d1 = std::cos(a1) * u + std::sin(a1) * v;
+      quad(c + inner * d0, c + outer * d0, c + outer * d1, c + inner * d1);
+    }
+  }
+
+  void add(const Domain& domain) {
+    std::visit([&](const auto& d) { shape(d); }, domain.shape());
+  }
+  void shape(const PointDomain&) {}
+  void shape(const BlobDomain&) {}
+  void shape(const LineDomain& d) { segment(d.p0, d.p1); }
+  void shape(const TriangleDomain& d) {
+    segment(d.p0, d.p1);
+    segment(d.p1, d.p2);
+    segment(d.p2, d.p0);
+    triangle(d.p0, d.p1, d.p2);
+  }
+  void shape(const PlaneDomain& d) {
+    // A ground: a square of grid lines around the plane's point, faintly filled.
+    Vec3 u, v;
+    basis(d.normal, u, v);
+    const int cells = 16;
+    const float step = 2.0f * extent / float(cells);
+    for (int k = 0; k <= cells; ++k) {
+      const float t = -extent + step * float(k);
+      segment(d.point + t * u - extent * v, d.point + t * u + extent * v);
+      segment(d.point - extent * u + t * v, d.point + extent * u + t * v);
+    }
+    quad(d.point - extent * u - extent * v, d.point + extent * u - extent * v,
+         d.point + extent * u + extent * v, d.point - extent * u + extent * v);
+  }
+  void shape(const RectangleDomain& d) {
+    const Vec3 a = d.origin, b = d.origin + d.u, c = d.origin + d.u + d.v, e = d.origin + d.v;
+    segment(a, b);
+    segment(b, c);
+    segment(c, e);
+    segment(e, a);
+    quad(a, b, c, e);
+  }
+  void shape(const DiscDomain& d) {
+    circle(d.center, d.normal, d.outerRadius);
+    if (d.innerRadius > 0.0f) circle(d.center, d.normal, d.innerRadius);
+    annulus(d.center, d.normal, d.outerRadius, d.innerRadius);
+  }
+  void shape(const BoxDomain& d) {
+    const Vec3 lo = d.min, hi = d.max;
+    auto corner = [&](int i) {
+      return Vec3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
+    };
+    for (int i = 0; i < 8; ++i)
+      for (int bit : {1, 2, 4})
+        if (!(i & bit)) segment(corner(i), corner(i | bit));
+    // Faces: the pairs of corners differing in two of the three axes.
+    for (int axis : {1, 2, 4}) {
+      const int a = axis == 1 ? 2 : 1, b = axis == 4 ? 2 : 4;
+      for (int side : {0, axis})
+        quad(corner(side), corner(side | a), corner(side | a | b), corner(side | b));
+    }
+  }
+  void shape(const SphereDomain& d) {
+    for (int k = -2; k <= 2; ++k) {  // latitude rings
+      const float y = d.outerRadius * float(k) / 3.0f;
+      circle(d.center + Vec3(0, y, 0), Vec3(0, 1, 0),
+             std::sqrt(d.outerRadius * d.outerRadius - y * y));
+    }
+    for (int k = 0; k < 4; ++k) {  // meridians
+      const float a = 3.14159265f * float(k) / 4.0f;
+      circle(d.center, Vec3(std::cos(a), 0, std::sin(a)), d.outerRadius);
+    }
+  }
+  void shape(const CylinderDomain& d) {
+    const Vec3 axis = d.p1 - d.p0;
+    const float len = glm::length(axis);
+    if (len <= 0.0f) return;
+    const Vec3 n = axis / len;
+    circle(d.p0, n, d.outerRadius);
+    circle(d.p1, n, d.outerRadius);
+    Vec3 u, v;
+    basis(n, u, v);
+    for (int k = 0; k < 8; ++k) {
+      const float a = 6.2831853f * float(k) / 8.0f;
+      const Vec3 o = d.outerRadius * (std::cos(a) * u + std::sin(a) * v);
+      segment(d.p0 + o, d.p1 + o);
+    }
+  }
+  void shape(const ConeDomain& d) {
+    const Vec3 axis = d.base - d.apex;
+    const float len = glm::length(axis);
+    if (len <= 0.0f) return;
+    const Vec3 n = axis / len;
+    circle(d.base, n, d.outerRadius);
+    Vec3 u, v;
+    basis(n, u, v);
+    for (int k = 0; k < 8; ++k) {
+      const float a = 6.2831853f * float(k) / 8.0f;
+      segment(d.apex, d.base + d.outerRadius * (std::cos(a) * u + std::sin(a) * v));
+    }
+  }
+  void shape(const MeshDomain& d) {
+    for (const glm::uvec3& t : d.mesh->triangles) {
+      const Vec3 a = d.mesh->vertices[t.x], b = d.mesh->vertices[t.y], c = d.mesh->vertices[t.z];
+      segment(a, b);
+      segment(b, c);
+      segment(c, a);
+      triangle(a, b, c);
+    }
+  }
+  void shape(const UnionDomain& d) {
+    for (const Domain& part : d.parts->parts) add(part);
+  }
+};
+
 }  // namespace
 
 struct Renderer::Impl {
   RenderSettings settings;
-  GLuint billboard = 0, points = 0, strands = 0;
+  GLuint billboard = 0, points = 0, strands = 0, geometry = 0, toneMap = 0;
+  GLuint geometryVbo = 0, geometryVao = 0, emptyVao = 0;
+  std::vector<float> geometryLines, geometryFaces;
+  // The HDR target of a tone-mapped frame: multisampled like the caller's framebuffer, then
+  // resolved into a texture that the tone map reads.
+  GLuint hdrMsFbo = 0, hdrMsColor = 0, hdrMsDepth = 0, hdrFbo = 0, hdrTexture = 0, hdrDepth = 0;
+  int hdrWidth = 0, hdrHeight = 0, hdrSamples = -1;
+  GLint target = 0;  // the draw framebuffer bound at begin()
+  bool hdrFrame = false;
   GLuint quadVbo = 0, instanceVbo = 0, strandVbo = 0;
   GLuint billboardVao = 0, pointVao = 0, strandVao = 0;
   GLuint sprite = 0;
@@ -147,12 +316,101 @@ struct Renderer::Impl {
     glUniform1i(loc(p, "uFalloff"), int(l.falloff));
   }
 
-  void setBlend(bool depthWrite) {
+  void releaseHdr() {
+    const GLuint fbs[] = {hdrMsFbo, hdrFbo};
+    glDeleteFramebuffers(2, fbs);
+    const GLuint rbs[] = {hdrMsColor, hdrMsDepth, hdrDepth};
+    glDeleteRenderbuffers(3, rbs);
+    if (hdrTexture) glDeleteTextures(1, &hdrTexture);
+    hdrMsFbo = hdrMsColor = hdrMsDepth = hdrFbo = hdrTexture = hdrDepth = 0;
+    hdrWidth = hdrHeight = 0;
+    hdrSamples = -1;
+  }
+
+  void ensureHdr(int samples) {
+    if (hdrFbo && hdrWidth == width && hdrHeight == height && hdrSamples == samples) return;
+    releaseHdr();
+    glGenTextures(1, &hdrTexture);
+    glBindTexture(GL_TEXTURE_2D, hdrTexture);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, width, height, 0, GL_RGBA, GL_FLOAT, nullptr);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glGenFramebuffers(1, &hdrFbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, hdrFbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, hdrTexture, 0);
+    glGenRenderbuffers(1, &hdrDepth);
+    glBindRenderbuffer(GL_RENDERBUFFER, hdrDepth);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, hdrDepth);
+    bool ok = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    if (ok && samples > 1) {
+      glGenFramebuffers(1, &hdrMsFbo);
+      glBindFramebuffer(GL_FRAMEBUFFER, hdrMsFbo);
+      glGenRenderbuffers(1, &hdrMsColor);
+      glBindRenderbuffer(GL_RENDERBUFFER, hdrMsColor);
+      glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA16F, width, height);
+      glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, hdrMsColor);
+      glGenRenderbuffers(1, &hdrMsDepth);
+      glBindRenderbuffer(GL_RENDERBUFFER, hdrMsDepth);
+      glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_DEPTH_COMPONENT24, width,
+                                       height);
+      glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, hdrMsDepth);
+      ok = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, GLuint(target));
+    if (!ok) {
+      releaseHdr();
+      throw RenderError("cannot make a " + std::to_string(width) + "x" + std::to_string(height) +
+                        " floating-point framebuffer for the tone map");
+    }
+    hdrWidth = width;
+    hdrHeight = height;
+    hdrSamples = samples;
+  }
+
+  void drawGeometry(const Group& group) {
+    const SceneGeometry& g = settings.geometry;
+    geometryLines.clear();
+    geometryFaces.clear();
+    GeometryBuilder b{geometryLines, geometryFaces, Vec4(g.color, g.opacity),
+                      Vec4(g.color, g.opacity / 3.0f), settings.camera.distance};
+    for (const Action& a : group.actions().actions()) {
+      if (const auto* x = std::get_if<Bounce>(&a); x && g.bounce) b.add(x->surface);
+      if (const auto* x = std::get_if<Sink>(&a); x && g.sink) {
+        // An `outside` or `leave` absorber bounds the scene; it is not an object in it.
+        const bool bounds =
+            !x->killInside || x->mode == Sink::Mode::Outside || x->mode == Sink::Mode::Leave;
+        if (!bounds) b.add(x->region);
+      }
+      if (const auto* x = std::get_if<Block>(&a); x && g.block) b.add(x->region);
+    }
+    if (geometryLines.empty() && geometryFaces.empty()) return;
+    setBlend(false, false);
+    glUseProgram(geometry);
+    glUniformMatrix4fv(loc(geometry, "uView"), 1, GL_FALSE, glm::value_ptr(view));
+    glUniformMatrix4fv(loc(geometry, "uProj"), 1, GL_FALSE, glm::value_ptr(proj));
+    glBindVertexArray(geometryVao);
+    glBindBuffer(GL_ARRAY_BUFFER, geometryVbo);
+    for (const auto& [verts, mode] : {std::pair{&geometryFaces, GLenum(GL_TRIANGLES)},
+                                      std::pair{&geometryLines, GLenum(GL_LINES)}}) {
+      if (verts->empty()) continue;
+      const auto bytes = GLsizeiptr(verts->size() * sizeof(float));
+      glBufferData(GL_ARRAY_BUFFER, bytes, nullptr, GL_STREAM_DRAW);
+      glBufferSubData(GL_ARRAY_BUFFER, 0, bytes, verts->data());
+      glDrawArrays(mode, 0, GLsizei(verts->size() / 7));
+    }
+    glBindVertexArray(0);
+  }
+
+  void setBlend(bool depthWrite, bool additive) {
     glEnable(GL_BLEND);
-    if (settings.blend == BlendMode::Additive)
-      glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE, GL_ZERO, GL_ONE);
+    // Opaque backgrounds keep alpha 1; a transparent one accumulates coverage in alpha.
+    const bool t = settings.transparent;
+    if (additive)
+      glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE, t ? GL_ONE : GL_ZERO, GL_ONE);
     else
-      glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+      glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, t ? GL_ONE : GL_ZERO,
+                          t ? GL_ONE_MINUS_SRC_ALPHA : GL_ONE);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LEQUAL);
     glDepthMask(depthWrite ? GL_TRUE : GL_FALSE);
@@ -174,6 +432,8 @@ Renderer::Renderer(RenderSettings settings) : impl_(std::make_unique<Impl>()) {
   d.points = link(std::string(g::kProjection) + g::kPointVs, g::kPointFs, "point");
   d.strands = link(std::string(g::kProjection) + g::kStrandVs,
                    std::string(g::kLighting) + g::kStrandFs, "strand");
+  d.geometry = link(g::kGeometryVs, g::kGeometryFs, "geometry");
+  d.toneMap = link(g::kToneMapVs, g::kToneMapFs, "tone map");
 
   const float quad[] = {-1, -1, 1, -1, -1, 1, 1, 1};
   glGenBuffers(1, &d.quadVbo);
@@ -215,6 +475,16 @@ Renderer::Renderer(RenderSettings settings) : impl_(std::make_unique<Impl>()) {
   glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, sstride, reinterpret_cast<void*>(24));
   glEnableVertexAttribArray(3);
   glVertexAttribPointer(3, 4, GL_FLOAT, GL_FALSE, sstride, reinterpret_cast<void*>(32));
+
+  glGenBuffers(1, &d.geometryVbo);
+  glGenVertexArrays(1, &d.geometryVao);
+  glBindVertexArray(d.geometryVao);
+  glBindBuffer(GL_ARRAY_BUFFER, d.geometryVbo);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 7 * sizeof(float), nullptr);
+  glEnableVertexAttribArray(1);
+  glVertexAttribPointer(1, 4, GL_FLOAT, GL_FALSE, 7 * sizeof(float), reinterpret_cast<void*>(12));
+  glGenVertexArrays(1, &d.emptyVao);  // the tone map's triangle needs no vertex data
   glBindVertexArray(0);
   if (const GLenum e = glGetError(); e != GL_NO_ERROR)
     throw RenderError("OpenGL error " + std::to_string(e) + " setting up the renderer");
@@ -225,10 +495,13 @@ Renderer::~Renderer() {
   glDeleteProgram(d.billboard);
   glDeleteProgram(d.points);
   glDeleteProgram(d.strands);
-  const GLuint buffers[] = {d.quadVbo, d.instanceVbo, d.strandVbo};
-  glDeleteBuffers(3, buffers);
-  const GLuint vaos[] = {d.billboardVao, d.pointVao, d.strandVao};
-  glDeleteVertexArrays(3, vaos);
+  glDeleteProgram(d.geometry);
+  glDeleteProgram(d.toneMap);
+  const GLuint buffers[] = {d.quadVbo, d.instanceVbo, d.strandVbo, d.geometryVbo};
+  glDeleteBuffers(4, buffers);
+  const GLuint vaos[] = {d.billboardVao, d.pointVao, d.strandVao, d.geometryVao, d.emptyVao};
+  glDeleteVertexArrays(5, vaos);
+  d.releaseHdr();
   if (d.sprite) glDeleteTextures(1, &d.sprite);
 }
 
@@ -255,18 +528,57 @@ void Renderer::begin(int width, int height) {
   d.proj = glm::perspective(glm::radians(c.fovY), float(d.width) / float(d.height), c.nearPlane,
                             c.farPlane);
   glViewport(0, 0, d.width, d.height);
+  glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &d.target);
+  d.hdrFrame = d.settings.toneMap != ToneMap::None;
+  if (d.hdrFrame) {
+    // As many samples as the caller's framebuffer has: its MSAA covers the HDR image too.
+    GLint samples = 0;
+    glGetIntegerv(GL_SAMPLES, &samples);
+    d.ensureHdr(samples > 1 ? samples : 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, d.hdrMsFbo ? d.hdrMsFbo : d.hdrFbo);
+  }
   const Vec3 bg = d.settings.background;
-  glClearColor(bg.r, bg.g, bg.b, 1.0f);
+  if (d.settings.transparent)
+    glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+  else
+    glClearColor(bg.r, bg.g, bg.b, 1.0f);
   glDepthMask(GL_TRUE);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   d.drawn = 0;
 }
 
+void Renderer::end() {
+  Impl& d = *impl_;
+  if (!d.hdrFrame) return;
+  d.hdrFrame = false;
+  if (d.hdrMsFbo) {
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, d.hdrMsFbo);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, d.hdrFbo);
+    glBlitFramebuffer(0, 0, d.width, d.height, 0, 0, d.width, d.height, GL_COLOR_BUFFER_BIT,
+                      GL_NEAREST);
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, GLuint(d.target));
+  glDisable(GL_BLEND);
+  glDisable(GL_DEPTH_TEST);
+  glUseProgram(d.toneMap);
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D, d.hdrTexture);
+  glUniform1i(loc(d.toneMap, "uHdr"), 0);
+  glUniform1i(loc(d.toneMap, "uCurve"), d.settings.toneMap == ToneMap::Reinhard ? 1 : 2);
+  glUniform1f(loc(d.toneMap, "uExposure"), d.settings.exposure);
+  glUniform1i(loc(d.toneMap, "uTransparent"), d.settings.transparent ? 1 : 0);
+  glBindVertexArray(d.emptyVao);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glBindVertexArray(0);
+  glEnable(GL_DEPTH_TEST);
+}
+
 void Renderer::draw(const Group& group) {
   // A hair-mode group's strands first: they write depth, so its particles behind them hide.
-  if (!group.strands().position.empty()) draw(group.strands());
   Impl& d = *impl_;
   const RenderSettings& s = d.settings;
+  if (s.geometry.show) d.drawGeometry(group);
+  if (!group.strands().position.empty()) draw(group.strands());
   PackOptions opts;
   opts.blockers = s.blockers;
   if (s.blend == BlendMode::Alpha && s.sortForAlpha) opts.sortFromEye = s.camera.eye();
@@ -279,7 +591,7 @@ void Renderer::draw(const Group& group) {
   // Orphan the old storage so the driver need not wait for the last frame's draw.
   glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(n * layout.stride), nullptr, GL_STREAM_DRAW);
   glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(n * layout.stride), d.packed.data());
-  d.setBlend(false);
+  d.setBlend(false, s.blend == BlendMode::Additive);
   if (s.sprite == Sprite::Point) {
     d.setCommon(d.points);
     glEnable(GL_PROGRAM_POINT_SIZE);
@@ -291,6 +603,7 @@ void Renderer::draw(const Group& group) {
     d.setLighting(d.billboard);
     const glm::mat3 viewToWorld = glm::transpose(glm::mat3(d.view));
     glUniformMatrix3fv(loc(d.billboard, "uViewToWorld"), 1, GL_FALSE, glm::value_ptr(viewToWorld));
+    glUniform1i(loc(d.billboard, "uFlat"), s.sprite == Sprite::Glow || s.sprite == Sprite::Puff);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, d.sprite);
     glUniform1i(loc(d.billboard, "uSprite"), 0);
@@ -355,7 +668,7 @@ void Renderer::draw(const Strands& strands) {
   glBufferData(GL_ARRAY_BUFFER, bytes, nullptr, GL_STREAM_DRAW);
   glBufferSubData(GL_ARRAY_BUFFER, 0, bytes, d.strandVerts.data());
   // Opaque strands hide what is behind them, particles included; translucent ones blend.
-  d.setBlend(true);
+  d.setBlend(true, s.blend == BlendMode::Additive);
   d.setCommon(d.strands);
   d.setLighting(d.strands);
   glUniform1i(loc(d.strands, "uLines"), lines ? 1 : 0);

@@ -82,7 +82,8 @@ RenderSettings parseRenderSettings(std::string_view text, const std::filesystem:
   const std::string p = "render";
   R::onlyKeys(root, p,
               {"background", "camera", "shading", "litMinPixels", "ambient", "lights", "material",
-               "falloff", "blend", "sort", "sprite", "strands"});
+               "falloff", "blend", "sort", "sprite", "strands", "toneMap", "exposure",
+               "transparent", "geometry"});
   if (root.contains("background")) s.background = R::rgb(root["background"], p + ".background");
   if (root.contains("camera")) {
     const json& c = root["camera"];
@@ -161,7 +162,7 @@ RenderSettings parseRenderSettings(std::string_view text, const std::filesystem:
   if (root.contains("sprite")) {
     const json& v = root["sprite"];
     if (!v.is_string())
-      R::fail(p + ".sprite", "must be point, disc, spark, snowflake or a PNG path");
+      R::fail(p + ".sprite", "must be point, disc, spark, snowflake, glow, puff or a PNG path");
     const std::string name = v.get<std::string>();
     if (name == "point")
       s.sprite = Sprite::Point;
@@ -171,6 +172,10 @@ RenderSettings parseRenderSettings(std::string_view text, const std::filesystem:
       s.sprite = Sprite::Spark;
     else if (name == "snowflake")
       s.sprite = Sprite::Snowflake;
+    else if (name == "glow")
+      s.sprite = Sprite::Glow;
+    else if (name == "puff")
+      s.sprite = Sprite::Puff;
     else {
       s.sprite = Sprite::Image;
       const std::filesystem::path file(name);
@@ -181,6 +186,39 @@ RenderSettings parseRenderSettings(std::string_view text, const std::filesystem:
     s.strandStyle = R::choice(root["strands"], p + ".strands", {"ribbon", "line"}) == "line"
                         ? StrandStyle::Line
                         : StrandStyle::Ribbon;
+  if (root.contains("toneMap")) {
+    const std::string t = R::choice(root["toneMap"], p + ".toneMap", {"none", "reinhard", "aces"});
+    s.toneMap = t == "aces" ? ToneMap::Aces : t == "reinhard" ? ToneMap::Reinhard : ToneMap::None;
+  }
+  if (root.contains("exposure")) {
+    s.exposure = R::number(root["exposure"], p + ".exposure");
+    if (!(s.exposure > 0.0f && s.exposure <= 100.0f))
+      R::fail(p + ".exposure", "must be within (0, 100]");
+  }
+  if (root.contains("transparent"))
+    s.transparent = R::boolean(root["transparent"], p + ".transparent");
+  if (root.contains("geometry")) {
+    // true / false, or an object: {"show", "color", "opacity", "bounce", "sink", "block"}.
+    const json& g = root["geometry"];
+    const std::string gp = p + ".geometry";
+    SceneGeometry& geo = s.geometry;
+    if (g.is_boolean()) {
+      geo.show = g.get<bool>();
+    } else {
+      if (!g.is_object()) R::fail(gp, "must be true, false or an object");
+      R::onlyKeys(g, gp, {"show", "color", "opacity", "bounce", "sink", "block"});
+      geo.show = g.contains("show") ? R::boolean(g["show"], gp + ".show") : true;
+      if (g.contains("color")) geo.color = R::rgb(g["color"], gp + ".color");
+      if (g.contains("opacity")) {
+        geo.opacity = R::number(g["opacity"], gp + ".opacity");
+        if (!(geo.opacity >= 0.0f && geo.opacity <= 1.0f))
+          R::fail(gp + ".opacity", "must be within [0, 1]");
+      }
+      if (g.contains("bounce")) geo.bounce = R::boolean(g["bounce"], gp + ".bounce");
+      if (g.contains("sink")) geo.sink = R::boolean(g["sink"], gp + ".sink");
+      if (g.contains("block")) geo.block = R::boolean(g["block"], gp + ".block");
+    }
+  }
   return s;
 }
 

@@ -110,6 +110,7 @@ flat in float vRadius;
 flat in int vMode;
 uniform sampler2D uSprite;
 uniform mat3 uViewToWorld;
+uniform bool uFlat;  // glow, puff: one normal facing the eye, so no sprite reads as a ball
 out vec4 oColor;
 void main() {
   if (vMode == 0) {
@@ -120,7 +121,10 @@ void main() {
   float a = vColor.a * t.a;
   if (a <= 0.0) discard;
   vec3 base = vColor.rgb * t.rgb;
-  if (vMode == 2) {
+  if (vMode == 2 && uFlat) {
+    vec3 n = normalize(uEye - vCenter);
+    base = shade(base, vCenter, n);
+  } else if (vMode == 2) {
     // A sphere's normal under the billboard; outside the disc, the rim's.
     float r2 = dot(vUV, vUV);
     vec3 nv = r2 < 1.0 ? vec3(vUV, sqrt(1.0 - r2)) : vec3(vUV * inversesqrt(r2), 0.0);
@@ -135,20 +139,83 @@ inline constexpr const char* kPointVs = R"(
 layout(location = 1) in vec4 aCenterRadius;
 layout(location = 2) in vec4 aColor;
 flat out vec4 vColor;
+flat out float vSize;
 void main() {
   vec4 c = uView * vec4(aCenterRadius.xyz, 1.0);
   float rpx = aCenterRadius.w * pixelsPerUnit(-c.z);
   vColor = aColor;
   if (rpx < 0.5) vColor.a *= 3.14159265 * rpx * rpx;
-  gl_PointSize = max(1.0, 2.0 * rpx);
+  // One pixel wider than the disc, so its anti-aliased rim fits inside the point.
+  vSize = max(1.0, 2.0 * rpx);
+  gl_PointSize = vSize > 1.5 ? vSize + 1.0 : vSize;
   gl_Position = uProj * c;
 }
 )";
 
+// GL rasterises wide points as squares, multisampled or not: the fragment shader cuts the
+// disc out, its rim's alpha the pixel's coverage, so points are round and anti-aliased.
 inline constexpr const char* kPointFs = R"(
 flat in vec4 vColor;
+flat in float vSize;
+out vec4 oColor;
+void main() {
+  float a = vColor.a;
+  if (vSize > 1.5) {
+    float rpx = length(gl_PointCoord * 2.0 - 1.0) * 0.5 * (vSize + 1.0);
+    a *= clamp(0.5 * vSize - rpx + 0.5, 0.0, 1.0);
+    if (a <= 0.0) discard;
+  }
+  oColor = vec4(vColor.rgb, a);
+}
+)";
+
+// Scene geometry: lines and faint faces in one colour per vertex.
+inline constexpr const char* kGeometryVs = R"(
+layout(location = 0) in vec3 aPos;
+layout(location = 1) in vec4 aColor;
+uniform mat4 uView, uProj;
+out vec4 vColor;
+void main() {
+  vColor = aColor;
+  gl_Position = uProj * uView * vec4(aPos, 1.0);
+}
+)";
+
+inline constexpr const char* kGeometryFs = R"(
+in vec4 vColor;
 out vec4 oColor;
 void main() { oColor = vColor; }
+)";
+
+// The tone map: a full-screen triangle reading the resolved HDR image.
+inline constexpr const char* kToneMapVs = R"(
+out vec2 vUV;
+void main() {
+  vec2 p = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);
+  vUV = p * 0.5 + 0.5;
+  gl_Position = vec4(p, 0.0, 1.0);
+}
+)";
+
+inline constexpr const char* kToneMapFs = R"(
+in vec2 vUV;
+uniform sampler2D uHdr;
+uniform int uCurve;  // 1 Reinhard, 2 ACES
+uniform float uExposure;
+uniform bool uTransparent;
+out vec4 oColor;
+void main() {
+  vec4 h = texture(uHdr, vUV);
+  float a = clamp(h.a, 0.0, 1.0);
+  // On a transparent background the colour accumulated premultiplied: map the straight one.
+  vec3 c = max(uTransparent ? (a > 0.0 ? h.rgb / a : vec3(0.0)) : h.rgb, vec3(0.0)) * uExposure;
+  if (uCurve == 1) {
+    c = c / (1.0 + c);
+  } else {
+    c = clamp((c * (2.51 * c + 0.03)) / (c * (2.43 * c + 0.59) + 0.14), 0.0, 1.0);
+  }
+  oColor = vec4(c, uTransparent ? a : 1.0);
+}
 )";
 
 inline constexpr const char* kStrandVs = R"(

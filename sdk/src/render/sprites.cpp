@@ -57,6 +57,24 @@ float snowflakeAlpha(float x, float y) {
   return 1.0f - smoothstep(w * 0.5f, w, d);
 }
 
+// A gaussian glow that reaches zero at the quad's edge: no visible square, a bright core.
+float glowAlpha(float x, float y) {
+  const float r2 = x * x + y * y;
+  return std::max(0.0f, std::exp(-r2 * 4.0f) - std::exp(-4.0f)) / (1.0f - std::exp(-4.0f));
+}
+
+// A soft puff: a smooth falloff made lumpy by a few fixed lobes, so overlapping puffs read
+// as billowing smoke rather than as discs. Fixed: the same bitmap on every run.
+float puffAlpha(float x, float y) {
+  const float r = std::hypot(x, y);
+  const float a = std::atan2(y, x);
+  const float lumps = 0.12f * std::sin(3.0f * a + 0.7f) + 0.08f * std::sin(5.0f * a + 2.1f) +
+                      0.06f * std::sin(7.0f * a + 4.0f) * r;
+  const float edge = std::clamp(1.0f - r / (0.85f + lumps), 0.0f, 1.0f);
+  const float inner = 0.85f + 0.15f * std::sin(9.0f * x + 4.0f * y) * std::sin(7.0f * y - 3.0f * x);
+  return edge * edge * (3.0f - 2.0f * edge) * inner;
+}
+
 }  // namespace
 
 Image spriteBitmap(Sprite sprite, const std::string& path, int size) {
@@ -85,6 +103,12 @@ Image spriteBitmap(Sprite sprite, const std::string& path, int size) {
           break;
         case Sprite::Snowflake:
           a = snowflakeAlpha(x, y);
+          break;
+        case Sprite::Glow:
+          a = glowAlpha(x, y);
+          break;
+        case Sprite::Puff:
+          a = puffAlpha(x, y);
           break;
         default:
           a = discAlpha(x, y);

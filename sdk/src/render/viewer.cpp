@@ -151,6 +151,7 @@ void runViewer(const std::function<ViewerScene()>& build, RenderSettings setting
         renderer->draw(*g);
         live += g->size();
       }
+      renderer->end();
       glfwSwapBuffers(window);
       ++frames;
       ++framesSinceTitle;
