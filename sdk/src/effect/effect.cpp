@@ -3,6 +3,7 @@
 // errors with a suggestion: a typo must not silently become a default.
 #include "flurry/effect.hpp"
 
+#include "effect/descriptors.hpp"
 #include "effect/effect_parts.hpp"
 
 #include <algorithm>
@@ -491,14 +492,6 @@ Domain readDomain(const json& j, const std::string& path, const Loader& L) {
   return d;
 }
 
-void read(const json& j, const std::string& path, const Loader& L, Falloff& out) {
-  Obj o(j, path, L);
-  o.opt("center", out.center);
-  o.opt("radius", out.radius);
-  o.opt("power", out.power);
-  o.finish();
-}
-
 template <class T, class F>
 void readArray(const json& j, const std::string& path, const Loader& L, std::vector<T>& out,
                F&& each) {
@@ -511,39 +504,28 @@ void readArray(const json& j, const std::string& path, const Loader& L, std::vec
   }
 }
 
-void read(const json& j, const std::string& path, const Loader& L, std::vector<Burst>& out) {
-  readArray(j, path, L, out, [&](const json& e, const std::string& p, Burst& b) {
-    Obj o(e, p, L);
-    o.opt("time", b.time);
-    o.req("count", b.count);
-    o.opt("interval", b.interval);
-    o.opt("repeat", b.repeat);
-    o.finish();
+/// Reads a described struct's fields (desc::Describe<S>) into `out`, which holds its
+/// defaults: each field in descriptor order, required ones named when missing.
+template <class S>
+void readFields(Obj& o, S& out) {
+  desc::forEachField<S>([&](const auto& f) {
+    if (f.required)
+      o.req(f.name, out.*f.member, f.required);
+    else
+      o.opt(f.name, out.*f.member);
   });
 }
 
-void read(const json& j, const std::string& path, const Loader& L, std::vector<Keyframe>& out) {
-  readArray(j, path, L, out, [&](const json& e, const std::string& p, Keyframe& k) {
-    Obj o(e, p, L);
-    o.req("time", k.time);
-    o.req("position", k.position);
-    o.finish();
-  });
-}
-
-void read(const json& j, const std::string& path, const Loader& L, ParticleType& t) {
+template <desc::Described S>
+void read(const json& j, const std::string& path, const Loader& L, S& out) {
   Obj o(j, path, L);
-  o.opt("weight", t.weight);
-  o.opt("velocity", t.velocity);
-  o.opt("color", t.color);
-  o.opt("alpha", t.alpha);
-  o.opt("size", t.size);
-  o.opt("mass", t.mass);
-  o.opt("lifetime", t.lifetime);
-  o.opt("charge", t.charge);
-  o.opt("up", t.up);
-  o.opt("rotVelocity", t.rotVelocity);
+  readFields(o, out);
   o.finish();
+}
+
+template <desc::Described T>
+void read(const json& j, const std::string& path, const Loader& L, std::vector<T>& out) {
+  readArray(j, path, L, out, [&](const json& e, const std::string& p, T& t) { read(e, p, L, t); });
 }
 
 void read(const json& j, const std::string& path, const Loader& L, std::vector<ParticleType>& out) {
@@ -552,33 +534,26 @@ void read(const json& j, const std::string& path, const Loader& L, std::vector<P
   if (out.empty()) L.fail(path, "an emitter needs at least one particle type");
 }
 
-/// The fields an emitter and a prime emitter share: where, when and how many.
-template <class E>
-void readCounting(Obj& o, E& e) {
-  o.opt("name", e.name);
-  o.opt("shape", e.shape);
-  o.opt("rate", e.rate);
-  o.opt("bursts", e.bursts);
-  o.opt("position", e.position);
-  o.opt("velocity", e.velocity);
-  o.opt("path", e.path);
-  o.opt("start", e.start);
-  o.opt("stop", e.stop);
-}
-
-Emitter readEmitterFields(const json& j, const std::string& path, const Loader& L) {
-  Obj o(j, path, L);
-  Emitter e;
-  readCounting(o, e);
-  o.opt("types", e.types);
-  o.opt("spacing", e.spacing);
-  o.opt("normalSpeed", e.normalSpeed);
-  o.finish();
-  return e;
+template <desc::NamedEnum E>
+void read(const json& j, const std::string& path, const Loader& L, E& out) {
+  std::string s;
+  read(j, path, L, s);
+  std::vector<std::string> all;
+  std::string list;
+  for (const auto& [n, val] : desc::EnumNames<E>::values) {
+    if (n == s) {
+      out = val;
+      return;
+    }
+    all.emplace_back(n);
+    list += (list.empty() ? "" : ", ") + std::string(n);
+  }
+  L.fail(path, "\"" + s + "\" is not one of " + list + suggestion(s, all));
 }
 
 Emitter readEmitter(const json& j, const std::string& path, const Loader& L) {
-  Emitter e = readEmitterFields(j, path, L);
+  Emitter e;
+  read(j, path, L, e);
   try {
     e.validate(path);
   } catch (const InvalidArgument& x) {
@@ -587,30 +562,23 @@ Emitter readEmitter(const json& j, const std::string& path, const Loader& L) {
   return e;
 }
 
-std::shared_ptr<EmitterSpec> readSpec(const json& j, const std::string& path, const Loader& L) {
+/// A prime emitter's levels nest: bounded like domains.
+void read(const json& j, const std::string& path, const Loader& L, EmitterSpec& out) {
   DepthGuard guard(L, path);
   Obj o(j, path, L);
-  auto s = std::make_shared<EmitterSpec>();
-  if (const json* e = o.get("emitter")) s->emitter = readEmitterFields(*e, o.at("emitter"), L);
-  o.opt("velocity", s->velocity);
-  o.opt("inheritVelocity", s->inheritVelocity);
-  o.opt("lifetime", s->lifetime);
-  o.opt("acceleration", s->acceleration);
-  o.opt("drag", s->drag);
-  o.opt("deathBurst", s->deathBurst);
-  o.opt("deathChildren", s->deathChildren);
-  if (const json* n = o.get("next")) s->next = readSpec(*n, o.at("next"), L);
+  readFields(o, out);
   o.finish();
-  return s;
+}
+void read(const json& j, const std::string& path, const Loader& L,
+          std::shared_ptr<const EmitterSpec>& out) {
+  auto s = std::make_shared<EmitterSpec>();
+  read(j, path, L, *s);
+  out = std::move(s);
 }
 
 PrimeEmitter readPrime(const json& j, const std::string& path, const Loader& L) {
-  Obj o(j, path, L);
   PrimeEmitter p;
-  readCounting(o, p);
-  p.child = *readSpec(o.require("child", "the emitters it emits"), o.at("child"), L);
-  o.opt("maxEmitters", p.maxEmitters);
-  o.finish();
+  read(j, path, L, p);
   try {
     p.validate(path);
   } catch (const InvalidArgument& x) {
@@ -621,43 +589,13 @@ PrimeEmitter readPrime(const json& j, const std::string& path, const Loader& L) 
 
 // ---- actions --------------------------------------------------------------------------------
 
-const std::vector<std::string> kActionTypes = {"Gravity",
-                                               "Damping",
-                                               "RotDamping",
-                                               "OrbitPoint",
-                                               "OrbitLine",
-                                               "Gravitate",
-                                               "Vortex",
-                                               "Jet",
-                                               "Explosion",
-                                               "RandomAccel",
-                                               "RandomDisplace",
-                                               "RandomVelocity",
-                                               "RandomRotVelocity",
-                                               "Turbulence",
-                                               "ElectricField",
-                                               "MagneticField",
-                                               "SampledField",
-                                               "Avoid",
-                                               "Follow",
-                                               "MatchVelocity",
-                                               "MatchRotVelocity",
-                                               "TargetVelocity",
-                                               "TargetRotVelocity",
-                                               "TargetColor",
-                                               "TargetSize",
-                                               "SpeedClamp",
-                                               "ColorOverLife",
-                                               "SizeOverLife",
-                                               "Bounce",
-                                               "Sink",
-                                               "SinkVelocity",
-                                               "Block",
-                                               "KillOld",
-                                               "Move",
-                                               "Constrain2D",
-                                               "CopyVertexB",
-                                               "Restore"};
+/// The actions an effect file can hold, by name (all but Callback).
+const std::vector<std::string> kActionTypes = [] {
+  std::vector<std::string> names;
+  desc::forEachAction(
+      [&](auto a) { names.emplace_back(desc::Describe<typename decltype(a)::type>::name); });
+  return names;
+}();
 
 std::shared_ptr<const VectorField> readField(const json& j, const std::string& path,
                                              const Loader& L) {
@@ -715,284 +653,22 @@ std::shared_ptr<const VectorField> readField(const json& j, const std::string& p
   return f;
 }
 
-template <class T>
-void readEnum(Obj& o, const char* key, T& out,
-              const std::vector<std::pair<std::string, T>>& names) {
-  std::string s;
-  if (const json* v = o.get(key))
-    read(*v, o.at(key), o.loader(), s);
-  else
-    return;
-  for (const auto& [n, val] : names)
-    if (n == s) {
-      out = val;
-      return;
-    }
-  std::vector<std::string> all;
-  std::string list;
-  for (const auto& [n, val] : names) {
-    all.push_back(n);
-    list += (list.empty() ? "" : ", ") + n;
-  }
-  o.loader().fail(o.at(key), "\"" + s + "\" is not one of " + list + suggestion(s, all));
+void read(const json& j, const std::string& path, const Loader& L,
+          std::shared_ptr<const VectorField>& out) {
+  out = readField(j, path, L);
 }
 
+/// The action named `type` (a known name), its fields read from `o` by its descriptor.
 Action readActionBody(Obj& o, const std::string& type) {
-  const Loader& L = o.loader();
-  auto falloff = [&](Falloff& f) { o.opt("falloff", f); };
-  if (type == "Gravity") {
-    Gravity a;
-    o.opt("acceleration", a.acceleration);
-    falloff(a.falloff);
-    return a;
-  }
-  if (type == "Damping") {
-    Damping a;
-    o.opt("rate", a.rate);
-    falloff(a.falloff);
-    return a;
-  }
-  if (type == "RotDamping") {
-    RotDamping a;
-    o.opt("rate", a.rate);
-    return a;
-  }
-  if (type == "OrbitPoint") {
-    OrbitPoint a;
-    o.opt("center", a.center);
-    o.opt("magnitude", a.magnitude);
-    o.opt("epsilon", a.epsilon);
-    o.opt("maxRadius", a.maxRadius);
-    return a;
-  }
-  if (type == "OrbitLine") {
-    OrbitLine a;
-    o.opt("point", a.point);
-    o.opt("axis", a.axis);
-    o.opt("magnitude", a.magnitude);
-    o.opt("epsilon", a.epsilon);
-    o.opt("maxRadius", a.maxRadius);
-    return a;
-  }
-  if (type == "Gravitate" || type == "Follow") {
-    float magnitude = 1.0f, epsilon = 1e-3f, maxRadius = kInfinity;
-    o.opt("magnitude", magnitude);
-    o.opt("epsilon", epsilon);
-    o.opt("maxRadius", maxRadius);
-    if (type == "Follow") return Follow{magnitude, epsilon, maxRadius};
-    return Gravitate{magnitude, epsilon, maxRadius};
-  }
-  if (type == "Vortex") {
-    Vortex a;
-    o.opt("center", a.center);
-    o.opt("axis", a.axis);
-    o.opt("aroundSpeed", a.aroundSpeed);
-    o.opt("coreRadius", a.coreRadius);
-    o.opt("tightness", a.tightness);
-    o.opt("inSpeed", a.inSpeed);
-    o.opt("upSpeed", a.upSpeed);
-    o.opt("responsiveness", a.responsiveness);
-    o.opt("maxRadius", a.maxRadius);
-    return a;
-  }
-  if (type == "Jet") {
-    Jet a;
-    o.opt("center", a.center);
-    o.opt("radius", a.radius);
-    o.opt("acceleration", a.acceleration);
-    return a;
-  }
-  if (type == "Explosion") {
-    Explosion a;
-    o.opt("center", a.center);
-    o.opt("speed", a.speed);
-    o.opt("magnitude", a.magnitude);
-    o.opt("stddev", a.stddev);
-    o.opt("epsilon", a.epsilon);
-    o.opt("time", a.time);
-    return a;
-  }
-  if (type == "RandomAccel") {
-    RandomAccel a;
-    o.opt("acceleration", a.acceleration);
-    falloff(a.falloff);
-    return a;
-  }
-  if (type == "RandomDisplace") {
-    RandomDisplace a;
-    o.opt("displacement", a.displacement);
-    return a;
-  }
-  if (type == "RandomVelocity") {
-    RandomVelocity a;
-    o.opt("velocity", a.velocity);
-    return a;
-  }
-  if (type == "RandomRotVelocity") {
-    RandomRotVelocity a;
-    o.opt("rotVelocity", a.rotVelocity);
-    return a;
-  }
-  if (type == "Turbulence") {
-    Turbulence a;
-    o.opt("amplitude", a.amplitude);
-    o.opt("frequency", a.frequency);
-    o.opt("octaves", a.octaves);
-    o.opt("drift", a.drift);
-    falloff(a.falloff);
-    return a;
-  }
-  if (type == "ElectricField") {
-    ElectricField a;
-    o.opt("field", a.field);
-    falloff(a.falloff);
-    return a;
-  }
-  if (type == "MagneticField") {
-    MagneticField a;
-    o.opt("field", a.field);
-    falloff(a.falloff);
-    return a;
-  }
-  if (type == "SampledField") {
-    SampledField a;
-    a.field = readField(o.require("field", "a dense grid or {\"vdb\": file}"), o.at("field"), L);
-    readEnum(o, "mode", a.mode,
-             {{"acceleration", SampledField::Mode::Acceleration},
-              {"velocity", SampledField::Mode::Velocity}});
-    o.opt("strength", a.strength);
-    o.opt("responsiveness", a.responsiveness);
-    falloff(a.falloff);
-    return a;
-  }
-  if (type == "Avoid") {
-    Avoid a;
-    o.opt("obstacle", a.obstacle);
-    o.opt("magnitude", a.magnitude);
-    o.opt("epsilon", a.epsilon);
-    o.opt("lookAhead", a.lookAhead);
-    return a;
-  }
-  if (type == "MatchVelocity" || type == "MatchRotVelocity") {
-    float magnitude = 1.0f, epsilon = 1e-3f, maxRadius = 1.0f;
-    o.opt("magnitude", magnitude);
-    o.opt("epsilon", epsilon);
-    o.opt("maxRadius", maxRadius);
-    if (type == "MatchVelocity") return MatchVelocity{magnitude, epsilon, maxRadius};
-    return MatchRotVelocity{magnitude, epsilon, maxRadius};
-  }
-  if (type == "TargetVelocity") {
-    TargetVelocity a;
-    o.opt("velocity", a.velocity);
-    o.opt("rate", a.rate);
-    return a;
-  }
-  if (type == "TargetRotVelocity") {
-    TargetRotVelocity a;
-    o.opt("rotVelocity", a.rotVelocity);
-    o.opt("rate", a.rate);
-    return a;
-  }
-  if (type == "TargetColor") {
-    TargetColor a;
-    o.opt("color", a.color);
-    o.opt("alpha", a.alpha);
-    o.opt("rate", a.rate);
-    return a;
-  }
-  if (type == "TargetSize") {
-    TargetSize a;
-    o.opt("size", a.size);
-    o.opt("rate", a.rate);
-    return a;
-  }
-  if (type == "SpeedClamp") {
-    SpeedClamp a;
-    o.opt("minSpeed", a.minSpeed);
-    o.opt("maxSpeed", a.maxSpeed);
-    return a;
-  }
-  if (type == "ColorOverLife") {
-    ColorOverLife a;
-    readEnum(o, "mode", a.mode,
-             {{"multiply", OverLifeMode::Multiply}, {"replace", OverLifeMode::Replace}});
-    if (const json* k = o.get("keys"))
-      readArray(*k, o.at("keys"), L, a.keys,
-                [&](const json& e, const std::string& p, ColorOverLife::Key& key) {
-                  Obj ko(e, p, L);
-                  ko.req("t", key.t);
-                  ko.req("color", key.color);
-                  ko.finish();
-                });
-    return a;
-  }
-  if (type == "SizeOverLife") {
-    SizeOverLife a;
-    readEnum(o, "mode", a.mode,
-             {{"multiply", OverLifeMode::Multiply}, {"replace", OverLifeMode::Replace}});
-    if (const json* k = o.get("keys"))
-      readArray(*k, o.at("keys"), L, a.keys,
-                [&](const json& e, const std::string& p, SizeOverLife::Key& key) {
-                  Obj ko(e, p, L);
-                  ko.req("t", key.t);
-                  ko.req("size", key.size);
-                  ko.finish();
-                });
-    return a;
-  }
-  if (type == "Bounce") {
-    Bounce a;
-    o.req("surface", a.surface, "the deflecting surface, a domain");
-    o.opt("restitution", a.restitution);
-    o.opt("friction", a.friction);
-    o.opt("cutoff", a.cutoff);
-    o.opt("inside", a.inside);
-    o.opt("planeNormal", a.planeNormal);
-    return a;
-  }
-  if (type == "Sink") {
-    Sink a;
-    o.req("region", a.region, "the absorbing region or surface, a domain");
-    o.opt("killInside", a.killInside);
-    o.opt("passThrough", a.passThrough);
-    readEnum(o, "mode", a.mode,
-             {{"inside", Sink::Mode::Inside},
-              {"outside", Sink::Mode::Outside},
-              {"enter", Sink::Mode::Enter},
-              {"leave", Sink::Mode::Leave},
-              {"hit", Sink::Mode::Hit}});
-    return a;
-  }
-  if (type == "SinkVelocity") {
-    SinkVelocity a;
-    o.opt("velocity", a.velocity);
-    o.opt("killInside", a.killInside);
-    return a;
-  }
-  if (type == "Block") {
-    Block a;
-    o.req("region", a.region, "the region that hides particles, a domain");
-    return a;
-  }
-  if (type == "KillOld") return KillOld{};
-  if (type == "Move") return Move{};
-  if (type == "Constrain2D") {
-    Constrain2D a;
-    o.opt("point", a.point);
-    o.opt("normal", a.normal);
-    return a;
-  }
-  if (type == "CopyVertexB") {
-    CopyVertexB a;
-    o.opt("copyPosition", a.copyPosition);
-    o.opt("copyVelocity", a.copyVelocity);
-    return a;
-  }
-  // Restore
-  Restore a;
-  o.opt("start", a.start);
-  o.opt("duration", a.duration);
-  return a;
+  std::optional<Action> out;
+  desc::forEachAction([&](auto tag) {
+    using A = typename decltype(tag)::type;
+    if (out || type != desc::Describe<A>::name) return;
+    A a;
+    readFields(o, a);
+    out = std::move(a);
+  });
+  return std::move(*out);
 }
 
 /// Fails at `typePath` unless `type` names an action an effect file can hold.
