@@ -1,6 +1,6 @@
-// One descriptor per action (and per emitter part): its effect-file name, a one-line doc, and
-// each field once, with its JSON name, the member, its unit, its valid values and a one-line
-// doc. Defaults are never restated: they are the struct's own member initialisers (a
+// One descriptor per action (and per emitter part and domain shape): its effect-file name, a
+// one-line doc, and each field once, with its JSON name, the member, its unit, its valid values and
+// a one-line doc. Defaults are never restated: they are the struct's own member initialisers (a
 // default-constructed struct). From these the effect loader reads each action's body, the
 // writer (saveEffect) writes it, and the JSON Schema, the reference docs and the fuzz
 // dictionary are generated (flurry_effect_docs). Internal: not installed.
@@ -651,6 +651,149 @@ struct Describe<PrimeEmitter> {
                 "the emitters it emits"),
           field("maxEmitters", &PrimeEmitter::maxEmitters, "", kAny, "live emitters at most"),
       });
+};
+
+// ---- domains (mesh and union hold lists: read and written by hand) --------------------------
+
+/// Calls f(std::type_identity<S>{}) for each described domain shape, in Domain::Shape's order.
+template <class F>
+void forEachDomainKind(F&& f) {
+  [&]<std::size_t... I>(std::index_sequence<I...>) {
+    (
+        [&] {
+          using S = std::variant_alternative_t<I, Domain::Shape>;
+          if constexpr (Described<S>) f(std::type_identity<S>{});
+        }(),
+        ...);
+  }
+  (std::make_index_sequence<std::variant_size_v<Domain::Shape>>{});
+}
+
+template <>
+struct Describe<PointDomain> {
+  static constexpr const char* name = "point";
+  static constexpr const char* doc = "A point (also written [x, y, z]).";
+  static constexpr auto fields =
+      std::tuple{field("point", &PointDomain::p, "units", kAny, "the point")};
+  static Domain make(const PointDomain& s) { return Domain::point(s.p); }
+};
+template <>
+struct Describe<LineDomain> {
+  static constexpr const char* name = "line";
+  static constexpr const char* doc = "A line segment.";
+  static constexpr auto fields = std::tuple{
+      field("p0", &LineDomain::p0, "units", kAny, "one end", kRequired),
+      field("p1", &LineDomain::p1, "units", kAny, "the other end", kRequired),
+  };
+  static Domain make(const LineDomain& s) { return Domain::line(s.p0, s.p1); }
+};
+template <>
+struct Describe<TriangleDomain> {
+  static constexpr const char* name = "triangle";
+  static constexpr const char* doc = "A triangle.";
+  static constexpr auto fields = std::tuple{
+      field("p0", &TriangleDomain::p0, "units", kAny, "a corner", kRequired),
+      field("p1", &TriangleDomain::p1, "units", kAny, "a corner", kRequired),
+      field("p2", &TriangleDomain::p2, "units", kAny, "a corner", kRequired),
+  };
+  static Domain make(const TriangleDomain& s) { return Domain::triangle(s.p0, s.p1, s.p2); }
+};
+template <>
+struct Describe<PlaneDomain> {
+  static constexpr const char* name = "plane";
+  static constexpr const char* doc = "An infinite plane.";
+  static constexpr auto fields = std::tuple{
+      field("point", &PlaneDomain::point, "units", kAny, "a point of the plane"),
+      field("normal", &PlaneDomain::normal, "", kNonZero, "its normal", kRequired),
+  };
+  static Domain make(const PlaneDomain& s) { return Domain::plane(s.point, s.normal); }
+};
+template <>
+struct Describe<RectangleDomain> {
+  static constexpr const char* name = "rectangle";
+  static constexpr const char* doc = "A parallelogram: origin + s·u + t·v, s and t in [0, 1].";
+  static constexpr auto fields = std::tuple{
+      field("origin", &RectangleDomain::origin, "units", kAny, "a corner"),
+      field("u", &RectangleDomain::u, "units", kAny, "one edge", kRequired),
+      field("v", &RectangleDomain::v, "units", kAny, "the other edge", kRequired),
+  };
+  static Domain make(const RectangleDomain& s) { return Domain::rectangle(s.origin, s.u, s.v); }
+};
+template <>
+struct Describe<DiscDomain> {
+  static constexpr const char* name = "disc";
+  static constexpr const char* doc = "A disc, or a ring between innerRadius and outerRadius.";
+  static constexpr auto fields = std::tuple{
+      field("center", &DiscDomain::center, "units", kAny, "its center"),
+      field("normal", &DiscDomain::normal, "", kNonZero, "its normal", kRequired),
+      field("outerRadius", &DiscDomain::outerRadius, "units", kAny, "its radius", "the radius"),
+      field("innerRadius", &DiscDomain::innerRadius, "units", kAny, "a ring's inner radius"),
+  };
+  static Domain make(const DiscDomain& s) {
+    return Domain::disc(s.center, s.normal, s.outerRadius, s.innerRadius);
+  }
+};
+template <>
+struct Describe<BoxDomain> {
+  static constexpr const char* name = "box";
+  static constexpr const char* doc = "An axis-aligned box.";
+  static constexpr auto fields = std::tuple{
+      field("min", &BoxDomain::min, "units", kAny, "a corner", kRequired),
+      field("max", &BoxDomain::max, "units", kAny, "the opposite corner", kRequired),
+  };
+  static Domain make(const BoxDomain& s) { return Domain::box(s.min, s.max); }
+};
+template <>
+struct Describe<SphereDomain> {
+  static constexpr const char* name = "sphere";
+  static constexpr const char* doc = "A ball, or a shell between innerRadius and outerRadius.";
+  static constexpr auto fields = std::tuple{
+      field("center", &SphereDomain::center, "units", kAny, "its center"),
+      field("outerRadius", &SphereDomain::outerRadius, "units", kAny, "its radius", "the radius"),
+      field("innerRadius", &SphereDomain::innerRadius, "units", kAny, "a shell's inner radius"),
+  };
+  static Domain make(const SphereDomain& s) {
+    return Domain::sphere(s.center, s.outerRadius, s.innerRadius);
+  }
+};
+template <>
+struct Describe<CylinderDomain> {
+  static constexpr const char* name = "cylinder";
+  static constexpr const char* doc = "A solid or hollow cylinder from p0 to p1.";
+  static constexpr auto fields = std::tuple{
+      field("p0", &CylinderDomain::p0, "units", kAny, "one end's center", kRequired),
+      field("p1", &CylinderDomain::p1, "units", kAny, "the other end's center", kRequired),
+      field("outerRadius", &CylinderDomain::outerRadius, "units", kAny, "its radius", "the radius"),
+      field("innerRadius", &CylinderDomain::innerRadius, "units", kAny, "a tube's inner radius"),
+  };
+  static Domain make(const CylinderDomain& s) {
+    return Domain::cylinder(s.p0, s.p1, s.outerRadius, s.innerRadius);
+  }
+};
+template <>
+struct Describe<ConeDomain> {
+  static constexpr const char* name = "cone";
+  static constexpr const char* doc = "A solid or hollow cone from its apex to its base's center.";
+  static constexpr auto fields = std::tuple{
+      field("apex", &ConeDomain::apex, "units", kAny, "its apex"),
+      field("base", &ConeDomain::base, "units", kAny, "its base's center", kRequired),
+      field("outerRadius", &ConeDomain::outerRadius, "units", kAny, "the base's radius",
+            "the radius"),
+      field("innerRadius", &ConeDomain::innerRadius, "units", kAny, "a hollow cone's inner radius"),
+  };
+  static Domain make(const ConeDomain& s) {
+    return Domain::cone(s.apex, s.base, s.outerRadius, s.innerRadius);
+  }
+};
+template <>
+struct Describe<BlobDomain> {
+  static constexpr const char* name = "blob";
+  static constexpr const char* doc = "A gaussian blob.";
+  static constexpr auto fields = std::tuple{
+      field("center", &BlobDomain::center, "units", kAny, "its center"),
+      field("stddev", &BlobDomain::stddev, "units", kAny, "its standard deviation", kRequired),
+  };
+  static Domain make(const BlobDomain& s) { return Domain::blob(s.center, s.stddev); }
 };
 
 }  // namespace flurry::desc

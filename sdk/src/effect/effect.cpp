@@ -304,6 +304,18 @@ void Obj::req(const char* key, T& out, const char* what) {
   read(require(key, what), at(key), L_, out);
 }
 
+/// Reads a described struct's fields (desc::Describe<S>) into `out`, which holds its
+/// defaults: each field in descriptor order, required ones named when missing.
+template <class S>
+void readFields(Obj& o, S& out) {
+  desc::forEachField<S>([&](const auto& f) {
+    if (f.required)
+      o.req(f.name, out.*f.member, f.required);
+    else
+      o.opt(f.name, out.*f.member);
+  });
+}
+
 /// 3, [3, 0.5], {"center": 3, "spread": 0.5 | "percent": 10, "distribution": "normal"}.
 void read(const json& j, const std::string& path, const Loader& L, Fuzzy& out) {
   if (j.is_number()) {
@@ -364,72 +376,15 @@ Domain readDomain(const json& j, const std::string& path, const Loader& L);
 
 Domain readDomainObject(Obj& o, const std::string& type) {
   const Loader& L = o.loader();
-  Vec3 a(0.0f), b(0.0f), c(0.0f);
-  float outer = 0, inner = 0;
-  auto radii = [&] {
-    o.req("outerRadius", outer, "the radius");
-    o.opt("innerRadius", inner);
-  };
-  if (type == "point") {
-    o.opt("point", a);
-    return Domain::point(a);
-  }
-  if (type == "line") {
-    o.req("p0", a);
-    o.req("p1", b);
-    return Domain::line(a, b);
-  }
-  if (type == "triangle") {
-    o.req("p0", a);
-    o.req("p1", b);
-    o.req("p2", c);
-    return Domain::triangle(a, b, c);
-  }
-  if (type == "plane") {
-    o.opt("point", a);
-    o.req("normal", b);
-    return Domain::plane(a, b);
-  }
-  if (type == "rectangle") {
-    o.opt("origin", a);
-    o.req("u", b);
-    o.req("v", c);
-    return Domain::rectangle(a, b, c);
-  }
-  if (type == "disc") {
-    o.opt("center", a);
-    o.req("normal", b);
-    radii();
-    return Domain::disc(a, b, outer, inner);
-  }
-  if (type == "box") {
-    o.req("min", a);
-    o.req("max", b);
-    return Domain::box(a, b);
-  }
-  if (type == "sphere") {
-    o.opt("center", a);
-    radii();
-    return Domain::sphere(a, outer, inner);
-  }
-  if (type == "cylinder") {
-    o.req("p0", a);
-    o.req("p1", b);
-    radii();
-    return Domain::cylinder(a, b, outer, inner);
-  }
-  if (type == "cone") {
-    o.opt("apex", a);
-    o.req("base", b);
-    radii();
-    return Domain::cone(a, b, outer, inner);
-  }
-  if (type == "blob") {
-    o.opt("center", a);
-    float stddev = 0;
-    o.req("stddev", stddev);
-    return Domain::blob(a, stddev);
-  }
+  std::optional<Domain> described;
+  desc::forEachDomainKind([&](auto tag) {
+    using S = typename decltype(tag)::type;
+    if (described || type != desc::Describe<S>::name) return;
+    S s{};  // zeros: a shape's optional fields default to the origin, radius 0
+    readFields(o, s);
+    described = desc::Describe<S>::make(s);
+  });
+  if (described) return std::move(*described);
   if (type == "mesh") {
     const json& vs = o.require("vertices");
     const std::string vp = o.at("vertices");
@@ -504,18 +459,6 @@ void readArray(const json& j, const std::string& path, const Loader& L, std::vec
     each(j[i], index(path, i), t);
     out.push_back(std::move(t));
   }
-}
-
-/// Reads a described struct's fields (desc::Describe<S>) into `out`, which holds its
-/// defaults: each field in descriptor order, required ones named when missing.
-template <class S>
-void readFields(Obj& o, S& out) {
-  desc::forEachField<S>([&](const auto& f) {
-    if (f.required)
-      o.req(f.name, out.*f.member, f.required);
-    else
-      o.opt(f.name, out.*f.member);
-  });
 }
 
 template <desc::Described S>

@@ -3,8 +3,8 @@
 // (docs/effect-reference.md) and the fuzzer's dictionary (tests/fuzz/effect.dict). The tool
 // tests/effect/flurry_effect_docs prints them; tests fail when the committed files differ.
 //
-// Domains and the effect's and groups' own fields have no descriptors yet: they are listed
-// here, once, for the schema and the dictionary.
+// The effect's and groups' own fields, and the mesh and union domains, have no descriptors yet:
+// they are listed here, once, for the schema and the dictionary.
 #include <cctype>
 #include <set>
 
@@ -122,7 +122,7 @@ ojson objectSchema(const char* type) {
   return o;
 }
 
-// ---- domains: no descriptors yet (see the top of the file) -----------------------------------
+// ---- domains: a mesh and a union hold lists, listed here; the other shapes are described --
 
 struct DomainKind {
   const char* name;
@@ -131,28 +131,6 @@ struct DomainKind {
 };
 const std::vector<DomainKind>& domainKinds() {
   static const std::vector<DomainKind> kinds = {
-      {"point", {{"point", "vec3"}}, {}},
-      {"line", {{"p0", "vec3"}, {"p1", "vec3"}}, {"p0", "p1"}},
-      {"triangle", {{"p0", "vec3"}, {"p1", "vec3"}, {"p2", "vec3"}}, {"p0", "p1", "p2"}},
-      {"plane", {{"point", "vec3"}, {"normal", "direction"}}, {"normal"}},
-      {"rectangle", {{"origin", "vec3"}, {"u", "vec3"}, {"v", "vec3"}}, {"u", "v"}},
-      {"disc",
-       {{"center", "vec3"},
-        {"normal", "direction"},
-        {"outerRadius", "number"},
-        {"innerRadius", "number"}},
-       {"normal", "outerRadius"}},
-      {"box", {{"min", "vec3"}, {"max", "vec3"}}, {"min", "max"}},
-      {"sphere",
-       {{"center", "vec3"}, {"outerRadius", "number"}, {"innerRadius", "number"}},
-       {"outerRadius"}},
-      {"cylinder",
-       {{"p0", "vec3"}, {"p1", "vec3"}, {"outerRadius", "number"}, {"innerRadius", "number"}},
-       {"p0", "p1", "outerRadius"}},
-      {"cone",
-       {{"apex", "vec3"}, {"base", "vec3"}, {"outerRadius", "number"}, {"innerRadius", "number"}},
-       {"base", "outerRadius"}},
-      {"blob", {{"center", "vec3"}, {"stddev", "number"}}, {"stddev"}},
       {"mesh", {{"vertices", "vec3"}, {"triangles", "triangleIndices"}}, {"vertices", "triangles"}},
       {"union", {{"parts", "domain"}}, {"parts"}},
   };
@@ -161,11 +139,14 @@ const std::vector<DomainKind>& domainKinds() {
 
 ojson domainSchema() {
   ojson any = ojson::array({defRef("vec3")});
+  desc::forEachDomainKind([&](auto tag) {
+    using S = typename decltype(tag)::type;
+    any.push_back(objectSchema<S>(desc::Describe<S>::name));
+  });
   for (const DomainKind& k : domainKinds()) {
     ojson props = {{"type", {{"const", k.name}}}, {"$comment", {{"type", "string"}}}};
     for (const auto& [key, def] : k.fields) {
-      const bool list = std::string(k.name) == "mesh" || std::string(k.name) == "union";
-      props[key] = list ? ojson{{"type", "array"}, {"items", defRef(def)}} : defRef(def);
+      props[key] = {{"type", "array"}, {"items", defRef(def)}};
     }
     ojson required = {"type"};
     for (const char* r : k.required) required.push_back(r);
@@ -425,6 +406,12 @@ std::string effectReference() {
   out += "## Emitters\n\n";
   out += table<Emitter>("###") + table<ParticleType>("###") + table<Burst>("###") +
          table<Keyframe>("###") + table<PrimeEmitter>("###") + table<EmitterSpec>("###");
+  out +=
+      "## Domains\n\n"
+      "A domain is `[x, y, z]` (a point) or `{\"type\": \"kind\", ...fields}`; besides the "
+      "kinds below, `mesh` (`vertices` [[x, y, z], ...], `triangles` [[i, j, k], ...]) and "
+      "`union` (`parts`: domains) hold lists.\n\n";
+  desc::forEachDomainKind([&](auto tag) { out += table<typename decltype(tag)::type>("###"); });
   out.pop_back();  // one newline at the end
   return out;
 }
@@ -462,6 +449,11 @@ std::string fuzzDictionary() {
   described(Tag<SizeOverLife::Key>{}), described(Tag<Burst>{}), described(Tag<Keyframe>{});
   described(Tag<ParticleType>{}), described(Tag<Emitter>{}), described(Tag<EmitterSpec>{});
   described(Tag<PrimeEmitter>{});
+  desc::forEachDomainKind([&](auto tag) {
+    using S = typename decltype(tag)::type;
+    values.insert(desc::Describe<S>::name);
+    described(Tag<S>{});
+  });
   for (int i = 0; i < int(Attribute::Count); ++i)
     values.insert(std::string(attributeName(Attribute(i))));
   for (Integrator i : {Integrator::SemiImplicitEuler, Integrator::ExplicitEuler,

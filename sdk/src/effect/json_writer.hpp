@@ -67,40 +67,25 @@ inline ojson write(Writer w, const Fuzzy& f) {
   return {write(w, f.center), write(w, f.spread)};
 }
 
+template <class S>
+inline void writeFields(Writer w, ojson& o, const S& s);
+
+/// A point as [x, y, z]; a mesh and a union by hand (they hold lists); the rest by descriptor.
 inline ojson write(Writer w, const Domain& d) {
   const Domain::Shape& s = d.shape();
   if (const auto* p = std::get_if<PointDomain>(&s)) return write(w, p->p);
   ojson o = ojson::object();
   o["type"] = d.name();
-  auto radii = [&](float outer, float inner) {
-    o["outerRadius"] = write(w, outer);
-    if (inner != 0.0f) o["innerRadius"] = write(w, inner);
-  };
-  if (const auto* x = std::get_if<LineDomain>(&s)) {
-    o["p0"] = write(w, x->p0), o["p1"] = write(w, x->p1);
-  } else if (const auto* x = std::get_if<TriangleDomain>(&s)) {
-    o["p0"] = write(w, x->p0), o["p1"] = write(w, x->p1), o["p2"] = write(w, x->p2);
-  } else if (const auto* x = std::get_if<PlaneDomain>(&s)) {
-    o["point"] = write(w, x->point), o["normal"] = write(w, x->normal);
-  } else if (const auto* x = std::get_if<RectangleDomain>(&s)) {
-    o["origin"] = write(w, x->origin), o["u"] = write(w, x->u), o["v"] = write(w, x->v);
-  } else if (const auto* x = std::get_if<DiscDomain>(&s)) {
-    o["center"] = write(w, x->center), o["normal"] = write(w, x->normal);
-    radii(x->outerRadius, x->innerRadius);
-  } else if (const auto* x = std::get_if<BoxDomain>(&s)) {
-    o["min"] = write(w, x->min), o["max"] = write(w, x->max);
-  } else if (const auto* x = std::get_if<SphereDomain>(&s)) {
-    o["center"] = write(w, x->center);
-    radii(x->outerRadius, x->innerRadius);
-  } else if (const auto* x = std::get_if<CylinderDomain>(&s)) {
-    o["p0"] = write(w, x->p0), o["p1"] = write(w, x->p1);
-    radii(x->outerRadius, x->innerRadius);
-  } else if (const auto* x = std::get_if<ConeDomain>(&s)) {
-    o["apex"] = write(w, x->apex), o["base"] = write(w, x->base);
-    radii(x->outerRadius, x->innerRadius);
-  } else if (const auto* x = std::get_if<BlobDomain>(&s)) {
-    o["center"] = write(w, x->center), o["stddev"] = write(w, x->stddev);
-  } else if (const auto* x = std::get_if<MeshDomain>(&s)) {
+  if (std::visit(
+          [&](const auto& x) {
+            using S = std::decay_t<decltype(x)>;
+            if constexpr (desc::Described<S>) writeFields(w, o, x);
+            return desc::Described<S>;
+          },
+          s)) {
+    return o;
+  }
+  if (const auto* x = std::get_if<MeshDomain>(&s)) {
     ojson vs = ojson::array(), ts = ojson::array();
     for (const Vec3& v : x->mesh->vertices) vs.push_back(write(w, v));
     for (const glm::uvec3& t : x->mesh->triangles) ts.push_back({t.x, t.y, t.z});
