@@ -336,7 +336,7 @@ std::string typeText(Tag<Fuzzy>) {
   return "fuzzy";
 }
 std::string typeText(Tag<Domain>) {
-  return "domain";
+  return "[domain](#domains)";
 }
 std::string typeText(Tag<std::shared_ptr<const VectorField>>) {
   return "sampled field";
