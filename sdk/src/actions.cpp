@@ -3,29 +3,20 @@
 
 #include "flurry/actions.hpp"
 #include "action_traits.hpp"
+#include "effect/descriptors.hpp"
 #include "flurry/error.hpp"
 
 namespace flurry {
 
 namespace {
 
+/// The descriptor's name (effect/descriptors.hpp); Callback has none (no effect file holds it).
 template <class T>
 constexpr const char* nameOf() {
-#define FLURRY_NAME(X) \
-  if constexpr (std::is_same_v<T, X>) return #X;
-  FLURRY_NAME(Gravity) FLURRY_NAME(Damping) FLURRY_NAME(RotDamping) FLURRY_NAME(OrbitPoint)
-  FLURRY_NAME(OrbitLine) FLURRY_NAME(Gravitate) FLURRY_NAME(Vortex) FLURRY_NAME(Jet)
-  FLURRY_NAME(Explosion) FLURRY_NAME(RandomAccel) FLURRY_NAME(RandomDisplace)
-  FLURRY_NAME(RandomVelocity) FLURRY_NAME(RandomRotVelocity) FLURRY_NAME(Turbulence)
-  FLURRY_NAME(ElectricField) FLURRY_NAME(MagneticField) FLURRY_NAME(SampledField)
-  FLURRY_NAME(Avoid) FLURRY_NAME(Follow) FLURRY_NAME(MatchVelocity) FLURRY_NAME(MatchRotVelocity)
-  FLURRY_NAME(TargetVelocity) FLURRY_NAME(TargetRotVelocity) FLURRY_NAME(TargetColor)
-  FLURRY_NAME(TargetSize) FLURRY_NAME(SpeedClamp) FLURRY_NAME(ColorOverLife)
-  FLURRY_NAME(SizeOverLife) FLURRY_NAME(Bounce) FLURRY_NAME(Sink) FLURRY_NAME(SinkVelocity)
-  FLURRY_NAME(Block) FLURRY_NAME(KillOld) FLURRY_NAME(Move) FLURRY_NAME(Constrain2D)
-  FLURRY_NAME(CopyVertexB) FLURRY_NAME(Restore) FLURRY_NAME(Callback)
-#undef FLURRY_NAME
-  return "Action";
+  if constexpr (desc::Described<T>)
+    return desc::Describe<T>::name;
+  else
+    return "Callback";
 }
 
 bool finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }

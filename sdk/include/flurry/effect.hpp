@@ -121,6 +121,13 @@ Effect parseEffect(std::string_view json, const std::string& fileName = "<effect
 /// empty JSON path).
 Effect loadEffect(const std::filesystem::path& file, EffectLoadOptions options = {});
 
+/// Writes `effect` as effect-file JSON that parseEffect reads back to the same effect: every
+/// group, emitter, action (a `mode2d` group's Constrain2D as the action it became), sampled
+/// field (inline, even one read from a VDB file) and the render object; fields at their
+/// defaults are left out. Throws InvalidArgument naming the JSON path of what a file cannot
+/// hold (a Callback action).
+std::string saveEffect(const Effect& effect);
+
 /// The names effect files use for attributes ("color", "size", ...): attributeName(a).
 /// Returns false if `name` is not one.
 bool attributeFromName(std::string_view name, Attribute& out);

@@ -3,10 +3,13 @@
 // errors with a suggestion: a typo must not silently become a default.
 #include "flurry/effect.hpp"
 
+#include "effect/descriptors.hpp"
 #include "effect/effect_parts.hpp"
+#include "effect/json_writer.hpp"
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -301,6 +304,18 @@ void Obj::req(const char* key, T& out, const char* what) {
   read(require(key, what), at(key), L_, out);
 }
 
+/// Reads a described struct's fields (desc::Describe<S>) into `out`, which holds its
+/// defaults: each field in descriptor order, required ones named when missing.
+template <class S>
+void readFields(Obj& o, S& out) {
+  desc::forEachField<S>([&](const auto& f) {
+    if (f.required)
+      o.req(f.name, out.*f.member, f.required);
+    else
+      o.opt(f.name, out.*f.member);
+  });
+}
+
 /// 3, [3, 0.5], {"center": 3, "spread": 0.5 | "percent": 10, "distribution": "normal"}.
 void read(const json& j, const std::string& path, const Loader& L, Fuzzy& out) {
   if (j.is_number()) {
@@ -361,72 +376,15 @@ Domain readDomain(const json& j, const std::string& path, const Loader& L);
 
 Domain readDomainObject(Obj& o, const std::string& type) {
   const Loader& L = o.loader();
-  Vec3 a(0.0f), b(0.0f), c(0.0f);
-  float outer = 0, inner = 0;
-  auto radii = [&] {
-    o.req("outerRadius", outer, "the radius");
-    o.opt("innerRadius", inner);
-  };
-  if (type == "point") {
-    o.opt("point", a);
-    return Domain::point(a);
-  }
-  if (type == "line") {
-    o.req("p0", a);
-    o.req("p1", b);
-    return Domain::line(a, b);
-  }
-  if (type == "triangle") {
-    o.req("p0", a);
-    o.req("p1", b);
-    o.req("p2", c);
-    return Domain::triangle(a, b, c);
-  }
-  if (type == "plane") {
-    o.opt("point", a);
-    o.req("normal", b);
-    return Domain::plane(a, b);
-  }
-  if (type == "rectangle") {
-    o.opt("origin", a);
-    o.req("u", b);
-    o.req("v", c);
-    return Domain::rectangle(a, b, c);
-  }
-  if (type == "disc") {
-    o.opt("center", a);
-    o.req("normal", b);
-    radii();
-    return Domain::disc(a, b, outer, inner);
-  }
-  if (type == "box") {
-    o.req("min", a);
-    o.req("max", b);
-    return Domain::box(a, b);
-  }
-  if (type == "sphere") {
-    o.opt("center", a);
-    radii();
-    return Domain::sphere(a, outer, inner);
-  }
-  if (type == "cylinder") {
-    o.req("p0", a);
-    o.req("p1", b);
-    radii();
-    return Domain::cylinder(a, b, outer, inner);
-  }
-  if (type == "cone") {
-    o.opt("apex", a);
-    o.req("base", b);
-    radii();
-    return Domain::cone(a, b, outer, inner);
-  }
-  if (type == "blob") {
-    o.opt("center", a);
-    float stddev = 0;
-    o.req("stddev", stddev);
-    return Domain::blob(a, stddev);
-  }
+  std::optional<Domain> described;
+  desc::forEachDomainKind([&](auto tag) {
+    using S = typename decltype(tag)::type;
+    if (described || type != desc::Describe<S>::name) return;
+    S s{};  // zeros: a shape's optional fields default to the origin, radius 0
+    readFields(o, s);
+    described = desc::Describe<S>::make(s);
+  });
+  if (described) return std::move(*described);
   if (type == "mesh") {
     const json& vs = o.require("vertices");
     const std::string vp = o.at("vertices");
@@ -491,14 +449,6 @@ Domain readDomain(const json& j, const std::string& path, const Loader& L) {
   return d;
 }
 
-void read(const json& j, const std::string& path, const Loader& L, Falloff& out) {
-  Obj o(j, path, L);
-  o.opt("center", out.center);
-  o.opt("radius", out.radius);
-  o.opt("power", out.power);
-  o.finish();
-}
-
 template <class T, class F>
 void readArray(const json& j, const std::string& path, const Loader& L, std::vector<T>& out,
                F&& each) {
@@ -511,39 +461,16 @@ void readArray(const json& j, const std::string& path, const Loader& L, std::vec
   }
 }
 
-void read(const json& j, const std::string& path, const Loader& L, std::vector<Burst>& out) {
-  readArray(j, path, L, out, [&](const json& e, const std::string& p, Burst& b) {
-    Obj o(e, p, L);
-    o.opt("time", b.time);
-    o.req("count", b.count);
-    o.opt("interval", b.interval);
-    o.opt("repeat", b.repeat);
-    o.finish();
-  });
-}
-
-void read(const json& j, const std::string& path, const Loader& L, std::vector<Keyframe>& out) {
-  readArray(j, path, L, out, [&](const json& e, const std::string& p, Keyframe& k) {
-    Obj o(e, p, L);
-    o.req("time", k.time);
-    o.req("position", k.position);
-    o.finish();
-  });
-}
-
-void read(const json& j, const std::string& path, const Loader& L, ParticleType& t) {
+template <desc::Described S>
+void read(const json& j, const std::string& path, const Loader& L, S& out) {
   Obj o(j, path, L);
-  o.opt("weight", t.weight);
-  o.opt("velocity", t.velocity);
-  o.opt("color", t.color);
-  o.opt("alpha", t.alpha);
-  o.opt("size", t.size);
-  o.opt("mass", t.mass);
-  o.opt("lifetime", t.lifetime);
-  o.opt("charge", t.charge);
-  o.opt("up", t.up);
-  o.opt("rotVelocity", t.rotVelocity);
+  readFields(o, out);
   o.finish();
+}
+
+template <desc::Described T>
+void read(const json& j, const std::string& path, const Loader& L, std::vector<T>& out) {
+  readArray(j, path, L, out, [&](const json& e, const std::string& p, T& t) { read(e, p, L, t); });
 }
 
 void read(const json& j, const std::string& path, const Loader& L, std::vector<ParticleType>& out) {
@@ -552,33 +479,26 @@ void read(const json& j, const std::string& path, const Loader& L, std::vector<P
   if (out.empty()) L.fail(path, "an emitter needs at least one particle type");
 }
 
-/// The fields an emitter and a prime emitter share: where, when and how many.
-template <class E>
-void readCounting(Obj& o, E& e) {
-  o.opt("name", e.name);
-  o.opt("shape", e.shape);
-  o.opt("rate", e.rate);
-  o.opt("bursts", e.bursts);
-  o.opt("position", e.position);
-  o.opt("velocity", e.velocity);
-  o.opt("path", e.path);
-  o.opt("start", e.start);
-  o.opt("stop", e.stop);
-}
-
-Emitter readEmitterFields(const json& j, const std::string& path, const Loader& L) {
-  Obj o(j, path, L);
-  Emitter e;
-  readCounting(o, e);
-  o.opt("types", e.types);
-  o.opt("spacing", e.spacing);
-  o.opt("normalSpeed", e.normalSpeed);
-  o.finish();
-  return e;
+template <desc::NamedEnum E>
+void read(const json& j, const std::string& path, const Loader& L, E& out) {
+  std::string s;
+  read(j, path, L, s);
+  std::vector<std::string> all;
+  std::string list;
+  for (const auto& [n, val] : desc::EnumNames<E>::values) {
+    if (n == s) {
+      out = val;
+      return;
+    }
+    all.emplace_back(n);
+    list += (list.empty() ? "" : ", ") + std::string(n);
+  }
+  L.fail(path, "\"" + s + "\" is not one of " + list + suggestion(s, all));
 }
 
 Emitter readEmitter(const json& j, const std::string& path, const Loader& L) {
-  Emitter e = readEmitterFields(j, path, L);
+  Emitter e;
+  read(j, path, L, e);
   try {
     e.validate(path);
   } catch (const InvalidArgument& x) {
@@ -587,30 +507,23 @@ Emitter readEmitter(const json& j, const std::string& path, const Loader& L) {
   return e;
 }
 
-std::shared_ptr<EmitterSpec> readSpec(const json& j, const std::string& path, const Loader& L) {
+/// A prime emitter's levels nest: bounded like domains.
+void read(const json& j, const std::string& path, const Loader& L, EmitterSpec& out) {
   DepthGuard guard(L, path);
   Obj o(j, path, L);
-  auto s = std::make_shared<EmitterSpec>();
-  if (const json* e = o.get("emitter")) s->emitter = readEmitterFields(*e, o.at("emitter"), L);
-  o.opt("velocity", s->velocity);
-  o.opt("inheritVelocity", s->inheritVelocity);
-  o.opt("lifetime", s->lifetime);
-  o.opt("acceleration", s->acceleration);
-  o.opt("drag", s->drag);
-  o.opt("deathBurst", s->deathBurst);
-  o.opt("deathChildren", s->deathChildren);
-  if (const json* n = o.get("next")) s->next = readSpec(*n, o.at("next"), L);
+  readFields(o, out);
   o.finish();
-  return s;
+}
+void read(const json& j, const std::string& path, const Loader& L,
+          std::shared_ptr<const EmitterSpec>& out) {
+  auto s = std::make_shared<EmitterSpec>();
+  read(j, path, L, *s);
+  out = std::move(s);
 }
 
 PrimeEmitter readPrime(const json& j, const std::string& path, const Loader& L) {
-  Obj o(j, path, L);
   PrimeEmitter p;
-  readCounting(o, p);
-  p.child = *readSpec(o.require("child", "the emitters it emits"), o.at("child"), L);
-  o.opt("maxEmitters", p.maxEmitters);
-  o.finish();
+  read(j, path, L, p);
   try {
     p.validate(path);
   } catch (const InvalidArgument& x) {
@@ -621,43 +534,13 @@ PrimeEmitter readPrime(const json& j, const std::string& path, const Loader& L) 
 
 // ---- actions --------------------------------------------------------------------------------
 
-const std::vector<std::string> kActionTypes = {"Gravity",
-                                               "Damping",
-                                               "RotDamping",
-                                               "OrbitPoint",
-                                               "OrbitLine",
-                                               "Gravitate",
-                                               "Vortex",
-                                               "Jet",
-                                               "Explosion",
-                                               "RandomAccel",
-                                               "RandomDisplace",
-                                               "RandomVelocity",
-                                               "RandomRotVelocity",
-                                               "Turbulence",
-                                               "ElectricField",
-                                               "MagneticField",
-                                               "SampledField",
-                                               "Avoid",
-                                               "Follow",
-                                               "MatchVelocity",
-                                               "MatchRotVelocity",
-                                               "TargetVelocity",
-                                               "TargetRotVelocity",
-                                               "TargetColor",
-                                               "TargetSize",
-                                               "SpeedClamp",
-                                               "ColorOverLife",
-                                               "SizeOverLife",
-                                               "Bounce",
-                                               "Sink",
-                                               "SinkVelocity",
-                                               "Block",
-                                               "KillOld",
-                                               "Move",
-                                               "Constrain2D",
-                                               "CopyVertexB",
-                                               "Restore"};
+/// The actions an effect file can hold, by name (all but Callback).
+const std::vector<std::string> kActionTypes = [] {
+  std::vector<std::string> names;
+  desc::forEachAction(
+      [&](auto a) { names.emplace_back(desc::Describe<typename decltype(a)::type>::name); });
+  return names;
+}();
 
 std::shared_ptr<const VectorField> readField(const json& j, const std::string& path,
                                              const Loader& L) {
@@ -715,284 +598,22 @@ std::shared_ptr<const VectorField> readField(const json& j, const std::string& p
   return f;
 }
 
-template <class T>
-void readEnum(Obj& o, const char* key, T& out,
-              const std::vector<std::pair<std::string, T>>& names) {
-  std::string s;
-  if (const json* v = o.get(key))
-    read(*v, o.at(key), o.loader(), s);
-  else
-    return;
-  for (const auto& [n, val] : names)
-    if (n == s) {
-      out = val;
-      return;
-    }
-  std::vector<std::string> all;
-  std::string list;
-  for (const auto& [n, val] : names) {
-    all.push_back(n);
-    list += (list.empty() ? "" : ", ") + n;
-  }
-  o.loader().fail(o.at(key), "\"" + s + "\" is not one of " + list + suggestion(s, all));
+void read(const json& j, const std::string& path, const Loader& L,
+          std::shared_ptr<const VectorField>& out) {
+  out = readField(j, path, L);
 }
 
+/// The action named `type` (a known name), its fields read from `o` by its descriptor.
 Action readActionBody(Obj& o, const std::string& type) {
-  const Loader& L = o.loader();
-  auto falloff = [&](Falloff& f) { o.opt("falloff", f); };
-  if (type == "Gravity") {
-    Gravity a;
-    o.opt("acceleration", a.acceleration);
-    falloff(a.falloff);
-    return a;
-  }
-  if (type == "Damping") {
-    Damping a;
-    o.opt("rate", a.rate);
-    falloff(a.falloff);
-    return a;
-  }
-  if (type == "RotDamping") {
-    RotDamping a;
-    o.opt("rate", a.rate);
-    return a;
-  }
-  if (type == "OrbitPoint") {
-    OrbitPoint a;
-    o.opt("center", a.center);
-    o.opt("magnitude", a.magnitude);
-    o.opt("epsilon", a.epsilon);
-    o.opt("maxRadius", a.maxRadius);
-    return a;
-  }
-  if (type == "OrbitLine") {
-    OrbitLine a;
-    o.opt("point", a.point);
-    o.opt("axis", a.axis);
-    o.opt("magnitude", a.magnitude);
-    o.opt("epsilon", a.epsilon);
-    o.opt("maxRadius", a.maxRadius);
-    return a;
-  }
-  if (type == "Gravitate" || type == "Follow") {
-    float magnitude = 1.0f, epsilon = 1e-3f, maxRadius = kInfinity;
-    o.opt("magnitude", magnitude);
-    o.opt("epsilon", epsilon);
-    o.opt("maxRadius", maxRadius);
-    if (type == "Follow") return Follow{magnitude, epsilon, maxRadius};
-    return Gravitate{magnitude, epsilon, maxRadius};
-  }
-  if (type == "Vortex") {
-    Vortex a;
-    o.opt("center", a.center);
-    o.opt("axis", a.axis);
-    o.opt("aroundSpeed", a.aroundSpeed);
-    o.opt("coreRadius", a.coreRadius);
-    o.opt("tightness", a.tightness);
-    o.opt("inSpeed", a.inSpeed);
-    o.opt("upSpeed", a.upSpeed);
-    o.opt("responsiveness", a.responsiveness);
-    o.opt("maxRadius", a.maxRadius);
-    return a;
-  }
-  if (type == "Jet") {
-    Jet a;
-    o.opt("center", a.center);
-    o.opt("radius", a.radius);
-    o.opt("acceleration", a.acceleration);
-    return a;
-  }
-  if (type == "Explosion") {
-    Explosion a;
-    o.opt("center", a.center);
-    o.opt("speed", a.speed);
-    o.opt("magnitude", a.magnitude);
-    o.opt("stddev", a.stddev);
-    o.opt("epsilon", a.epsilon);
-    o.opt("time", a.time);
-    return a;
-  }
-  if (type == "RandomAccel") {
-    RandomAccel a;
-    o.opt("acceleration", a.acceleration);
-    falloff(a.falloff);
-    return a;
-  }
-  if (type == "RandomDisplace") {
-    RandomDisplace a;
-    o.opt("displacement", a.displacement);
-    return a;
-  }
-  if (type == "RandomVelocity") {
-    RandomVelocity a;
-    o.opt("velocity", a.velocity);
-    return a;
-  }
-  if (type == "RandomRotVelocity") {
-    RandomRotVelocity a;
-    o.opt("rotVelocity", a.rotVelocity);
-    return a;
-  }
-  if (type == "Turbulence") {
-    Turbulence a;
-    o.opt("amplitude", a.amplitude);
-    o.opt("frequency", a.frequency);
-    o.opt("octaves", a.octaves);
-    o.opt("drift", a.drift);
-    falloff(a.falloff);
-    return a;
-  }
-  if (type == "ElectricField") {
-    ElectricField a;
-    o.opt("field", a.field);
-    falloff(a.falloff);
-    return a;
-  }
-  if (type == "MagneticField") {
-    MagneticField a;
-    o.opt("field", a.field);
-    falloff(a.falloff);
-    return a;
-  }
-  if (type == "SampledField") {
-    SampledField a;
-    a.field = readField(o.require("field", "a dense grid or {\"vdb\": file}"), o.at("field"), L);
-    readEnum(o, "mode", a.mode,
-             {{"acceleration", SampledField::Mode::Acceleration},
-              {"velocity", SampledField::Mode::Velocity}});
-    o.opt("strength", a.strength);
-    o.opt("responsiveness", a.responsiveness);
-    falloff(a.falloff);
-    return a;
-  }
-  if (type == "Avoid") {
-    Avoid a;
-    o.opt("obstacle", a.obstacle);
-    o.opt("magnitude", a.magnitude);
-    o.opt("epsilon", a.epsilon);
-    o.opt("lookAhead", a.lookAhead);
-    return a;
-  }
-  if (type == "MatchVelocity" || type == "MatchRotVelocity") {
-    float magnitude = 1.0f, epsilon = 1e-3f, maxRadius = 1.0f;
-    o.opt("magnitude", magnitude);
-    o.opt("epsilon", epsilon);
-    o.opt("maxRadius", maxRadius);
-    if (type == "MatchVelocity") return MatchVelocity{magnitude, epsilon, maxRadius};
-    return MatchRotVelocity{magnitude, epsilon, maxRadius};
-  }
-  if (type == "TargetVelocity") {
-    TargetVelocity a;
-    o.opt("velocity", a.velocity);
-    o.opt("rate", a.rate);
-    return a;
-  }
-  if (type == "TargetRotVelocity") {
-    TargetRotVelocity a;
-    o.opt("rotVelocity", a.rotVelocity);
-    o.opt("rate", a.rate);
-    return a;
-  }
-  if (type == "TargetColor") {
-    TargetColor a;
-    o.opt("color", a.color);
-    o.opt("alpha", a.alpha);
-    o.opt("rate", a.rate);
-    return a;
-  }
-  if (type == "TargetSize") {
-    TargetSize a;
-    o.opt("size", a.size);
-    o.opt("rate", a.rate);
-    return a;
-  }
-  if (type == "SpeedClamp") {
-    SpeedClamp a;
-    o.opt("minSpeed", a.minSpeed);
-    o.opt("maxSpeed", a.maxSpeed);
-    return a;
-  }
-  if (type == "ColorOverLife") {
-    ColorOverLife a;
-    readEnum(o, "mode", a.mode,
-             {{"multiply", OverLifeMode::Multiply}, {"replace", OverLifeMode::Replace}});
-    if (const json* k = o.get("keys"))
-      readArray(*k, o.at("keys"), L, a.keys,
-                [&](const json& e, const std::string& p, ColorOverLife::Key& key) {
-                  Obj ko(e, p, L);
-                  ko.req("t", key.t);
-                  ko.req("color", key.color);
-                  ko.finish();
-                });
-    return a;
-  }
-  if (type == "SizeOverLife") {
-    SizeOverLife a;
-    readEnum(o, "mode", a.mode,
-             {{"multiply", OverLifeMode::Multiply}, {"replace", OverLifeMode::Replace}});
-    if (const json* k = o.get("keys"))
-      readArray(*k, o.at("keys"), L, a.keys,
-                [&](const json& e, const std::string& p, SizeOverLife::Key& key) {
-                  Obj ko(e, p, L);
-                  ko.req("t", key.t);
-                  ko.req("size", key.size);
-                  ko.finish();
-                });
-    return a;
-  }
-  if (type == "Bounce") {
-    Bounce a;
-    o.req("surface", a.surface, "the deflecting surface, a domain");
-    o.opt("restitution", a.restitution);
-    o.opt("friction", a.friction);
-    o.opt("cutoff", a.cutoff);
-    o.opt("inside", a.inside);
-    o.opt("planeNormal", a.planeNormal);
-    return a;
-  }
-  if (type == "Sink") {
-    Sink a;
-    o.req("region", a.region, "the absorbing region or surface, a domain");
-    o.opt("killInside", a.killInside);
-    o.opt("passThrough", a.passThrough);
-    readEnum(o, "mode", a.mode,
-             {{"inside", Sink::Mode::Inside},
-              {"outside", Sink::Mode::Outside},
-              {"enter", Sink::Mode::Enter},
-              {"leave", Sink::Mode::Leave},
-              {"hit", Sink::Mode::Hit}});
-    return a;
-  }
-  if (type == "SinkVelocity") {
-    SinkVelocity a;
-    o.opt("velocity", a.velocity);
-    o.opt("killInside", a.killInside);
-    return a;
-  }
-  if (type == "Block") {
-    Block a;
-    o.req("region", a.region, "the region that hides particles, a domain");
-    return a;
-  }
-  if (type == "KillOld") return KillOld{};
-  if (type == "Move") return Move{};
-  if (type == "Constrain2D") {
-    Constrain2D a;
-    o.opt("point", a.point);
-    o.opt("normal", a.normal);
-    return a;
-  }
-  if (type == "CopyVertexB") {
-    CopyVertexB a;
-    o.opt("copyPosition", a.copyPosition);
-    o.opt("copyVelocity", a.copyVelocity);
-    return a;
-  }
-  // Restore
-  Restore a;
-  o.opt("start", a.start);
-  o.opt("duration", a.duration);
-  return a;
+  std::optional<Action> out;
+  desc::forEachAction([&](auto tag) {
+    using A = typename decltype(tag)::type;
+    if (out || type != desc::Describe<A>::name) return;
+    A a;
+    readFields(o, a);
+    out = std::move(a);
+  });
+  return std::move(*out);
 }
 
 /// Fails at `typePath` unless `type` names an action an effect file can hold.
@@ -1481,6 +1102,97 @@ Emitter parseEffectEmitter(std::string_view emitter, const std::string& fileName
 }
 
 }  // namespace detail
+
+// ---- the writer -----------------------------------------------------------------------------
+
+namespace {
+
+using jsonio::ojson;
+using jsonio::write;
+using jsonio::writeFields;
+using jsonio::Writer;
+
+ojson writeAction(Writer w, const Action& a, const std::string& path) {
+  return std::visit(
+      [&](const auto& x) -> ojson {
+        using A = std::decay_t<decltype(x)>;
+        if constexpr (desc::Described<A>) {
+          ojson o = ojson::object();
+          o["type"] = desc::Describe<A>::name;
+          writeFields(w, o, x);
+          return o;
+        } else {
+          throw InvalidArgument(path, std::string("a ") + actionName(a) +
+                                          " runs C++ code and cannot be saved in an effect file");
+        }
+      },
+      a);
+}
+
+ojson writeGroup(Writer w, const EffectGroup& g, const std::string& path) {
+  ojson o = ojson::object();
+  o["name"] = g.name;
+  o["capacity"] = std::uint64_t(g.capacity);
+  if (!g.emitters.empty()) o["emitters"] = write(w, g.emitters);
+  if (!g.primeEmitters.empty()) o["primeEmitters"] = write(w, g.primeEmitters);
+  ojson actions = ojson::array();
+  for (std::size_t i = 0; i < g.actions.size(); ++i)
+    actions.push_back(writeAction(w, g.actions.actions()[i], index(join(path, "actions"), i)));
+  o["actions"] = std::move(actions);
+  if (g.actions.integrator() != Integrator::SemiImplicitEuler)
+    o["integrator"] = integratorName(g.actions.integrator());
+  const Substeps& sub = g.actions.substeps();
+  const Substeps subDefault;
+  if (sub.maxStep != subDefault.maxStep || sub.maxDistance != subDefault.maxDistance ||
+      sub.maxSubsteps != subDefault.maxSubsteps) {
+    ojson so = ojson::object();
+    so["maxStep"] = write(w, sub.maxStep);
+    so["maxDistance"] = write(w, sub.maxDistance);
+    so["maxSubsteps"] = sub.maxSubsteps;
+    o["substeps"] = std::move(so);
+  }
+  const HairOptions hairDefault;
+  if (g.hair.enabled) {
+    ojson ho = ojson::object();
+    if (g.hair.every != hairDefault.every) ho["every"] = g.hair.every;
+    if (g.hair.maxVertices != hairDefault.maxVertices) ho["maxVertices"] = g.hair.maxVertices;
+    o["hair"] = ho.empty() ? ojson(true) : std::move(ho);
+  }
+  if (g.require.bits() != 0) {
+    ojson r = ojson::array();
+    for (int i = 0; i < int(Attribute::Count); ++i)
+      if (g.require.has(Attribute(i))) r.push_back(std::string(attributeName(Attribute(i))));
+    o["require"] = std::move(r);
+  }
+  return o;
+}
+
+}  // namespace
+
+std::string saveEffect(const Effect& fx) {
+  const Writer w;
+  ojson o = ojson::object();
+  o["version"] = 1;
+  o["name"] = fx.name;
+  if (!fx.description.empty()) o["description"] = fx.description;
+  o["dt"] = write(w, fx.dt);
+  o["seed"] = fx.seed;
+  o["frames"] = fx.frames;
+  ojson groups = ojson::array();
+  for (std::size_t i = 0; i < fx.groups.size(); ++i)
+    groups.push_back(writeGroup(w, fx.groups[i], index("groups", i)));
+  o["groups"] = std::move(groups);
+  if (!fx.render.empty() && fx.render != "{}") {
+    try {
+      o["render"] = ojson::parse(fx.render);
+    } catch (const ojson::exception& e) {
+      throw InvalidArgument("render", std::string("not JSON: ") + e.what());
+    }
+  }
+  std::string out;
+  jsonio::print(o, out, 0);
+  return out + "\n";
+}
 
 namespace {
 std::string byteCount(std::size_t n) {
