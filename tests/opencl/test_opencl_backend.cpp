@@ -117,23 +117,41 @@ TEST(OpenCLBackend, ProgramsAreCachedOnDisk) {
   EXPECT_EQ(after.diskHits, before.diskHits + 1);
 }
 
+// A group the host fills (the list of the host read/write tests: one program for them all),
+// on backend b; `add(n, vz, life)` adds n particles along x, particle i with velocity
+// (0, 1, vz·i) and lifetime life·(i % 7 or i).
+struct HostGroup {
+  Context ctx;
+  Group& g;
+  explicit HostGroup(Backend b)
+      : ctx([b] {
+          ContextOptions o = openclOptions();
+          o.backend = b;
+          return o;
+        }()),
+        g(ctx.createGroup("g", 1000)) {
+    g.setActions({Gravity{Vec3(0.0f, -1.0f, 0.0f)}, Move{}, KillOld{}});
+  }
+  void add(int n, float vz, float life, bool cycle = false) {
+    for (int i = 0; i < n; ++i) {
+      Particle p;
+      p.position = Vec3(float(i), 0.0f, 0.0f);
+      p.velocity = Vec3(0.0f, 1.0f, vz * float(i));
+      p.lifetime = life * float(cycle ? i % 7 : i);
+      g.add(p);
+    }
+  }
+};
+
 // Particles added and edited by the host between steps reach the device, and the device's
 // particles come back when the host reads them.
 TEST(OpenCLBackend, HostReadsAndWritesBetweenSteps) {
   FLURRY_REQUIRE_OPENCL();
   auto run = [](Backend b) {
-    ContextOptions o = openclOptions();
-    o.backend = b;
-    Context ctx(o);
-    Group& g = ctx.createGroup("g", 1000);
-    g.setActions({Gravity{Vec3(0.0f, -1.0f, 0.0f)}, Move{}, KillOld{}});
-    for (int i = 0; i < 100; ++i) {
-      Particle p;
-      p.position = Vec3(float(i), 0.0f, 0.0f);
-      p.velocity = Vec3(0.0f, 1.0f, 0.0f);
-      p.lifetime = 0.05f * float(i);
-      g.add(p);
-    }
+    HostGroup h(b);
+    Context& ctx = h.ctx;
+    Group& g = h.g;
+    h.add(100, 0.0f, 0.05f);
     ctx.run(10);
     EXPECT_LT(g.size(), 100u);                // some died of age
     auto y = g.lane(Attribute::Position, 1);  // writable: the device must take it
@@ -307,18 +325,10 @@ TEST(OpenCLBackend, TheActBodyIsInTheProgramOnce) {
 TEST(OpenCLBackend, ReadsBackOnlyWhatIsAsked) {
   FLURRY_REQUIRE_OPENCL();
   auto run = [](Backend b) {
-    ContextOptions o = openclOptions();
-    o.backend = b;
-    Context ctx(o);
-    Group& g = ctx.createGroup("g", 1000);
-    g.setActions({Gravity{Vec3(0.0f, -1.0f, 0.0f)}, Move{}, KillOld{}});
-    for (int i = 0; i < 300; ++i) {
-      Particle p;
-      p.position = Vec3(float(i), 0.0f, 0.0f);
-      p.velocity = Vec3(0.0f, 1.0f, 0.01f * float(i));
-      p.lifetime = 0.01f * float(i);
-      g.add(p);
-    }
+    HostGroup h(b);
+    Context& ctx = h.ctx;
+    Group& g = h.g;
+    h.add(300, 0.01f, 0.01f);
     const Group& reader = g;
     std::vector<float> seen;
     const std::uint64_t lane = 4;  // bytes per particle per component
@@ -376,19 +386,10 @@ TEST(OpenCLBackend, ReadsBackOnlyWhatIsAsked) {
 TEST(OpenCLBackend, IdleGroupsCostNoLaunch) {
   FLURRY_REQUIRE_OPENCL();
   auto run = [](Backend b) {
-    ContextOptions o = openclOptions();
-    o.backend = b;
-    Context ctx(o);
-    Group& g = ctx.createGroup("g", 1000);
-    g.setActions({Gravity{Vec3(0.0f, -1.0f, 0.0f)}, Move{}, KillOld{}});
-    auto addSome = [&](int n) {
-      for (int i = 0; i < n; ++i) {
-        Particle p;
-        p.position = Vec3(float(i), 0.0f, 0.0f);
-        p.lifetime = 0.02f * float(i % 7);
-        g.add(p);
-      }
-    };
+    HostGroup h(b);
+    Context& ctx = h.ctx;
+    Group& g = h.g;
+    auto addSome = [&](int n) { h.add(n, 0.0f, 0.02f, true); };
     addSome(100);
     ctx.run(30);
     EXPECT_EQ(g.size(), 0u);
