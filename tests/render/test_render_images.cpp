@@ -73,19 +73,6 @@ struct EnvGuard {
   }
 };
 
-// Mesa's DRI driver is dlclose()d when GLFW closes its display; what it keeps in globals
-// then looks to LeakSanitizer like leaks from an unknown module (112 bytes a context), which
-// no suppression can name. Kept loaded, its globals stay visible and nothing is reported.
-class KeepDriverLoaded : public ::testing::Environment {
- public:
-  void SetUp() override {
-#ifdef FLURRY_TEST_DRI_DRIVER
-    dlopen(FLURRY_TEST_DRI_DRIVER, RTLD_NOW | RTLD_NODELETE);
-#endif
-  }
-};
-const auto* const kKeepDriver = ::testing::AddGlobalTestEnvironment(new KeepDriverLoaded);
-
 }  // namespace
 
 // One sphere-like particle under one directional light. Its color has no blue, so the blue

@@ -24,17 +24,6 @@ using namespace flurry;
 
 namespace {
 
-// See test_render_images.cpp: keeps Mesa's driver loaded so LeakSanitizer can read it.
-class KeepDriverLoaded : public ::testing::Environment {
- public:
-  void SetUp() override {
-#ifdef FLURRY_TEST_DRI_DRIVER
-    dlopen(FLURRY_TEST_DRI_DRIVER, RTLD_NOW | RTLD_NODELETE);
-#endif
-  }
-};
-const auto* const kKeepDriver = ::testing::AddGlobalTestEnvironment(new KeepDriverLoaded);
-
 struct Expect {
   std::string name;
   int frames;
