@@ -330,3 +330,82 @@ TEST(Emitter, ExactFountainDoesNotDependOnTheStep) {
   for (std::size_t i = 0; i < coarse.size(); ++i) mean += double(coarse[i]) - double(fine[i]);
   EXPECT_NEAR(mean / 37.0, 0.0, 1e-5);
 }
+
+// Newborns run the action list over what is left of their birth step in one batch, each with
+// its own step length: every one ends where the closed forms put it for that length, also
+// when the newborns start in the middle of a block and span several blocks and threads.
+TEST(Emitter, NewbornsRunTheActionsForTheirOwnPartOfTheStep) {
+  const double rate = 1000.0, dt = 0.5;
+  const Vec3 p0(0.5f, 1.0f, -0.25f), v0(1.0f, 2.0f, 0.5f), c0(0.2f, 0.4f, 0.6f);
+  const Vec3 centre(2.0f, 0.0f, 0.0f), targetColour(1.0f, 0.0f, 0.5f);
+  const float drag = 0.7f, pull = 3.0f, eps = 0.01f, colourRate = 2.0f;
+  ContextOptions o;
+  o.dt = dt;
+  o.threads = 2;
+  o.blockSize = 64;  // the newborns begin inside a block and fill several
+  Context ctx(o);
+  Group& g = ctx.createGroup("g", 10000);
+  Emitter e;
+  e.rate = rate;
+  e.shape = Domain::point(p0);
+  ParticleType t;
+  t.velocity = Domain::point(v0);
+  t.color = Domain::point(c0);
+  e.types = {t};
+  g.addEmitter(e);
+  g.setActions({Damping{Vec3(drag)}, OrbitPoint{centre, pull, eps},
+                TargetColor{targetColour, 0.5f, colourRate}, Move{}, KillOld{}});
+  ctx.run(2);
+  std::size_t checked = 0;
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const Particle p = g.particle(i);
+    const double born = double(p.id + 1) / rate;
+    if (born <= dt) continue;  // born in the first step: ran a whole second one
+    const double h = 2.0 * dt - born;
+    // Damping, then the pull from the birth place, then Move (semi-implicit Euler).
+    const glm::dvec3 d = glm::dvec3(centre) - glm::dvec3(p0);
+    const double s = glm::dot(d, d) + eps;
+    const glm::dvec3 v =
+        glm::dvec3(v0) * std::exp(-double(drag) * h) + d * (double(pull) / (s * std::sqrt(s))) * h;
+    const glm::dvec3 pos = glm::dvec3(p0) + v * h;
+    const double k = 1.0 - std::exp(-double(colourRate) * h);
+    const glm::dvec3 col = glm::dvec3(c0) + (glm::dvec3(targetColour) - glm::dvec3(c0)) * k;
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(p.velocity[c], v[c], 2e-6 * (1.0 + std::abs(v[c]))) << "id " << p.id;
+      EXPECT_NEAR(p.position[c], pos[c], 2e-6 * (1.0 + std::abs(pos[c]))) << "id " << p.id;
+      EXPECT_NEAR(p.color[c], col[c], 2e-6) << "id " << p.id;
+    }
+    EXPECT_NEAR(p.color.a, 1.0 + (0.5 - 1.0) * k, 2e-6) << "id " << p.id;
+    EXPECT_NEAR(p.age, h, 2e-6) << "id " << p.id;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 500u);
+}
+
+// The same in front of a sphere and a box: their bounces take each newborn's own step too.
+TEST(Emitter, NewbornsNearASphereOrABoxNeverEndInside) {
+  for (const Domain& solid : {Domain::sphere(Vec3(0.0f, -1.0f, 0.0f), 1.0f),
+                              Domain::box(Vec3(-1.0f, -2.0f, -1.0f), Vec3(1.0f, 0.0f, 1.0f))})
+    for (double dt : {1.0 / 30.0, 0.1, 0.5}) {
+      ContextOptions o;
+      o.dt = dt;
+      o.threads = 1;
+      Context ctx(o);
+      Group& g = ctx.createGroup("g", 100000);
+      Emitter e;
+      e.rate = 3000.0;
+      e.shape = Domain::disc(Vec3(0.0f, 0.01f, 0.0f), Vec3(0, 1, 0), 0.2f);  // 0.01 above
+      ParticleType t;
+      t.velocity = Domain::box(Vec3(-1.0f, -4.0f, -1.0f), Vec3(1.0f, -2.0f, 1.0f));
+      e.types = {t};
+      g.addEmitter(e);
+      g.setActions({Gravity{}, Bounce{solid, 0.5f, 0.0f, 0.0f}, Move{}});
+      for (int s = 0; s < 6; ++s) {
+        ctx.step();
+        ASSERT_GT(g.size(), 0u);
+        std::size_t inside = 0;
+        for (std::size_t i = 0; i < g.size(); ++i) inside += solid.contains(g.particle(i).position);
+        ASSERT_EQ(inside, 0u) << "dt " << dt << ", step " << s << ", of " << g.size();
+      }
+    }
+}

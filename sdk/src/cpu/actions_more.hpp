@@ -101,30 +101,36 @@ inline void sampleFromActionStreams(const Domain& d, const Lanes& L, std::size_t
   }
 }
 
-// v += a[i]·dt over a batch.
+// v += a[i]·dt[i] over a batch.
+template <class Dt>
 inline void addVaryingLoop(float* __restrict vx, float* __restrict vy, float* __restrict vz,
                            const float* __restrict ax, const float* __restrict ay,
-                           const float* __restrict az, std::size_t n, float dt) {
+                           const float* __restrict az, std::size_t n, Dt dt) {
   for (std::size_t i = 0; i < n; ++i) {
-    vx[i] = vx[i] + ax[i] * dt;
-    vy[i] = vy[i] + ay[i] * dt;
-    vz[i] = vz[i] + az[i] * dt;
+    vx[i] = vx[i] + ax[i] * dt[i];
+    vy[i] = vy[i] + ay[i] * dt[i];
+    vz[i] = vz[i] + az[i] * dt[i];
   }
+}
+// x += (target - x)·(1 - exp(-rate·dt[i])): an exponential approach over each particle's step.
+inline void approachOwnLoop(float* __restrict x, std::size_t n, float target, float rate,
+                            const float* __restrict h) {
+  for (std::size_t i = 0; i < n; ++i) x[i] += (target - x[i]) * approach(rate, h[i]);
 }
 }  // namespace
 
 // ---- Absorbers, blockers -----------------------------------------------------------------
 
-template <class Shape>
+template <class Shape, class Dt>
 inline void sinkMotionLoop(const Shape& shape, const float* __restrict px,
                            const float* __restrict py, const float* __restrict pz,
                            const float* __restrict vx, const float* __restrict vy,
                            const float* __restrict vz, std::uint32_t* __restrict dead,
-                           std::size_t n, float dt, std::uint32_t code, bool enter) {
+                           std::size_t n, Dt dt, std::uint32_t code, bool enter) {
   for (std::size_t i = 0; i < n; ++i) {
     const bool now = detail::inside(shape, Vec3(px[i], py[i], pz[i]));
-    const bool next =
-        detail::inside(shape, Vec3(px[i] + vx[i] * dt, py[i] + vy[i] * dt, pz[i] + vz[i] * dt));
+    const bool next = detail::inside(
+        shape, Vec3(px[i] + vx[i] * dt[i], py[i] + vy[i] * dt[i], pz[i] + vz[i] * dt[i]));
     const bool k = enter ? (!now & next) : (now & !next);
     const std::uint32_t kk = k ? code : 0u;
     dead[i] = dead[i] != 0u ? dead[i] : kk;
@@ -142,16 +148,18 @@ inline void apply(const Sink& a, const Lanes& L, std::size_t n, const BlockConte
         },
         a.region.shape());
   } else if (a.mode == M::Enter || a.mode == M::Leave) {
-    std::visit(
-        [&](const auto& shape) {
-          sinkMotionLoop(shape, L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], c.dead, n, c.dt,
-                         code, a.mode == M::Enter);
-        },
-        a.region.shape());
+    withDt(c, [&](auto dt) {
+      std::visit(
+          [&](const auto& shape) {
+            sinkMotionLoop(shape, L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], c.dead, n, dt,
+                           code, a.mode == M::Enter);
+          },
+          a.region.shape());
+    });
   } else {  // Hit: the coming Move crosses the plane piece
     for (std::size_t i = 0; i < n; ++i) {
       const Vec3 p = at(L.p, i), v = at(L.v, i);
-      const Vec3 q = p + v * c.dt;
+      const Vec3 q = p + v * c.dtAt(i);
       const Vec3 nrm = a.region.normal(p);
       const Vec3 origin = a.region.closestPoint(p);
       const float d0 = glm::dot(p - origin, nrm), d1 = glm::dot(q - origin, nrm);
@@ -193,46 +201,48 @@ inline void apply(const Block& a, const Lanes& L, std::size_t n, const BlockCont
 // Gravity and Damping with a falloff radius (without one they are the vectorised loops).
 inline void applyWeighted(const Gravity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
   for (std::size_t i = 0; i < n; ++i)
-    put(L.v, i, at(L.v, i) + a.acceleration * (c.dt * falloffWeight(a.falloff, at(L.p, i))));
+    put(L.v, i, at(L.v, i) + a.acceleration * (c.dtAt(i) * falloffWeight(a.falloff, at(L.p, i))));
 }
 
 inline void applyWeighted(const Damping& a, const Lanes& L, std::size_t n, const BlockContext& c) {
   for (std::size_t i = 0; i < n; ++i) {
-    const float w = falloffWeight(a.falloff, at(L.p, i));
+    const float w = falloffWeight(a.falloff, at(L.p, i)), dt = c.dtAt(i);
     const Vec3 v = at(L.v, i);
     put(L.v, i,
-        Vec3(v.x * std::exp(-a.rate.x * c.dt * w), v.y * std::exp(-a.rate.y * c.dt * w),
-             v.z * std::exp(-a.rate.z * c.dt * w)));
+        Vec3(v.x * std::exp(-a.rate.x * dt * w), v.y * std::exp(-a.rate.y * dt * w),
+             v.z * std::exp(-a.rate.z * dt * w)));
   }
 }
 
 inline void apply(const RotDamping& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  scaleLoop(L.rot[0], L.rot[1], L.rot[2], n, std::exp(-a.rate.x * c.dt), std::exp(-a.rate.y * c.dt),
-            std::exp(-a.rate.z * c.dt));
+  withDt(c, [&](auto dt) { dampLoop(L.rot[0], L.rot[1], L.rot[2], n, a.rate, dt); });
 }
 
 // softPull's arithmetic, branch-free over __restrict lanes so that it vectorises: the pull
 // is computed everywhere and selected where it applies (0 beyond maxRadius and at the centre,
 // where softPull returns 0 untouched: the select keeps out what is computed there).
+template <class Dt>
 inline void orbitPointLoop(const float* __restrict px, const float* __restrict py,
                            const float* __restrict pz, float* __restrict vx, float* __restrict vy,
                            float* __restrict vz, std::size_t n, Vec3 center, float magnitude,
-                           float eps, float maxR2, float dt) {
+                           float eps, float maxR2, Dt dt) {
   for (std::size_t i = 0; i < n; ++i) {
     const float dx = center.x - px[i], dy = center.y - py[i], dz = center.z - pz[i];
     const float r2 = dx * dx + dy * dy + dz * dz;  // glm::dot's order
     const bool pulls = (r2 <= maxR2) & (r2 > 0.0f);
     const float s = r2 + eps;
     const float k = magnitude / (s * std::sqrt(s));
-    vx[i] = vx[i] + (pulls ? dx * k : 0.0f) * dt;
-    vy[i] = vy[i] + (pulls ? dy * k : 0.0f) * dt;
-    vz[i] = vz[i] + (pulls ? dz * k : 0.0f) * dt;
+    vx[i] = vx[i] + (pulls ? dx * k : 0.0f) * dt[i];
+    vy[i] = vy[i] + (pulls ? dy * k : 0.0f) * dt[i];
+    vz[i] = vz[i] + (pulls ? dz * k : 0.0f) * dt[i];
   }
 }
 
 inline void apply(const OrbitPoint& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  orbitPointLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, a.center, a.magnitude,
-                 a.epsilon, a.maxRadius * a.maxRadius, c.dt);
+  withDt(c, [&](auto dt) {
+    orbitPointLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, a.center, a.magnitude,
+                   a.epsilon, a.maxRadius * a.maxRadius, dt);
+  });
 }
 
 inline void apply(const OrbitLine& a, const Lanes& L, std::size_t n, const BlockContext& c) {
@@ -240,7 +250,7 @@ inline void apply(const OrbitLine& a, const Lanes& L, std::size_t n, const Block
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3 w = at(L.p, i) - a.point;
     const Vec3 d = -(w - axis * glm::dot(w, axis));  // towards the nearest point of the line
-    put(L.v, i, at(L.v, i) + softPull(d, a.magnitude, a.epsilon, a.maxRadius) * c.dt);
+    put(L.v, i, at(L.v, i) + softPull(d, a.magnitude, a.epsilon, a.maxRadius) * c.dtAt(i));
   }
 }
 
@@ -255,14 +265,15 @@ inline void apply(const Gravitate& a, const Lanes& L, std::size_t n, const Block
       acc +=
           softPull(Vec3(s.p[0][j], s.p[1][j], s.p[2][j]) - p, a.magnitude, a.epsilon, a.maxRadius);
     }
-    put(L.v, i, at(L.v, i) + acc * c.dt);
+    put(L.v, i, at(L.v, i) + acc * c.dtAt(i));
   }
 }
 
 inline void apply(const Vortex& a, const Lanes& L, std::size_t n, const BlockContext& c) {
   const Vec3 axis = glm::normalize(a.axis);
-  const float k = approach(a.responsiveness, c.dt);
+  const float kStep = approach(a.responsiveness, c.dt);
   for (std::size_t i = 0; i < n; ++i) {
+    const float k = c.ownDt ? approach(a.responsiveness, c.ownDt[i]) : kStep;
     const Vec3 w = at(L.p, i) - a.center;
     const Vec3 radial = w - axis * glm::dot(w, axis);
     const float r = glm::length(radial);
@@ -288,7 +299,7 @@ inline void apply(const Jet& a, const Lanes& L, std::size_t n, const BlockContex
       Random rng = actionRandom(c, L, i);
       acc = a.acceleration.sample(rng);
     }
-    put(L.v, i, at(L.v, i) + acc * c.dt);
+    put(L.v, i, at(L.v, i) + acc * c.dtAt(i));
   }
 }
 
@@ -313,22 +324,32 @@ inline void apply(const RandomAccel& a, const Lanes& L, std::size_t n, const Blo
   const bool weighted = a.falloff.radius < kInfinity;
   sampleFromActionStreams(a.acceleration, L, n, c,
                           [&](std::size_t first, std::size_t m, float* ax, float* ay, float* az) {
-                            if (weighted)  // v + a·(dt·w), as without a falloff (w = 1)
+                            if (weighted) {  // v + a·(dt·w), as without a falloff (w = 1)
                               for (std::size_t k = 0; k < m; ++k) {
-                                const float s = c.dt * falloffWeight(a.falloff, at(L.p, first + k));
+                                const float s = c.dtAt(first + k) *
+                                                falloffWeight(a.falloff, at(L.p, first + k));
                                 ax[k] *= s;
                                 ay[k] *= s;
                                 az[k] *= s;
                               }
-                            addVaryingLoop(L.v[0] + first, L.v[1] + first, L.v[2] + first, ax, ay,
-                                           az, m, weighted ? 1.0f : c.dt);
+                              addVaryingLoop(L.v[0] + first, L.v[1] + first, L.v[2] + first, ax, ay,
+                                             az, m, UniformDt{1.0f});
+                              return;
+                            }
+                            withDt(c, [&](auto dt) {
+                              addVaryingLoop(L.v[0] + first, L.v[1] + first, L.v[2] + first, ax, ay,
+                                             az, m, OffsetDt<decltype(dt)>{dt, first});
+                            });
                           });
 }
 inline void apply(const RandomDisplace& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  sampleFromActionStreams(
-      a.displacement, L, n, c, [&](std::size_t first, std::size_t m, float* x, float* y, float* z) {
-        addVaryingLoop(L.p[0] + first, L.p[1] + first, L.p[2] + first, x, y, z, m, c.dt);
-      });
+  sampleFromActionStreams(a.displacement, L, n, c,
+                          [&](std::size_t first, std::size_t m, float* x, float* y, float* z) {
+                            withDt(c, [&](auto dt) {
+                              addVaryingLoop(L.p[0] + first, L.p[1] + first, L.p[2] + first, x, y,
+                                             z, m, OffsetDt<decltype(dt)>{dt, first});
+                            });
+                          });
 }
 // A batch of samples stored into a vector attribute.
 inline void storeSamples(const Domain& d, float* const* lane, const Lanes& L, std::size_t n,
@@ -351,7 +372,7 @@ inline void apply(const Turbulence& a, const Lanes& L, std::size_t n, const Bloc
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3 p = at(L.p, i);
     const Vec3 acc = curlNoise((p - shift) * a.frequency, a.octaves) * a.amplitude;
-    put(L.v, i, at(L.v, i) + acc * (c.dt * falloffWeight(a.falloff, p)));
+    put(L.v, i, at(L.v, i) + acc * (c.dtAt(i) * falloffWeight(a.falloff, p)));
   }
 }
 
@@ -364,7 +385,7 @@ inline float chargePerMass(const Lanes& L, std::size_t i) {
 inline void apply(const ElectricField& a, const Lanes& L, std::size_t n, const BlockContext& c) {
   for (std::size_t i = 0; i < n; ++i) {
     const float w = falloffWeight(a.falloff, at(L.p, i));
-    put(L.v, i, at(L.v, i) + a.field * (chargePerMass(L, i) * c.dt * w));
+    put(L.v, i, at(L.v, i) + a.field * (chargePerMass(L, i) * c.dtAt(i) * w));
   }
 }
 
@@ -376,7 +397,7 @@ inline void apply(const MagneticField& a, const Lanes& L, std::size_t n, const B
     // dv/dt = (q/m) v × B is a rotation about B at -(q/m)|B|: done exactly (Rodrigues), in
     // double so that the speed does not drift by float rounding over many steps.
     const double theta =
-        -double(chargePerMass(L, i)) * B * c.dt * falloffWeight(a.falloff, at(L.p, i));
+        -double(chargePerMass(L, i)) * B * c.dtAt(i) * falloffWeight(a.falloff, at(L.p, i));
     const double ct = std::cos(theta), st = std::sin(theta);
     const glm::dvec3 v(at(L.v, i)), kd(k);
     const glm::dvec3 r = v * ct + glm::cross(kd, v) * st + kd * (glm::dot(kd, v) * (1.0 - ct));
@@ -386,14 +407,15 @@ inline void apply(const MagneticField& a, const Lanes& L, std::size_t n, const B
 
 inline void apply(const SampledField& a, const Lanes& L, std::size_t n, const BlockContext& c) {
   const VectorField& f = *a.field;
-  const float k = approach(a.responsiveness, c.dt);
+  const float kStep = approach(a.responsiveness, c.dt);
   for (std::size_t i = 0; i < n; ++i) {
+    const float k = c.ownDt ? approach(a.responsiveness, c.ownDt[i]) : kStep, dt = c.dtAt(i);
     const Vec3 p = at(L.p, i);
     const float w = falloffWeight(a.falloff, p);
     const Vec3 u = sampleTrilinear(f, p) * a.strength;
     const Vec3 v = at(L.v, i);
     put(L.v, i,
-        a.mode == SampledField::Mode::Acceleration ? v + u * (c.dt * w) : v + (u - v) * (k * w));
+        a.mode == SampledField::Mode::Acceleration ? v + u * (dt * w) : v + (u - v) * (k * w));
   }
 }
 
@@ -417,7 +439,7 @@ inline void apply(const Avoid& a, const Lanes& L, std::size_t n, const BlockCont
     const float dist = a.obstacle.distance(p);
     Vec3 away = a.obstacle.normal(p);
     if (planar && glm::dot(p - a.obstacle.closestPoint(p), away) < 0.0f) away = -away;
-    put(L.v, i, v + away * (a.magnitude / (dist * dist + a.epsilon) * c.dt));
+    put(L.v, i, v + away * (a.magnitude / (dist * dist + a.epsilon) * c.dtAt(i)));
   }
 }
 
@@ -427,7 +449,7 @@ inline void apply(const Follow& a, const Lanes& L, std::size_t n, const BlockCon
     const std::size_t next = c.base + i + 1;
     if (next >= s.size) continue;  // the last particle leads
     const Vec3 d = Vec3(s.p[0][next], s.p[1][next], s.p[2][next]) - at(L.p, i);
-    put(L.v, i, at(L.v, i) + softPull(d, a.magnitude, a.epsilon, a.maxRadius) * c.dt);
+    put(L.v, i, at(L.v, i) + softPull(d, a.magnitude, a.epsilon, a.maxRadius) * c.dtAt(i));
   }
 }
 
@@ -435,7 +457,7 @@ inline void apply(const Follow& a, const Lanes& L, std::size_t n, const BlockCon
 inline void matchMean(const Snapshot& s, const float* const* self, const float* const* field,
                       float* const* out, std::size_t n, const BlockContext& c, float rate,
                       float maxR) {
-  const float k = approach(rate, c.dt);
+  const float kStep = approach(rate, c.dt);
   const float r2max = maxR * maxR;
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3 p = at(self, i);
@@ -449,6 +471,7 @@ inline void matchMean(const Snapshot& s, const float* const* self, const float* 
       ++count;
     }
     if (count == 0) continue;
+    const float k = c.ownDt ? approach(rate, c.ownDt[i]) : kStep;
     const Vec3 v = at(out, i);
     put(out, i, v + (sum / float(count) - v) * k);
   }
@@ -465,22 +488,32 @@ inline void apply(const MatchRotVelocity& a, const Lanes& L, std::size_t n, cons
 inline void approachLoop(float* __restrict x, std::size_t n, float target, float k) {
   for (std::size_t i = 0; i < n; ++i) x[i] += (target - x[i]) * k;
 }
+// Each lane towards its target at `rate`: one factor for the block's step, or one per
+// newborn for its own.
+inline void approachLanes(float* const* lane, const float* target, int count, float rate,
+                          std::size_t n, const BlockContext& c) {
+  const float k = approach(rate, c.dt);
+  for (int d = 0; d < count; ++d)
+    if (c.ownDt)
+      approachOwnLoop(lane[d], n, target[d], rate, c.ownDt);
+    else
+      approachLoop(lane[d], n, target[d], k);
+}
 inline void apply(const TargetVelocity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const float k = approach(a.rate, c.dt);
-  for (int d = 0; d < 3; ++d) approachLoop(L.v[d], n, a.velocity[d], k);
+  const float t[3] = {a.velocity.x, a.velocity.y, a.velocity.z};
+  approachLanes(L.v, t, 3, a.rate, n, c);
 }
 inline void apply(const TargetRotVelocity& a, const Lanes& L, std::size_t n,
                   const BlockContext& c) {
-  const float k = approach(a.rate, c.dt);
-  for (int d = 0; d < 3; ++d) approachLoop(L.rot[d], n, a.rotVelocity[d], k);
+  const float t[3] = {a.rotVelocity.x, a.rotVelocity.y, a.rotVelocity.z};
+  approachLanes(L.rot, t, 3, a.rate, n, c);
 }
 inline void apply(const TargetColor& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const float k = approach(a.rate, c.dt);
-  for (int d = 0; d < 3; ++d) approachLoop(L.color[d], n, a.color[d], k);
-  approachLoop(L.color[3], n, a.alpha, k);
+  const float t[4] = {a.color.x, a.color.y, a.color.z, a.alpha};
+  approachLanes(L.color, t, 4, a.rate, n, c);
 }
 inline void apply(const TargetSize& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  approachLoop(L.size, n, a.size, approach(a.rate, c.dt));
+  approachLanes(&L.size, &a.size, 1, a.rate, n, c);
 }
 
 inline void apply(const SpeedClamp& a, const Lanes& L, std::size_t n, const BlockContext&) {

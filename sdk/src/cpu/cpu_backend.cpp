@@ -6,7 +6,7 @@
 
 #include "../action_traits.hpp"
 #include "../backend.hpp"
-#include "kernels.hpp"
+#include "actions_more.hpp"  // (defines what kernels.hpp declares)
 
 namespace flurry::detail {
 

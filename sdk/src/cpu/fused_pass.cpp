@@ -221,35 +221,20 @@ void runActions(const std::vector<Action>& acts, const Plan& plan, std::size_t f
   }
 }
 
-// The actions most effects run, over newborns each with its own step length h[i]: vectorised
-// like the block's loops. False for the others (they run per particle).
-bool runWithOwnSteps(const Action& act, bool eulerMove, const Lanes& L, std::size_t n,
-                     const float* h) {
-  if (const auto* a = std::get_if<Gravity>(&act)) {
-    if (a->falloff.radius < kInfinity) return false;
-    cpu::addScaledLoop(L.v[0], L.v[1], L.v[2], h, n, a->acceleration.x, a->acceleration.y,
-                       a->acceleration.z);
-    return true;
-  }
-  if (std::holds_alternative<Move>(act)) {
-    if (!eulerMove || (L.up[0] && L.rot[0])) return false;
-    if (L.prev[0]) cpu::copyLoop(L.prev[0], L.prev[1], L.prev[2], L.p[0], L.p[1], L.p[2], n);
-    cpu::moveLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, cpu::OwnDt{h});
-    if (L.age) cpu::ageLoop(L.age, n, cpu::OwnDt{h});
-    return true;
-  }
-  if (const auto* a = std::get_if<Bounce>(&act))
-    return cpu::withPlanarPiece(*a, [&](Vec3 P, Vec3 N, auto onPiece) {
-      cpu::bouncePlanarLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, cpu::OwnDt{h}, P, N,
-                            onPiece, *a);
-    });
-  return false;
+// Whether an action runs over a batch of newborns, each with its own step length
+// (BlockContext::ownDt), in one call like a block. What depends on the time itself (not
+// only on the step's length), and the integrators' Move, runs per newborn instead.
+bool takesOwnDt(const Action& act, bool eulerMove) {
+  if (std::holds_alternative<Move>(act)) return eulerMove;
+  if (const auto* t = std::get_if<Turbulence>(&act)) return t->drift == Vec3(0.0f);
+  return !std::holds_alternative<Explosion>(act) && !std::holds_alternative<Restore>(act) &&
+         !std::holds_alternative<Callback>(act);
 }
 
 // Actions [first, last) of the list over a block's newborns, [0, count) of `lanes`: each
-// lives only what is left of the step after its birth (remaining[i]), so what depends on
-// the step's length or time runs per particle with its own, the rest over all at once.
-// `ctx` is the sub-step's (sub of plan.substeps).
+// lives only what is left of the step after its birth (remaining[i]). Most actions run over
+// all of them at once with each one's own step length; what depends on the time runs per
+// newborn. `ctx` is the sub-step's (sub of plan.substeps).
 void runNewborns(const std::vector<Action>& acts, const Plan& plan, std::size_t first,
                  std::size_t last, const Lanes& lanes, std::size_t count,
                  const cpu::BlockContext& ctx, const float* remaining, std::uint32_t sub,
@@ -261,14 +246,18 @@ void runNewborns(const std::vector<Action>& acts, const Plan& plan, std::size_t 
   for (std::size_t i = 0; i < count; ++i)
     own[i] = float(double(remaining[i]) / double(plan.substeps));
   const bool euler = plan.list.integrator == Integrator::SemiImplicitEuler;
+  cpu::BlockContext batch = ctx;
+  batch.ownDt = own.data();
   for (std::size_t k = first; k < last; ++k) {
     if (plan.list.gathered[k]) continue;  // evaluated inside its Move
     if (plan.list.timeFree[k]) {
       runActions(acts, plan, k, k + 1, lanes, count, ctx);
       continue;
     }
-    if (!plan.list.curvedBy[k] && runWithOwnSteps(acts[k], euler, lanes, count, own.data()))
+    if (!plan.list.curvedBy[k] && takesOwnDt(acts[k], euler)) {
+      runActions(acts, plan, k, k + 1, lanes, count, batch);
       continue;
+    }
     for (std::size_t i = 0; i < count; ++i) {
       cpu::BlockContext c = ctx;
       c.dt = own[i];

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <type_traits>
 
 #include "../group_impl.hpp"
 #include "../isa_namespace.hpp"
@@ -39,6 +40,11 @@ struct BlockContext {
   std::size_t base = 0;      ///< index of the block's first particle in the group
   const Snapshot* snapshot = nullptr;
   std::uint32_t firstBlocker = ~0u;  ///< index of the list's first Block action
+  /// Newborns: each particle's own step length (what is left of its birth step), indexed as
+  /// `dead`; null when every particle of the block steps `dt`.
+  const float* ownDt = nullptr;
+  /// Particle i's step length.
+  float dtAt(std::size_t i) const { return ownDt ? ownDt[i] : dt; }
 };
 
 // The loops take their arrays as __restrict parameters: GCC 12 vectorises these, but not
@@ -61,6 +67,38 @@ struct OffsetDt {
   std::size_t first;
   float operator[](std::size_t i) const { return dt[first + i]; }
 };
+
+/// Calls f with the block's step lengths: the sub-step for all, or each newborn's own. Loops
+/// written over a Dt serve both, the newborns in one batch like everyone else.
+template <class F>
+inline void withDt(const BlockContext& c, F&& f) {
+  if (c.ownDt)
+    f(OwnDt{c.ownDt});
+  else
+    f(UniformDt{c.dt});
+}
+
+/// v *= exp(-rate·dt) per component: the exact solution of dv/dt = -rate·v over each
+/// particle's step (one exp per component for a uniform step).
+template <class Dt>
+inline void dampLoop(float* __restrict x, float* __restrict y, float* __restrict z, std::size_t n,
+                     Vec3 rate, Dt dt) {
+  if constexpr (std::is_same_v<Dt, UniformDt>) {
+    const float fx = std::exp(-rate.x * dt.h), fy = std::exp(-rate.y * dt.h),
+                fz = std::exp(-rate.z * dt.h);
+    for (std::size_t i = 0; i < n; ++i) {
+      x[i] *= fx;
+      y[i] *= fy;
+      z[i] *= fz;
+    }
+  } else {
+    for (std::size_t i = 0; i < n; ++i) {
+      x[i] *= std::exp(-rate.x * dt[i]);
+      y[i] *= std::exp(-rate.y * dt[i]);
+      z[i] *= std::exp(-rate.z * dt[i]);
+    }
+  }
+}
 
 /// v += a·dt with each particle's own dt.
 inline void addScaledLoop(float* __restrict x, float* __restrict y, float* __restrict z,
@@ -151,21 +189,26 @@ inline void applyWeighted(const Damping& a, const Lanes& L, std::size_t n, const
 
 inline void apply(const Gravity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
   if (a.falloff.radius < kInfinity) return applyWeighted(a, L, n, c);
-  addLoop(L.v[0], L.v[1], L.v[2], n, a.acceleration.x * c.dt, a.acceleration.y * c.dt,
-          a.acceleration.z * c.dt);
+  if (c.ownDt)
+    addScaledLoop(L.v[0], L.v[1], L.v[2], c.ownDt, n, a.acceleration.x, a.acceleration.y,
+                  a.acceleration.z);
+  else
+    addLoop(L.v[0], L.v[1], L.v[2], n, a.acceleration.x * c.dt, a.acceleration.y * c.dt,
+            a.acceleration.z * c.dt);
 }
 
 inline void apply(const Damping& a, const Lanes& L, std::size_t n, const BlockContext& c) {
   if (a.falloff.radius < kInfinity) return applyWeighted(a, L, n, c);
   // The exact solution of dv/dt = -k v over the step: independent of the step size.
-  scaleLoop(L.v[0], L.v[1], L.v[2], n, std::exp(-a.rate.x * c.dt), std::exp(-a.rate.y * c.dt),
-            std::exp(-a.rate.z * c.dt));
+  withDt(c, [&](auto dt) { dampLoop(L.v[0], L.v[1], L.v[2], n, a.rate, dt); });
 }
 
 inline void apply(const Move&, const Lanes& L, std::size_t n, const BlockContext& c) {
   if (L.prev[0]) copyLoop(L.prev[0], L.prev[1], L.prev[2], L.p[0], L.p[1], L.p[2], n);
-  moveLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, UniformDt{c.dt});
-  if (L.age) ageLoop(L.age, n, UniformDt{c.dt});
+  withDt(c, [&](auto dt) {
+    moveLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, dt);
+    if (L.age) ageLoop(L.age, n, dt);
+  });
   if (L.up[0] && L.rot[0]) {
     // The up vector turns with the angular velocity: exactly, about ω by |ω|·dt.
     for (std::size_t i = 0; i < n; ++i) {
@@ -173,7 +216,7 @@ inline void apply(const Move&, const Lanes& L, std::size_t n, const BlockContext
       const float speed = glm::length(w);
       if (!(speed > 0.0f)) continue;
       const Vec3 k = w / speed, u(L.up[0][i], L.up[1][i], L.up[2][i]);
-      const float ct = std::cos(speed * c.dt), st = std::sin(speed * c.dt);
+      const float ct = std::cos(speed * c.dtAt(i)), st = std::sin(speed * c.dtAt(i));
       const Vec3 r = u * ct + glm::cross(k, u) * st + k * (glm::dot(k, u) * (1.0f - ct));
       L.up[0][i] = r.x;
       L.up[1][i] = r.y;
@@ -427,15 +470,16 @@ inline void bouncePlanarAccelLoop(float* __restrict px, float* __restrict py, fl
 }
 
 /// A sphere deflecting from outside (Inside = false) or keeping particles in (Inside = true).
-template <bool Inside>
+template <bool Inside, class Dt>
 inline void bounceSphereLoop(float* __restrict px, float* __restrict py, float* __restrict pz,
                              float* __restrict vxs, float* __restrict vys, float* __restrict vzs,
-                             std::size_t n, float dt, const SphereDomain& s, const Bounce& b) {
+                             std::size_t n, Dt dts, const SphereDomain& s, const Bounce& b) {
   const Reflect reflect{b.restitution, 1.0f - b.friction, b.cutoff * b.cutoff};
   const Vec3 C = s.center;
   const float R = s.outerRadius, R2 = R * R, invR = 1.0f / R;
   const float scaleC = std::abs(C.x) + std::abs(C.y) + std::abs(C.z) + R;
   for (std::size_t i = 0; i < n; ++i) {
+    const float dt = dts[i];
     const float x = px[i], y = py[i], z = pz[i];
     const float vx = vxs[i], vy = vys[i], vz = vzs[i];
     const float rx = x - C.x, ry = y - C.y, rz = z - C.z;
@@ -485,6 +529,7 @@ inline void bounceSphereLoop(float* __restrict px, float* __restrict py, float* 
     // A particle that crosses the sphere more than once in a step bounces at every exit for
     // what is left of the step, from where it began; past 16 bounces it ends inside.
     for (std::size_t i = 0; i < n; ++i) {
+      const float dt = dts[i];
       const Vec3 p(px[i], py[i], pz[i]);
       Vec3 v(vxs[i], vys[i], vzs[i]);
       const float slack = 4e-7f * (R + glm::length(v) * dt);
@@ -524,13 +569,15 @@ inline void bounceSphereLoop(float* __restrict px, float* __restrict py, float* 
 
 /// A box keeping particles inside: each axis is its own pair of walls (exact for an
 /// axis-aligned box, also in corners); friction acts on the other two axes on a hit.
+template <class Dt>
 inline void bounceBoxInside(float* __restrict px, float* __restrict py, float* __restrict pz,
                             float* __restrict vxs, float* __restrict vys, float* __restrict vzs,
-                            std::size_t n, float dt, const BoxDomain& box, const Bounce& b) {
+                            std::size_t n, Dt dts, const BoxDomain& box, const Bounce& b) {
   float* p[3] = {px, py, pz};
   float* v[3] = {vxs, vys, vzs};
   const float e = b.restitution, keep = 1.0f - b.friction, cut2 = b.cutoff * b.cutoff;
   for (std::size_t i = 0; i < n; ++i) {
+    const float dt = dts[i];
     bool hit[3];
     float wall[3], tau[3];
     for (int k = 0; k < 3; ++k) {
@@ -567,11 +614,13 @@ inline void bounceBoxInside(float* __restrict px, float* __restrict py, float* _
 }
 
 /// A box deflecting from outside: the segment's entry face (slab method).
+template <class Dt>
 inline void bounceBoxOutside(float* __restrict px, float* __restrict py, float* __restrict pz,
                              float* __restrict vxs, float* __restrict vys, float* __restrict vzs,
-                             std::size_t n, float dt, const BoxDomain& box, const Bounce& b) {
+                             std::size_t n, Dt dts, const BoxDomain& box, const Bounce& b) {
   const Reflect reflect{b.restitution, 1.0f - b.friction, b.cutoff * b.cutoff};
   for (std::size_t i = 0; i < n; ++i) {
+    const float dt = dts[i];
     const Vec3 p(px[i], py[i], pz[i]), v(vxs[i], vys[i], vzs[i]);
     if (detail::inside(box, p)) continue;  // already in: not this deflector's business
     float tEnter = 0.0f, tExit = dt;
@@ -672,23 +721,24 @@ inline bool isPlanarBounce(const Bounce& a) {
 }
 
 inline void apply(const Bounce& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const bool planar = withPlanarPiece(a, [&](Vec3 P, Vec3 N, auto onPiece) {
-    bouncePlanarLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, UniformDt{c.dt}, P, N,
-                     onPiece, a);
+  withDt(c, [&](auto dt) {
+    const bool planar = withPlanarPiece(a, [&](Vec3 P, Vec3 N, auto onPiece) {
+      bouncePlanarLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, dt, P, N, onPiece, a);
+    });
+    if (planar) return;
+    const auto& shape = a.surface.shape();
+    if (const auto* s = std::get_if<SphereDomain>(&shape)) {
+      if (a.inside)
+        bounceSphereLoop<true>(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, dt, *s, a);
+      else
+        bounceSphereLoop<false>(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, dt, *s, a);
+    } else if (const auto* bx = std::get_if<BoxDomain>(&shape)) {
+      if (a.inside)
+        bounceBoxInside(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, dt, *bx, a);
+      else
+        bounceBoxOutside(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, dt, *bx, a);
+    }
   });
-  if (planar) return;
-  const auto& shape = a.surface.shape();
-  if (const auto* s = std::get_if<SphereDomain>(&shape)) {
-    if (a.inside)
-      bounceSphereLoop<true>(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, c.dt, *s, a);
-    else
-      bounceSphereLoop<false>(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, c.dt, *s, a);
-  } else if (const auto* bx = std::get_if<BoxDomain>(&shape)) {
-    if (a.inside)
-      bounceBoxInside(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, c.dt, *bx, a);
-    else
-      bounceBoxOutside(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, c.dt, *bx, a);
-  }
 }
 
 /// A Bounce before a Move whose integrator moves each particle with the acceleration `acc`
