@@ -4,6 +4,7 @@
 #include <type_traits>
 
 namespace flurry::detail {
+inline namespace FLURRY_ISA_NAMESPACE {
 
 namespace {
 
@@ -252,4 +253,5 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) void uniformBatch(
   }
 }
 
+}  // namespace FLURRY_ISA_NAMESPACE
 }  // namespace flurry::detail

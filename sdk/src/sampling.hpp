@@ -16,8 +16,12 @@
 #include "flurry/domain.hpp"
 #include "flurry/fuzzy.hpp"
 #include "flurry/random.hpp"
+#include "isa_namespace.hpp"
 
 namespace flurry::detail {
+// Compiled once per instruction set, like the fused pass that samples for its random
+// actions (isa_namespace.hpp): each build calls its own copies.
+inline namespace FLURRY_ISA_NAMESPACE {
 
 constexpr float kTwoPiF = 6.28318530717958647692f;
 
@@ -77,4 +81,5 @@ void sampleBatch(const Fuzzy& f, const float* const* u, std::size_t n, float* ou
 void uniformBatch(std::uint64_t seed, std::uint32_t firstId, std::uint32_t c1, std::uint32_t c2,
                   std::uint32_t block, std::size_t n, float* u0, float* u1, float* u2, float* u3);
 
+}  // namespace FLURRY_ISA_NAMESPACE
 }  // namespace flurry::detail
