@@ -8,18 +8,15 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <memory>
 
 #include "backend.hpp"
 #include "emission_plan.hpp"
-#include "sampling.hpp"
 
 namespace flurry::detail {
 
 namespace {
 
-constexpr std::size_t kNewbornsPerTask = 8192;  // a multiple of kBatch
-constexpr std::size_t kInlineMoves = 16384;     // lane elements compaction copies inline
+constexpr std::size_t kInlineMoves = 16384;  // lane elements compaction copies inline
 
 // Particles a rate has produced by time t: floor(rate·elapsed), with a relative guard so
 // that 10.5/s over 10 s gives 105 despite the rounding of the accumulated time.
@@ -31,253 +28,6 @@ std::uint64_t producedByRate(double rate, double start, double stop, double t) {
 }
 std::uint64_t producedBy(const Emitter& e, double t) {
   return producedByRate(e.rate, e.start, e.stop, t);
-}
-
-std::size_t chooseType(const Emitter& e, Random& rng) {
-  if (e.types.size() == 1) return 0;
-  float total = 0;
-  for (const auto& t : e.types) total += t.weight;
-  float u = rng.uniform() * total;
-  for (std::size_t k = 0; k < e.types.size(); ++k) {
-    if (u < e.types[k].weight) return k;
-    u -= e.types[k].weight;
-  }
-  return e.types.size() - 1;
-}
-
-constexpr std::size_t kBatch = 256;
-constexpr int kMaxDraws = 48;
-
-struct NewbornContext {
-  GroupImpl& g;
-  Lanes L;
-  const StepParams& sp;
-  double t1;              // end of the step
-  std::uint32_t firstId;  // id of newborn 0 of this step
-  std::size_t oldSize;    // newborn i is in slot oldSize + i
-  float* remaining;       // newborn i lives remaining[i] of this step
-
-  std::size_t slot(std::size_t i) const { return oldSize + i; }
-  // What is left of the step after a birth at tb.
-  float left(double tb) const { return float(std::max(0.0, t1 - tb)); }
-};
-
-double birthTime(const BirthRun& run, const Emitter& em, std::uint64_t q) {
-  switch (run.kind) {
-    case BirthRun::Rate:
-      return em.start + double(run.first + q + 1) / em.rate;
-    case BirthRun::Burst:
-      return run.time;
-    default:
-      return run.time + run.dt * (run.s0 + double(q) * run.spacing) / run.span;
-  }
-}
-
-const Emitter& emitterOf(const GroupImpl& g, const BirthRun& run) {
-  return run.live ? g.live[run.index].emitter : g.emitters[run.index];
-}
-
-// One newborn, where and as it was born.
-struct Newborn {
-  Vec3 pos, vel;
-  float lifetime, r, gr, bl, alpha, size, mass, charge;
-  Vec3 up, rot;
-};
-
-// What the curves over life scale: the colour and size just stored (Particle's defaults for
-// a lane not stored).
-void storeBirth(const Lanes& L, std::size_t slot) {
-  for (int c = 0; c < 4; ++c)
-    if (L.birthColor[c]) L.birthColor[c][slot] = L.color[c] ? L.color[c][slot] : 1.0f;
-  if (L.birthSize) L.birthSize[slot] = L.size ? L.size[slot] : Particle().size;
-}
-
-void store(const NewbornContext& nc, std::size_t slot, std::uint32_t id, const Newborn& b) {
-  const Lanes& L = nc.L;
-  for (int c = 0; c < 3; ++c) {
-    L.p[c][slot] = b.pos[c];
-    if (L.v[c]) L.v[c][slot] = b.vel[c];
-    if (L.prev[c]) L.prev[c][slot] = b.pos[c];
-    // A newborn's rest pose is where it was born, still (as ensureStorage gives a new lane).
-    if (L.posB[c]) L.posB[c][slot] = b.pos[c];
-    if (L.velB[c]) L.velB[c][slot] = 0.0f;
-    if (L.up[c]) L.up[c][slot] = b.up[c];
-    if (L.rot[c]) L.rot[c][slot] = b.rot[c];
-  }
-  if (L.lifetime) L.lifetime[slot] = std::max(b.lifetime, 0.0f);
-  if (L.color[0]) {
-    L.color[0][slot] = b.r;
-    L.color[1][slot] = b.gr;
-    L.color[2][slot] = b.bl;
-    L.color[3][slot] = b.alpha;
-  }
-  if (L.size) L.size[slot] = std::max(b.size, 0.0f);
-  storeBirth(L, slot);
-  if (L.mass) L.mass[slot] = b.mass;
-  if (L.charge) L.charge[slot] = b.charge;
-  if (L.age) L.age[slot] = 0.0f;
-  L.id[slot] = id;
-  if (L.visible) L.visible[slot] = 1u;
-  if (L.user) L.user[slot] = 0.0f;
-}
-
-// Emitters with one particle type: every draw of a batch at once (see sampling.hpp).
-void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em, std::uint64_t q0,
-               std::size_t i0, std::size_t m) {
-  const Lanes& L = nc.L;
-  const ParticleType& type = em.types[0];
-  // Scratch per thread, on the heap and reached through a pointer read once: in a shared
-  // library every access to a thread_local object goes through __tls_get_addr, and GCC
-  // folds a reference to one back into such accesses, once per element of the loops below.
-  struct Scratch {
-    float rows[kMaxDraws][kBatch];
-    float attr[16][kBatch];
-    float up[3][kBatch], rot[3][kBatch];
-    float age[kBatch];  // zeros
-    std::uint32_t slot[kBatch];
-  };
-  thread_local std::unique_ptr<Scratch> scratch;
-  if (!scratch) scratch = std::make_unique<Scratch>();  // once per thread
-  Scratch& sc = *scratch;
-  auto& rows = sc.rows;
-  auto& attr = sc.attr;
-  auto& up = sc.up;
-  auto& rot = sc.rot;
-  auto& age = sc.age;
-  auto& slot = sc.slot;
-  const float* row[kMaxDraws];
-  for (int k = 0; k < kMaxDraws; ++k) row[k] = rows[k];
-
-  // The draws in the order the one-by-one path makes them.
-  const bool alongNormal = !(em.normalSpeed.constant() && em.normalSpeed.center == 0.0f);
-  int draws = drawCount(type.velocity) + drawCount(em.shape);
-  if (alongNormal) draws += drawCount(em.normalSpeed);
-  if (L.lifetime) draws += drawCount(type.lifetime);
-  if (L.color[0]) draws += drawCount(type.color) + drawCount(type.alpha);
-  if (L.size) draws += drawCount(type.size);
-  if (L.mass) draws += drawCount(type.mass);
-  if (L.charge) draws += drawCount(type.charge);
-  if (L.up[0]) draws += drawCount(type.up);
-  if (L.rot[0]) draws += drawCount(type.rotVelocity);
-  const std::uint32_t firstId = nc.firstId + std::uint32_t(i0);
-  for (int blk = 0; blk * 4 < draws; ++blk)
-    uniformBatch(nc.sp.seed, firstId, nc.g.index, stream::kEmission, std::uint32_t(blk), m,
-                 rows[4 * blk], rows[4 * blk + 1], rows[4 * blk + 2], rows[4 * blk + 3]);
-
-  int cur = 0;
-  auto vec = [&](const Domain& d, int a) {
-    sampleBatch(d, row + cur, m, attr[a], attr[a + 1], attr[a + 2]);
-    cur += drawCount(d);
-  };
-  auto scalar = [&](const Fuzzy& f, int a) {
-    sampleBatch(f, row + cur, m, attr[a]);
-    cur += drawCount(f);
-  };
-  vec(type.velocity, 0);  // attr 0-2
-  vec(em.shape, 3);       // 3-5
-  if (alongNormal) {
-    // Every face emits along its normal: the shape's normal where the particle was born.
-    scalar(em.normalSpeed, 15);
-    for (std::size_t k = 0; k < m; ++k) {
-      const Vec3 nrm = em.shape.normal(Vec3(attr[3][k], attr[4][k], attr[5][k]));
-      for (int d = 0; d < 3; ++d) attr[d][k] += nrm[d] * attr[15][k];
-    }
-  }
-  if (L.lifetime) scalar(type.lifetime, 6);
-  if (L.color[0]) {
-    vec(type.color, 7);  // 7-9
-    scalar(type.alpha, 10);
-  }
-  if (L.size) scalar(type.size, 11);
-  if (L.mass) scalar(type.mass, 12);
-  if (L.charge) scalar(type.charge, 13);
-  if (L.up[0]) {
-    sampleBatch(type.up, row + cur, m, up[0], up[1], up[2]);
-    cur += drawCount(type.up);
-  }
-  if (L.rot[0]) sampleBatch(type.rotVelocity, row + cur, m, rot[0], rot[1], rot[2]);
-
-  // Birth places: where the emitter was at the birth time; and the time left of the step.
-  float* const px = attr[3];
-  float* const py = attr[4];
-  float* const pz = attr[5];
-  for (std::size_t k = 0; k < m; ++k) {
-    const double tb = birthTime(run, em, q0 + k);
-    nc.remaining[i0 + k] = nc.left(tb);
-    const Vec3 e =
-        em.path.empty() ? em.position + em.velocity * float(tb - em.start) : em.positionAt(tb);
-    px[k] += e.x;
-    py[k] += e.y;
-    pz[k] += e.z;
-    age[k] = 0.0f;
-    slot[k] = std::uint32_t(nc.slot(i0 + k));
-  }
-  // Scatter into the slots, one lane at a time.
-  auto put = [&](float* lane, const float* src) {
-    if (lane)
-      for (std::size_t k = 0; k < m; ++k) lane[slot[k]] = src[k];
-  };
-  auto putNonNegative = [&](float* lane, float* src) {
-    if (!lane) return;
-    for (std::size_t k = 0; k < m; ++k) src[k] = std::max(src[k], 0.0f);
-    put(lane, src);
-  };
-  for (int c = 0; c < 3; ++c) {
-    put(L.p[c], attr[3 + c]);
-    put(L.v[c], attr[c]);
-    put(L.prev[c], attr[3 + c]);
-    put(L.posB[c], attr[3 + c]);
-    if (L.velB[c])
-      for (std::size_t k = 0; k < m; ++k) L.velB[c][slot[k]] = 0.0f;
-    put(L.up[c], up[c]);
-    put(L.rot[c], rot[c]);
-  }
-  putNonNegative(L.lifetime, attr[6]);
-  for (int c = 0; c < 4; ++c) put(L.color[c], attr[7 + c]);
-  putNonNegative(L.size, attr[11]);
-  put(L.mass, attr[12]);
-  put(L.charge, attr[13]);
-  put(L.age, age);
-  if (L.birthColor[0] || L.birthSize)
-    for (std::size_t k = 0; k < m; ++k) storeBirth(L, slot[k]);
-  for (std::size_t k = 0; k < m; ++k) L.id[slot[k]] = firstId + std::uint32_t(k);
-  if (L.visible)
-    for (std::size_t k = 0; k < m; ++k) L.visible[slot[k]] = 1u;
-  if (L.user)
-    for (std::size_t k = 0; k < m; ++k) L.user[slot[k]] = 0.0f;
-}
-
-// Several particle types: each newborn picks its type first, then draws as emitBatch does.
-void emitOneByOne(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
-                  std::uint64_t q0, std::size_t i0, std::size_t m) {
-  const Lanes& L = nc.L;
-  for (std::size_t k = 0; k < m; ++k) {
-    const std::uint32_t id = nc.firstId + std::uint32_t(i0 + k);
-    Random rng(nc.sp.seed, id, nc.g.index, stream::kEmission);
-    const ParticleType& type = em.types[chooseType(em, rng)];
-    const double tb = birthTime(run, em, q0 + k);
-    nc.remaining[i0 + k] = nc.left(tb);
-    Newborn b{};
-    b.vel = type.velocity.sample(rng);
-    const Vec3 local = em.shape.sample(rng);
-    if (!(em.normalSpeed.constant() && em.normalSpeed.center == 0.0f))
-      b.vel += em.shape.normal(local) * em.normalSpeed.sample(rng);
-    b.pos = local + em.positionAt(tb);
-    if (L.lifetime) b.lifetime = type.lifetime.sample(rng);
-    if (L.color[0]) {
-      const Vec3 rgb = type.color.sample(rng);
-      b.r = rgb.x;
-      b.gr = rgb.y;
-      b.bl = rgb.z;
-      b.alpha = type.alpha.sample(rng);
-    }
-    if (L.size) b.size = type.size.sample(rng);
-    if (L.mass) b.mass = type.mass.sample(rng);
-    if (L.charge) b.charge = type.charge.sample(rng);
-    if (L.up[0]) b.up = type.up.sample(rng);
-    if (L.rot[0]) b.rot = type.rotVelocity.sample(rng);
-    store(nc, nc.slot(i0 + k), id, b);
-  }
 }
 
 // ---- Planning: who is born this step, by which emitter, when -----------------------------
@@ -627,28 +377,7 @@ void emitNewborns(GroupImpl& g, const StepParams& sp) {
           std::min<std::size_t>(g.capacity, std::max(accepted, 2 * g.bornRemaining.size())));
     runStart.assign(runs.size() + 1, 0);
     for (std::size_t r = 0; r < runs.size(); ++r) runStart[r + 1] = runStart[r] + runs[r].count;
-    NewbornContext nc{g, g.lanePointers(), sp, t1, g.nextId, g.size, g.bornRemaining.data()};
-    const std::size_t tasks = (accepted + kNewbornsPerTask - 1) / kNewbornsPerTask;
-    sp.pool->parallelFor(tasks, [&](std::size_t task) {
-      const std::size_t a = task * kNewbornsPerTask;
-      const std::size_t b = std::min(accepted, a + kNewbornsPerTask);
-      std::size_t r =
-          std::size_t(std::upper_bound(runStart.begin(), runStart.end(), a) - runStart.begin()) - 1;
-      // Split the task at run boundaries: a batch shares one emitter and birth rule.
-      for (std::size_t i = a; i < b;) {
-        while (i >= runStart[r + 1]) ++r;
-        const std::size_t end = std::min<std::size_t>(b, runStart[r + 1]);
-        const Emitter& em = emitterOf(g, runs[r]);
-        for (std::size_t j = i; j < end; j += kBatch) {
-          const std::size_t m = std::min(kBatch, end - j);
-          if (em.types.size() == 1)
-            emitBatch(nc, runs[r], em, j - runStart[r], j, m);
-          else
-            emitOneByOne(nc, runs[r], em, j - runStart[r], j, m);
-        }
-        i = end;
-      }
-    });
+    writeNewborns(g, sp, runs.data(), runStart.data(), runs.size(), accepted);
     g.nextId += std::uint32_t(accepted);
     g.bornCount = accepted;
     g.size += accepted;

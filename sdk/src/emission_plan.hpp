@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "backend.hpp"
+#include "isa_namespace.hpp"
 
 namespace flurry::detail {
 
@@ -34,5 +35,28 @@ std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, std::vector<BirthRu
 
 /// Drops the live emitters that died by t1 (after their last births are written).
 void retireDead(GroupImpl& g, double t1);
+
+/// Writes newborns [0, accepted) of this step's runs (runStart[r]: the first of run r;
+/// runCount runs) at the end of the group, each with the time it has left of the step in
+/// g.bornRemaining, in parallel. Compiled per instruction set (newborns.cpp).
+void writeNewborns(GroupImpl& g, const StepParams& sp, const BirthRun* runs,
+                   const std::uint64_t* runStart, std::size_t runCount, std::size_t accepted);
+
+inline namespace FLURRY_ISA_NAMESPACE {  // see isa_namespace.hpp
+inline double birthTime(const BirthRun& run, const Emitter& em, std::uint64_t q) {
+  switch (run.kind) {
+    case BirthRun::Rate:
+      return em.start + double(run.first + q + 1) / em.rate;
+    case BirthRun::Burst:
+      return run.time;
+    default:
+      return run.time + run.dt * (run.s0 + double(q) * run.spacing) / run.span;
+  }
+}
+
+inline const Emitter& emitterOf(const GroupImpl& g, const BirthRun& run) {
+  return run.live ? g.live[run.index].emitter : g.emitters[run.index];
+}
+}  // namespace FLURRY_ISA_NAMESPACE
 
 }  // namespace flurry::detail

@@ -1,23 +1,26 @@
-// The fused pass is compute-bound at SSE2 width (a bounce is ~60 flops per particle), so it
-// is compiled once per instruction set (sdk/CMakeLists.txt) and picked here at run time.
+// The fused pass is compute-bound at SSE2 width (a bounce is ~60 flops per particle), and so
+// is writing newborns (random numbers, shapes): both are compiled once per instruction set
+// (sdk/CMakeLists.txt) and picked here at run time.
 #include <cstdlib>
 #include <cstring>
 
 #include "../backend.hpp"
+#include "../emission_plan.hpp"
 
 namespace flurry::detail {
 
-namespace baseline {
-void actFusedImpl(GroupImpl& g, const StepParams& sp);
-}
+#define FLURRY_DECLARE_VARIANT(isa)                                                              \
+  namespace isa {                                                                                \
+  void actFusedImpl(GroupImpl& g, const StepParams& sp);                                         \
+  void writeNewborns(GroupImpl& g, const StepParams& sp, const BirthRun* runs,                   \
+                     const std::uint64_t* runStart, std::size_t runCount, std::size_t accepted); \
+  }
+FLURRY_DECLARE_VARIANT(baseline)
 #ifdef FLURRY_HAS_ISA_VARIANTS
-namespace avx2 {
-void actFusedImpl(GroupImpl& g, const StepParams& sp);
-}
-namespace avx512 {
-void actFusedImpl(GroupImpl& g, const StepParams& sp);
-}
+FLURRY_DECLARE_VARIANT(avx2)
+FLURRY_DECLARE_VARIANT(avx512)
 #endif
+#undef FLURRY_DECLARE_VARIANT
 
 namespace {
 using Impl = void (*)(GroupImpl&, const StepParams&);
@@ -53,6 +56,22 @@ const char* fusedPassIsa() {
 void actFused(GroupImpl& g, const StepParams& sp) {
   static const Impl impl = pick();
   impl(g, sp);
+}
+
+void writeNewborns(GroupImpl& g, const StepParams& sp, const BirthRun* runs,
+                   const std::uint64_t* runStart, std::size_t runCount, std::size_t accepted) {
+  using Write = decltype(&baseline::writeNewborns);
+  // The same instruction set as the fused pass.
+  static const Write write = [] {
+    const Impl impl = pick();
+#ifdef FLURRY_HAS_ISA_VARIANTS
+    if (impl == avx512::actFusedImpl) return &avx512::writeNewborns;
+    if (impl == avx2::actFusedImpl) return &avx2::writeNewborns;
+#endif
+    (void)impl;
+    return &baseline::writeNewborns;
+  }();
+  write(g, sp, runs, runStart, runCount, accepted);
 }
 
 }  // namespace flurry::detail
