@@ -6,10 +6,6 @@
  * Adding an action: a function in its family's .cl file, and a case in that family's
  * generator and packer (sdk/src/opencl/actions_*.cpp). */
 
-FL_INLINE float fl_maxf(float a, float b) { return a < b ? b : a; } /* std::max's rule */
-
-FL_INLINE float fl_minf(float a, float b) { return b < a ? b : a; } /* std::min's rule */
-
 FL_INLINE void fl_kill_old(float age, float life, uint code, uint* dead) {
   const uint k = age > life ? code : 0u;
   *dead = *dead != 0u ? *dead : k;

@@ -23,24 +23,14 @@ FL_INLINE float fl_surf_distance(__global const FlActionParams* a, uint kind, fl
 
 /* ---- Bounce ------------------------------------------------------------------------------ */
 
-/* Reflects the velocity at the hit point h (normal n, time of impact tau) and places the
- * particle so that Move ends it at the reflected point (kernels.hpp Reflect). f[6]
- * restitution, f[7] 1 - friction, f[8] cutoff^2. */
-FL_INLINE void fl_reflect(__global const FlActionParams* a, float* px, float* py, float* pz,
-                          float* vx, float* vy, float* vz, float hx, float hy, float hz, float nx,
-                          float ny, float nz, float tau) {
-  const float restitution = a->f[6], keep = a->f[7], cutoff2 = a->f[8];
-  const float vn = *vx * nx + *vy * ny + *vz * nz;
-  const float vnx = vn * nx, vny = vn * ny, vnz = vn * nz;
-  const float tx = *vx - vnx, ty = *vy - vny, tz = *vz - vnz;
-  const float t2 = tx * tx + ty * ty + tz * tz;
-  const float f = t2 > cutoff2 ? keep : 1.0f;
-  *vx = tx * f - vnx * restitution;
-  *vy = ty * f - vny * restitution;
-  *vz = tz * f - vnz * restitution;
-  *px = hx - *vx * tau;
-  *py = hy - *vy * tau;
-  *pz = hz - *vz * tau;
+/* How the deflector reflects (kernels/deflect.h): f[6] restitution, f[7] 1 - friction,
+ * f[8] cutoff^2. */
+FL_INLINE FlReflect fl_reflect_of(__global const FlActionParams* a) {
+  FlReflect r;
+  r.restitution = a->f[6];
+  r.keep = a->f[7];
+  r.cutoff2 = a->f[8];
+  return r;
 }
 
 #define FL_PIECE_PLANE 0
@@ -99,7 +89,7 @@ FL_INLINE void fl_bounce_planar(__global const FlActionParams* a, int piece, flo
                   fl_on_piece(a, piece, hx, hy, hz);
   if (!hit) return;
   float nx = x, ny = y, nz = z, nvx = vx, nvy = vy, nvz = vz;
-  fl_reflect(a, &nx, &ny, &nz, &nvx, &nvy, &nvz, hx, hy, hz, Nx, Ny, Nz, tau);
+  fl_reflect(fl_reflect_of(a), &nx, &ny, &nz, &nvx, &nvy, &nvz, hx, hy, hz, Nx, Ny, Nz, tau);
   /* Where Move will put it; pushed out if rounding left it on or behind the plane. */
   const float qx = nx + nvx * dt, qy = ny + nvy * dt, qz = nz + nvz * dt;
   const float qd = side * ((qx - Px) * Nx + (qy - Py) * Ny + (qz - Pz) * Nz);
@@ -151,7 +141,7 @@ FL_INLINE void fl_bounce_planar_accel(__global const FlActionParams* a, int piec
   if (!hit) return;
   float nx = x, ny = y, nz = z;
   float nvx = vx + ax * tau, nvy = vy + ay * tau, nvz = vz + az * tau;
-  fl_reflect(a, &nx, &ny, &nz, &nvx, &nvy, &nvz, hx, hy, hz, Nx, Ny, Nz, tau);
+  fl_reflect(fl_reflect_of(a), &nx, &ny, &nz, &nvx, &nvy, &nvz, hx, hy, hz, Nx, Ny, Nz, tau);
   const float htau2 = 0.5f * tau * tau;
   nx += ax * htau2;
   ny += ay * htau2;
@@ -177,176 +167,28 @@ FL_INLINE void fl_bounce_planar_accel(__global const FlActionParams* a, int piec
   *vzs = nvz;
 }
 
-/* A sphere deflecting from outside (inside == 0) or keeping particles in (kernels.hpp
- * bounceSphereLoop). f[0..2] center, f[9] |C|_1 + R, f[10] R, f[11] R^2, f[12] 1/R. */
+/* A sphere deflecting from outside (inside == 0) or keeping particles in: kernels/deflect.h,
+ * as on the CPU. f[0..2] center, f[9] |C|_1 + R, f[10] R, f[11] R^2, f[12] 1/R. */
 FL_INLINE void fl_bounce_sphere(__global const FlActionParams* a, int inside, float dt, float* px,
                                 float* py, float* pz, float* vxs, float* vys, float* vzs) {
-  const float Cx = a->f[0], Cy = a->f[1], Cz = a->f[2];
-  const float R = a->f[10], R2 = a->f[11], invR = a->f[12];
-  const float x = *px, y = *py, z = *pz, vx = *vxs, vy = *vys, vz = *vzs;
-  const float rx = x - Cx, ry = y - Cy, rz = z - Cz;
-  const float c2 = rx * rx + ry * ry + rz * rz - R2;
-  const float bb = rx * vx + ry * vy + rz * vz;
-  const float aa = vx * vx + vy * vy + vz * vz;
-  const float disc = bb * bb - aa * c2;
-  const float root = sqrt(fl_maxf(disc, 0.0f));
-  /* Outside: the entry root; inside: the exit root. inf/NaN (aa = 0) is a miss. */
-  const float tHit = inside ? (-bb + root) / aa : (-bb - root) / aa;
-  const int hit = inside ? (c2 <= 0.0f) & (tHit <= dt)
-                         : (c2 >= 0.0f) & (disc >= 0.0f) & (bb < 0.0f) & (tHit <= dt);
-  if (hit) {
-    const float tau = fl_maxf(tHit, 0.0f);
-    const float hx = x + vx * tau, hy = y + vy * tau, hz = z + vz * tau;
-    const float nnx = (hx - Cx) * invR, nny = (hy - Cy) * invR, nnz = (hz - Cz) * invR;
-    float nx = x, ny = y, nz = z, nvx = vx, nvy = vy, nvz = vz;
-    fl_reflect(a, &nx, &ny, &nz, &nvx, &nvy, &nvz, hx, hy, hz, nnx, nny, nnz, tau);
-    const float qx = nx + nvx * dt - Cx, qy = ny + nvy * dt - Cy, qz = nz + nvz * dt - Cz;
-    /* Signed clearance on the allowed side. */
-    const float ql = sqrt(qx * qx + qy * qy + qz * qz);
-    const float qd = inside ? R - ql : ql - R;
-    const float margin = 4e-7f * (fabs(qx) + fabs(qy) + fabs(qz) + a->f[9] + fabs(nvx * dt) +
-                                  fabs(nvy * dt) + fabs(nvz * dt)) +
-                         1e-30f;
-    const float push = fl_maxf(2.0f * margin - qd, 0.0f) * (inside ? -1.0f : 1.0f);
-    /* Inside, a reflected path that reaches the wall again, or ends too close to it, is
-     * left for the exact loop below (kernels.hpp bounceSphereLoop). */
-    if (!(inside && qd < 2.0f * margin)) {
-      *px = nx + push * nnx;
-      *py = ny + push * nny;
-      *pz = nz + push * nnz;
-      *vxs = nvx;
-      *vys = nvy;
-      *vzs = nvz;
-    }
-  }
-  if (!inside) return;
-  /* A particle that crosses the sphere more than once in a step bounces at every exit for
-   * what is left of the step, from where it began; past 16 bounces it ends inside. */
-  const float3 C = (float3)(Cx, Cy, Cz);
-  const float3 p = (float3)(*px, *py, *pz);
-  float3 v = (float3)(*vxs, *vys, *vzs);
-  const float slack = 4e-7f * (R + fl_lengthv(v) * dt);
-  if (!(fl_lengthv(p + v * dt - C) > R - slack) || fl_lengthv(p - C) > R + slack) return;
-  float left = dt;
-  float3 cur = p;
-  for (int bounce = 0; bounce < 16; ++bounce) {
-    const float3 r = cur - C;
-    const float bb2 = fl_dotv(r, v), aa2 = fl_dotv(v, v), c22 = fl_dotv(r, r) - R2;
-    const float root2 = sqrt(fl_maxf(bb2 * bb2 - aa2 * c22, 0.0f));
-    /* The exit root, in the form without cancellation for either sign of bb. */
-    const float t = fl_maxf(bb2 > 0.0f ? -c22 / (bb2 + root2) : (root2 - bb2) / aa2, 0.0f);
-    if (!(t < left)) break;
-    cur += v * t;
-    left -= t;
-    const float3 nrm = (cur - C) * invR; /* on the sphere: never the centre */
-    float qx = cur.x, qy = cur.y, qz = cur.z, nvx = v.x, nvy = v.y, nvz = v.z;
-    fl_reflect(a, &qx, &qy, &qz, &nvx, &nvy, &nvz, cur.x, cur.y, cur.z, nrm.x, nrm.y, nrm.z, 0.0f);
-    v = (float3)(nvx, nvy, nvz);
-  }
-  float3 pos = cur + v * left;
-  /* Inside by more than Move's rounding of p + v dt. */
-  const float margin = 4e-6f * R + 1e-6f * fl_lengthv(v) * dt;
-  const float dist = fl_lengthv(pos - C);
-  if (dist > R - margin) pos = C + (pos - C) * (fl_maxf(R - margin, 0.5f * R) / dist);
-  const float3 q = pos - v * dt;
-  *px = q.x;
-  *py = q.y;
-  *pz = q.z;
-  *vxs = v.x;
-  *vys = v.y;
-  *vzs = v.z;
+  const FlReflect rf = fl_reflect_of(a);
+  fl_bounce_sphere_once(rf, a->f[0], a->f[1], a->f[2], a->f[10], a->f[11], a->f[12], a->f[9],
+                        inside, dt, px, py, pz, vxs, vys, vzs);
+  if (inside)
+    fl_bounce_sphere_again(rf, a->f[0], a->f[1], a->f[2], a->f[10], a->f[11], a->f[12], dt, px,
+                           py, pz, vxs, vys, vzs);
 }
 
-/* A box keeping particles inside, each axis its own pair of walls (kernels.hpp
- * bounceBoxInside). The box is a->domain.v: min, max. */
-FL_INLINE void fl_bounce_box_inside(__global const FlActionParams* a, float dt, float* px,
-                                    float* py, float* pz, float* vxs, float* vys, float* vzs) {
+/* A box keeping particles in (inside == 1) or deflecting them from outside: kernels/deflect.h.
+ * The box is a->domain.v: min, max. */
+FL_INLINE void fl_bounce_box(__global const FlActionParams* a, int inside, float dt, float* px,
+                             float* py, float* pz, float* vxs, float* vys, float* vzs) {
   __global const float* box = a->domain.v;
-  const float e = a->f[6], keep = a->f[7], cut2 = a->f[8];
-  float* p[3] = {px, py, pz};
-  const float v[3] = {*vxs, *vys, *vzs};
-  int hit[3];
-  float wall[3], tau[3];
-  for (int k = 0; k < 3; ++k) {
-    const float x = *p[k], vk = v[k];
-    const float q = x + vk * dt;
-    hit[k] = q < box[k] || q > box[3 + k];
-    wall[k] = q > box[3 + k] ? box[3 + k] : box[k];
-    tau[k] = hit[k] ? fl_clamp((wall[k] - x) / vk, 0.0f, dt) : 0.0f;
-  }
-  if (!(hit[0] || hit[1] || hit[2])) return;
-  /* The final velocity first: reflected on the axes that hit, slowed by friction on the
-   * others. */
-  float nv[3];
-  for (int k = 0; k < 3; ++k) {
-    nv[k] = hit[k] ? -v[k] * e : v[k];
-    for (int j = 0; j < 3; ++j) {
-      if (j == k || !hit[j]) continue;
-      const int a1 = (j + 1) % 3, a2 = (j + 2) % 3;
-      const float t2 = v[a1] * v[a1] + v[a2] * v[a2];
-      if (t2 > cut2) nv[k] *= keep;
-    }
-  }
-  for (int k = 0; k < 3; ++k) {
-    if (hit[k]) {
-      const float margin = 4e-7f * (fabs(wall[k]) + fabs(nv[k] * dt)) + 1e-30f;
-      const float end =
-          fl_clamp(wall[k] + nv[k] * (dt - tau[k]), box[k] + margin, box[3 + k] - margin);
-      *p[k] = end - nv[k] * dt;
-    }
-  }
-  *vxs = nv[0];
-  *vys = nv[1];
-  *vzs = nv[2];
-}
-
-/* A box deflecting from outside: the segment's entry face, slab method (kernels.hpp
- * bounceBoxOutside). */
-FL_INLINE void fl_bounce_box_outside(__global const FlActionParams* a, float dt, float* px,
-                                     float* py, float* pz, float* vxs, float* vys, float* vzs) {
-  __global const float* box = a->domain.v;
-  const float p[3] = {*px, *py, *pz}, v[3] = {*vxs, *vys, *vzs};
-  if (fl_inside(box, FL_DOMAIN_BOX, p[0], p[1], p[2])) return; /* already in */
-  float tEnter = 0.0f, tExit = dt;
-  int axis = -1;
-  int miss = 0;
-  for (int k = 0; k < 3 && !miss; ++k) {
-    if (v[k] == 0.0f) {
-      miss = p[k] < box[k] || p[k] > box[3 + k];
-      continue;
-    }
-    float t0 = (box[k] - p[k]) / v[k], t1 = (box[3 + k] - p[k]) / v[k];
-    if (t0 > t1) {
-      const float s = t0;
-      t0 = t1;
-      t1 = s;
-    }
-    if (t0 > tEnter) {
-      tEnter = t0;
-      axis = k;
-    }
-    tExit = t1 < tExit ? t1 : tExit; /* std::min */
-    miss = tEnter > tExit;
-  }
-  if (miss || axis < 0) return;
-  float nrm[3] = {0.0f, 0.0f, 0.0f};
-  nrm[axis] = v[axis] > 0.0f ? -1.0f : 1.0f;
-  const float hx = p[0] + v[0] * tEnter, hy = p[1] + v[1] * tEnter, hz = p[2] + v[2] * tEnter;
-  float np[3] = {p[0], p[1], p[2]}, nv[3] = {v[0], v[1], v[2]};
-  fl_reflect(a, &np[0], &np[1], &np[2], &nv[0], &nv[1], &nv[2], hx, hy, hz, nrm[0], nrm[1], nrm[2],
-             tEnter);
-  /* Keep the end of the step outside the entry face. */
-  const float face = nrm[axis] > 0.0f ? box[3 + axis] : box[axis];
-  const float q = np[axis] + nv[axis] * dt;
-  const float margin = 4e-7f * (fabs(face) + fabs(q)) + 1e-30f;
-  const float clearance = (q - face) * nrm[axis];
-  if (clearance < margin) np[axis] += (2.0f * margin - clearance) * nrm[axis];
-  *px = np[0];
-  *py = np[1];
-  *pz = np[2];
-  *vxs = nv[0];
-  *vys = nv[1];
-  *vzs = nv[2];
+  const float lo[3] = {box[0], box[1], box[2]}, hi[3] = {box[3], box[4], box[5]};
+  if (inside)
+    fl_bounce_box_inside(fl_reflect_of(a), lo, hi, dt, px, py, pz, vxs, vys, vzs);
+  else
+    fl_bounce_box_outside(fl_reflect_of(a), lo, hi, dt, px, py, pz, vxs, vys, vzs);
 }
 
 /* After a Move by an integrator other than semi-implicit Euler: a particle that its curved

@@ -29,6 +29,8 @@ using std::fabs;
 using std::floor;
 using std::sqrt;
 
+#include "../../kernels/math.h"
+
 }  // namespace kernel
 }  // namespace FLURRY_ISA_NAMESPACE
 }  // namespace flurry::detail

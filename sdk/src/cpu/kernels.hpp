@@ -13,10 +13,19 @@
 
 #include "../group_impl.hpp"
 #include "../isa_namespace.hpp"
+#include "../kernel_compat.hpp"
 #include "../noise.hpp"
 #include "../shape_math.hpp"
 #include "flurry/actions.hpp"
 #include "flurry/random.hpp"
+
+namespace flurry::detail {
+inline namespace FLURRY_ISA_NAMESPACE {
+namespace kernel {
+#include "../../kernels/deflect.h"
+}  // namespace kernel
+}  // namespace FLURRY_ISA_NAMESPACE
+}  // namespace flurry::detail
 
 namespace flurry::detail::cpu {
 inline namespace FLURRY_ISA_NAMESPACE {  // see isa_namespace.hpp
@@ -230,24 +239,15 @@ inline void apply(const KillOld&, const Lanes& L, std::size_t n, const BlockCont
 }
 
 /// Reflects the velocity and places the particle so that the following Move ends it at the
-/// reflected point; then makes sure that point is strictly on the side it came from.
+/// reflected point (kernels/deflect.h fl_reflect, shared with the device).
 struct Reflect {
   float restitution, keep, cutoff2;
   // In: position p, velocity v, hit point h, unit normal nrm, time of impact tau.
   // Out: the new position and velocity.
   inline void operator()(float& px, float& py, float& pz, float& vx, float& vy, float& vz, float hx,
                          float hy, float hz, float nx, float ny, float nz, float tau) const {
-    const float vn = vx * nx + vy * ny + vz * nz;
-    const float vnx = vn * nx, vny = vn * ny, vnz = vn * nz;
-    const float tx = vx - vnx, ty = vy - vny, tz = vz - vnz;
-    const float t2 = tx * tx + ty * ty + tz * tz;
-    const float f = t2 > cutoff2 ? keep : 1.0f;  // the one select: vectorises
-    vx = tx * f - vnx * restitution;
-    vy = ty * f - vny * restitution;
-    vz = tz * f - vnz * restitution;
-    px = hx - vx * tau;
-    py = hy - vy * tau;
-    pz = hz - vz * tau;
+    kernel::fl_reflect(kernel::FlReflect{restitution, keep, cutoff2}, &px, &py, &pz, &vx, &vy, &vz,
+                       hx, hy, hz, nx, ny, nz, tau);
   }
 };
 
@@ -469,198 +469,39 @@ inline void bouncePlanarAccelLoop(float* __restrict px, float* __restrict py, fl
   }
 }
 
-/// A sphere deflecting from outside (Inside = false) or keeping particles in (Inside = true).
+/// A sphere deflecting from outside (Inside = false) or keeping particles in (Inside = true):
+/// kernels/deflect.h, shared with the device.
 template <bool Inside, class Dt>
 inline void bounceSphereLoop(float* __restrict px, float* __restrict py, float* __restrict pz,
                              float* __restrict vxs, float* __restrict vys, float* __restrict vzs,
                              std::size_t n, Dt dts, const SphereDomain& s, const Bounce& b) {
-  const Reflect reflect{b.restitution, 1.0f - b.friction, b.cutoff * b.cutoff};
+  const kernel::FlReflect rf{b.restitution, 1.0f - b.friction, b.cutoff * b.cutoff};
   const Vec3 C = s.center;
   const float R = s.outerRadius, R2 = R * R, invR = 1.0f / R;
   const float scaleC = std::abs(C.x) + std::abs(C.y) + std::abs(C.z) + R;
-  for (std::size_t i = 0; i < n; ++i) {
-    const float dt = dts[i];
-    const float x = px[i], y = py[i], z = pz[i];
-    const float vx = vxs[i], vy = vys[i], vz = vzs[i];
-    const float rx = x - C.x, ry = y - C.y, rz = z - C.z;
-    const float c2 = rx * rx + ry * ry + rz * rz - R2;
-    const float bb = rx * vx + ry * vy + rz * vz;
-    const float aa = vx * vx + vy * vy + vz * vz;
-    const float disc = bb * bb - aa * c2;
-    const float root = std::sqrt(std::max(disc, 0.0f));
-    // Outside: the entry root; inside: the exit root. inf/NaN (aa = 0) is a miss.
-    const float tHit = Inside ? (-bb + root) / aa : (-bb - root) / aa;
-    const bool hit = Inside ? (c2 <= 0.0f) & (tHit <= dt)
-                            : (c2 >= 0.0f) & (disc >= 0.0f) & (bb < 0.0f) & (tHit <= dt);
-    const float tau = std::max(tHit, 0.0f);
-    const float hx = x + vx * tau, hy = y + vy * tau, hz = z + vz * tau;
-    const float nnx = (hx - C.x) * invR, nny = (hy - C.y) * invR, nnz = (hz - C.z) * invR;
-    float nx = x, ny = y, nz = z, nvx = vx, nvy = vy, nvz = vz;
-    reflect(nx, ny, nz, nvx, nvy, nvz, hx, hy, hz, nnx, nny, nnz, tau);
-    const float qx = nx + nvx * dt - C.x, qy = ny + nvy * dt - C.y, qz = nz + nvz * dt - C.z;
-    // Signed clearance on the allowed side: outside it is |q| - R, inside R - |q|.
-    const float qd = Inside ? R - std::sqrt(qx * qx + qy * qy + qz * qz)
-                            : std::sqrt(qx * qx + qy * qy + qz * qz) - R;
-    const float margin = 4e-7f * (std::abs(qx) + std::abs(qy) + std::abs(qz) + scaleC +
-                                  std::abs(nvx * dt) + std::abs(nvy * dt) + std::abs(nvz * dt)) +
-                         1e-30f;
-    const float push = std::max(2.0f * margin - qd, 0.0f) * (Inside ? -1.0f : 1.0f);
-    // Inside, a reflected path that reaches the wall again (|v|·dt longer than the chord),
-    // or ends too close to it, is left as it was for the exact loop below: its end is near
-    // another point of the wall, where this hit's normal does not point inwards.
-    const bool again = Inside && qd < 2.0f * margin;
-    float ox = x, oy = y, oz = z, ovx = vx, ovy = vy, ovz = vz;
-    if (hit & !again) {
-      ox = nx + push * nnx;
-      oy = ny + push * nny;
-      oz = nz + push * nnz;
-      ovx = nvx;
-      ovy = nvy;
-      ovz = nvz;
-    }
-    px[i] = ox;
-    py[i] = oy;
-    pz[i] = oz;
-    vxs[i] = ovx;
-    vys[i] = ovy;
-    vzs[i] = ovz;
-  }
-  if constexpr (Inside) {
-    // A particle that crosses the sphere more than once in a step bounces at every exit for
-    // what is left of the step, from where it began; past 16 bounces it ends inside.
-    for (std::size_t i = 0; i < n; ++i) {
-      const float dt = dts[i];
-      const Vec3 p(px[i], py[i], pz[i]);
-      Vec3 v(vxs[i], vys[i], vzs[i]);
-      const float slack = 4e-7f * (R + glm::length(v) * dt);
-      // Bounced above (its end is inside), or outside to begin with: not ours.
-      if (!(glm::length(p + v * dt - C) > R - slack) || glm::length(p - C) > R + slack) continue;
-      Vec3 cur = p;
-      float left = dt;
-      for (int bounce = 0; bounce < 16; ++bounce) {
-        const Vec3 r = cur - C;
-        const float bb = glm::dot(r, v), aa = glm::dot(v, v), c2 = glm::dot(r, r) - R2;
-        const float root = std::sqrt(std::max(bb * bb - aa * c2, 0.0f));
-        // The exit root, in the form without cancellation for either sign of bb.
-        const float t = std::max(bb > 0.0f ? -c2 / (bb + root) : (root - bb) / aa, 0.0f);
-        if (!(t < left)) break;  // stays inside for the rest of the step
-        cur += v * t;
-        left -= t;
-        const Vec3 nrm = (cur - C) * invR;  // on the sphere: never the centre
-        float qx = cur.x, qy = cur.y, qz = cur.z, nvx = v.x, nvy = v.y, nvz = v.z;
-        reflect(qx, qy, qz, nvx, nvy, nvz, cur.x, cur.y, cur.z, nrm.x, nrm.y, nrm.z, 0.0f);
-        v = Vec3(nvx, nvy, nvz);
-      }
-      Vec3 pos = cur + v * left;
-      // Inside by more than Move's rounding of p + v·dt, which grows with |v|·dt.
-      const float margin = 4e-6f * R + 1e-6f * glm::length(v) * dt;
-      const float dist = glm::length(pos - C);
-      if (dist > R - margin) pos = C + (pos - C) * (std::max(R - margin, 0.5f * R) / dist);
-      const Vec3 start = pos - v * dt;
-      px[i] = start.x;
-      py[i] = start.y;
-      pz[i] = start.z;
-      vxs[i] = v.x;
-      vys[i] = v.y;
-      vzs[i] = v.z;
-    }
-  }
+  for (std::size_t i = 0; i < n; ++i)
+    kernel::fl_bounce_sphere_once(rf, C.x, C.y, C.z, R, R2, invR, scaleC, Inside, dts[i], &px[i],
+                                  &py[i], &pz[i], &vxs[i], &vys[i], &vzs[i]);
+  if constexpr (Inside)
+    for (std::size_t i = 0; i < n; ++i)
+      kernel::fl_bounce_sphere_again(rf, C.x, C.y, C.z, R, R2, invR, dts[i], &px[i], &py[i], &pz[i],
+                                     &vxs[i], &vys[i], &vzs[i]);
 }
 
-/// A box keeping particles inside: each axis is its own pair of walls (exact for an
-/// axis-aligned box, also in corners); friction acts on the other two axes on a hit.
-template <class Dt>
-inline void bounceBoxInside(float* __restrict px, float* __restrict py, float* __restrict pz,
-                            float* __restrict vxs, float* __restrict vys, float* __restrict vzs,
-                            std::size_t n, Dt dts, const BoxDomain& box, const Bounce& b) {
-  float* p[3] = {px, py, pz};
-  float* v[3] = {vxs, vys, vzs};
-  const float e = b.restitution, keep = 1.0f - b.friction, cut2 = b.cutoff * b.cutoff;
-  for (std::size_t i = 0; i < n; ++i) {
-    const float dt = dts[i];
-    bool hit[3];
-    float wall[3], tau[3];
-    for (int k = 0; k < 3; ++k) {
-      const float x = p[k][i], vk = v[k][i];
-      const float q = x + vk * dt;
-      hit[k] = q < box.min[k] || q > box.max[k];
-      wall[k] = q > box.max[k] ? box.max[k] : box.min[k];
-      tau[k] = hit[k] ? std::clamp((wall[k] - x) / vk, 0.0f, dt) : 0.0f;
-    }
-    if (!(hit[0] || hit[1] || hit[2])) continue;
-    // The final velocity first: reflected on the axes that hit, slowed by friction on the
-    // others; then positions that Move will carry to their reflected places.
-    float nv[3];
-    for (int k = 0; k < 3; ++k) {
-      nv[k] = hit[k] ? -v[k][i] * e : v[k][i];
-      for (int j = 0; j < 3; ++j) {
-        if (j == k || !hit[j]) continue;
-        const int a1 = (j + 1) % 3, a2 = (j + 2) % 3;
-        const float t2 = v[a1][i] * v[a1][i] + v[a2][i] * v[a2][i];
-        if (t2 > cut2) nv[k] *= keep;
-      }
-    }
-    for (int k = 0; k < 3; ++k) {
-      if (hit[k]) {
-        const float margin = 4e-7f * (std::abs(wall[k]) + std::abs(nv[k] * dt)) + 1e-30f;
-        const float end =
-            std::clamp(wall[k] + nv[k] * (dt - tau[k]), box.min[k] + margin, box.max[k] - margin);
-        p[k][i] = end - nv[k] * dt;
-      }
-      // A slower velocity on an axis that did not hit stays between here and the old end.
-      v[k][i] = nv[k];
-    }
-  }
-}
-
-/// A box deflecting from outside: the segment's entry face (slab method).
-template <class Dt>
-inline void bounceBoxOutside(float* __restrict px, float* __restrict py, float* __restrict pz,
-                             float* __restrict vxs, float* __restrict vys, float* __restrict vzs,
-                             std::size_t n, Dt dts, const BoxDomain& box, const Bounce& b) {
-  const Reflect reflect{b.restitution, 1.0f - b.friction, b.cutoff * b.cutoff};
-  for (std::size_t i = 0; i < n; ++i) {
-    const float dt = dts[i];
-    const Vec3 p(px[i], py[i], pz[i]), v(vxs[i], vys[i], vzs[i]);
-    if (detail::inside(box, p)) continue;  // already in: not this deflector's business
-    float tEnter = 0.0f, tExit = dt;
-    int axis = -1;
-    bool miss = false;
-    for (int k = 0; k < 3 && !miss; ++k) {
-      if (v[k] == 0.0f) {
-        miss = p[k] < box.min[k] || p[k] > box.max[k];
-        continue;
-      }
-      float t0 = (box.min[k] - p[k]) / v[k], t1 = (box.max[k] - p[k]) / v[k];
-      if (t0 > t1) std::swap(t0, t1);
-      if (t0 > tEnter) {
-        tEnter = t0;
-        axis = k;
-      }
-      tExit = std::min(tExit, t1);
-      miss = tEnter > tExit;
-    }
-    if (miss || axis < 0) continue;
-    Vec3 nrm(0.0f);
-    nrm[axis] = v[axis] > 0.0f ? -1.0f : 1.0f;
-    const Vec3 h = p + v * tEnter;
-    float nx = p.x, ny = p.y, nz = p.z, nvx = v.x, nvy = v.y, nvz = v.z;
-    reflect(nx, ny, nz, nvx, nvy, nvz, h.x, h.y, h.z, nrm.x, nrm.y, nrm.z, tEnter);
-    Vec3 np(nx, ny, nz);
-    const Vec3 nv(nvx, nvy, nvz);
-    // Keep the end of the step outside the entry face.
-    const float face = nrm[axis] > 0.0f ? box.max[axis] : box.min[axis];
-    const float q = np[axis] + nv[axis] * dt;
-    const float margin = 4e-7f * (std::abs(face) + std::abs(q)) + 1e-30f;
-    const float clearance = (q - face) * nrm[axis];
-    if (clearance < margin) np[axis] += (2.0f * margin - clearance) * nrm[axis];
-    px[i] = np.x;
-    py[i] = np.y;
-    pz[i] = np.z;
-    vxs[i] = nv.x;
-    vys[i] = nv.y;
-    vzs[i] = nv.z;
-  }
+/// A box keeping particles in, or deflecting them from outside: kernels/deflect.h.
+template <bool Inside, class Dt>
+inline void bounceBoxLoop(float* __restrict px, float* __restrict py, float* __restrict pz,
+                          float* __restrict vxs, float* __restrict vys, float* __restrict vzs,
+                          std::size_t n, Dt dts, const BoxDomain& box, const Bounce& b) {
+  const kernel::FlReflect rf{b.restitution, 1.0f - b.friction, b.cutoff * b.cutoff};
+  const float lo[3] = {box.min.x, box.min.y, box.min.z}, hi[3] = {box.max.x, box.max.y, box.max.z};
+  for (std::size_t i = 0; i < n; ++i)
+    if constexpr (Inside)
+      kernel::fl_bounce_box_inside(rf, lo, hi, dts[i], &px[i], &py[i], &pz[i], &vxs[i], &vys[i],
+                                   &vzs[i]);
+    else
+      kernel::fl_bounce_box_outside(rf, lo, hi, dts[i], &px[i], &py[i], &pz[i], &vxs[i], &vys[i],
+                                    &vzs[i]);
 }
 
 // Calls f(P, N, onPiece) for a planar Bounce surface (plane, rectangle, triangle, disc, and
@@ -734,9 +575,9 @@ inline void apply(const Bounce& a, const Lanes& L, std::size_t n, const BlockCon
         bounceSphereLoop<false>(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, dt, *s, a);
     } else if (const auto* bx = std::get_if<BoxDomain>(&shape)) {
       if (a.inside)
-        bounceBoxInside(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, dt, *bx, a);
+        bounceBoxLoop<true>(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, dt, *bx, a);
       else
-        bounceBoxOutside(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, dt, *bx, a);
+        bounceBoxLoop<false>(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, dt, *bx, a);
     }
   });
 }

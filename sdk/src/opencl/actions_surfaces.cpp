@@ -114,8 +114,7 @@ bool generateSurfaceAction(const Action& act, ActionSource& s) {
     if (std::holds_alternative<SphereDomain>(shape))
       s.apply = "fl_bounce_sphere(" + ap + ", " + in + ", dt, " + pv;
     else if (std::holds_alternative<BoxDomain>(shape))
-      s.apply = std::string(b->inside ? "fl_bounce_box_inside(" : "fl_bounce_box_outside(") + ap +
-                ", dt, " + pv;
+      s.apply = "fl_bounce_box(" + ap + ", " + in + ", dt, " + pv;
     else if (pieceOf(b->surface) >= 0)
       s.apply =
           "fl_bounce_planar(" + ap + ", " + std::to_string(pieceOf(b->surface)) + ", dt, " + pv;

@@ -520,8 +520,9 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   s << " } while (0)\n#define FL_LANE_ARGS ";
   for (std::size_t k = 0; k < all.size(); ++k) s << (k ? ", " : "") << "l_" << all[k].name;
   s << "\n";
-  for (const char* f : {"compat_opencl.h", "params.h", "philox.h", "noise.h", "domain.cl",
-                        "actions.cl", "forces.cl", "surfaces.cl", "compact.cl", "emit.cl"})
+  for (const char* f :
+       {"compat_opencl.h", "math.h", "params.h", "philox.h", "noise.h", "deflect.h", "domain.cl",
+        "actions.cl", "forces.cl", "surfaces.cl", "compact.cl", "emit.cl"})
     s << "/* ---- " << f << " */\n" << embeddedKernel(f) << "\n";
 
   s << "/* ---- generated: emission */\n" << emitSource;

@@ -1,0 +1,226 @@
+/* Deflectors (Bounce) on spheres and boxes, and the reflection every deflector shares: written
+ * once for both backends in the kernels' shared C subset (compat_opencl.h on the device,
+ * sdk/src/kernel_compat.hpp on the CPU, whose loops call these per particle and still
+ * vectorise). Scalars in, the particle's state through pointers; what a deflector needs comes
+ * as arguments, so each side keeps its own way of storing the action's constants.
+ *
+ * Every function is branch-free where the CPU's loop must vectorise (selects rather than
+ * early returns), and adds x, y, z in glm's order, so the two backends agree to the bit. */
+#ifndef FLURRY_KERNELS_DEFLECT_H
+#define FLURRY_KERNELS_DEFLECT_H
+
+/* How a deflector reflects: the normal part of the velocity is reversed and scaled by
+ * restitution; the tangential part keeps `keep` (1 - friction) when its square exceeds
+ * cutoff2. */
+typedef struct FlReflect {
+  float restitution, keep, cutoff2;
+} FlReflect;
+
+/* Reflects the velocity (vx, vy, vz) at the hit point h (unit normal n, time of impact tau)
+ * and places the particle so that the following Move ends it at the reflected point. */
+FL_INLINE void fl_reflect(FlReflect r, float* px, float* py, float* pz, float* vx, float* vy,
+                          float* vz, float hx, float hy, float hz, float nx, float ny, float nz,
+                          float tau) {
+  const float vn = *vx * nx + *vy * ny + *vz * nz;
+  const float vnx = vn * nx, vny = vn * ny, vnz = vn * nz;
+  const float tx = *vx - vnx, ty = *vy - vny, tz = *vz - vnz;
+  const float t2 = tx * tx + ty * ty + tz * tz;
+  const float f = t2 > r.cutoff2 ? r.keep : 1.0f; /* the one select: vectorises */
+  *vx = tx * f - vnx * r.restitution;
+  *vy = ty * f - vny * r.restitution;
+  *vz = tz * f - vnz * r.restitution;
+  *px = hx - *vx * tau;
+  *py = hy - *vy * tau;
+  *pz = hz - *vz * tau;
+}
+
+/* A sphere (centre C, radius R, R2 = R², invR = 1/R, scale = |C|₁ + R) deflecting from
+ * outside (inside = 0) or keeping particles in (inside = 1): one reflection where the step's
+ * straight path first meets it. Inside, a reflected path that reaches the wall again, or ends
+ * too close to it, is left as it was for fl_bounce_sphere_again: its end is near another point
+ * of the wall, where this hit's normal does not point inwards. */
+FL_INLINE void fl_bounce_sphere_once(FlReflect rf, float Cx, float Cy, float Cz, float R, float R2,
+                                     float invR, float scale, int inside, float dt, float* px,
+                                     float* py, float* pz, float* vxs, float* vys, float* vzs) {
+  const float x = *px, y = *py, z = *pz, vx = *vxs, vy = *vys, vz = *vzs;
+  const float rx = x - Cx, ry = y - Cy, rz = z - Cz;
+  const float c2 = rx * rx + ry * ry + rz * rz - R2;
+  const float bb = rx * vx + ry * vy + rz * vz;
+  const float aa = vx * vx + vy * vy + vz * vz;
+  const float disc = bb * bb - aa * c2;
+  const float root = sqrt(fl_maxf(disc, 0.0f));
+  /* Outside: the entry root; inside: the exit root. inf/NaN (aa = 0) is a miss. */
+  const float tHit = inside ? (-bb + root) / aa : (-bb - root) / aa;
+  const int hit = inside ? (c2 <= 0.0f) & (tHit <= dt)
+                         : (c2 >= 0.0f) & (disc >= 0.0f) & (bb < 0.0f) & (tHit <= dt);
+  const float tau = fl_maxf(tHit, 0.0f);
+  const float hx = x + vx * tau, hy = y + vy * tau, hz = z + vz * tau;
+  const float nnx = (hx - Cx) * invR, nny = (hy - Cy) * invR, nnz = (hz - Cz) * invR;
+  float nx = x, ny = y, nz = z, nvx = vx, nvy = vy, nvz = vz;
+  fl_reflect(rf, &nx, &ny, &nz, &nvx, &nvy, &nvz, hx, hy, hz, nnx, nny, nnz, tau);
+  const float qx = nx + nvx * dt - Cx, qy = ny + nvy * dt - Cy, qz = nz + nvz * dt - Cz;
+  /* Signed clearance on the allowed side: outside it is |q| - R, inside R - |q|. */
+  const float ql = sqrt(qx * qx + qy * qy + qz * qz);
+  const float qd = inside ? R - ql : ql - R;
+  const float margin = 4e-7f * (fabs(qx) + fabs(qy) + fabs(qz) + scale + fabs(nvx * dt) +
+                                fabs(nvy * dt) + fabs(nvz * dt)) +
+                       1e-30f;
+  const float push = fl_maxf(2.0f * margin - qd, 0.0f) * (inside ? -1.0f : 1.0f);
+  const int take = hit & !(inside & (qd < 2.0f * margin));
+  *px = take ? nx + push * nnx : x;
+  *py = take ? ny + push * nny : y;
+  *pz = take ? nz + push * nnz : z;
+  *vxs = take ? nvx : vx;
+  *vys = take ? nvy : vy;
+  *vzs = take ? nvz : vz;
+}
+
+/* Inside a sphere, after fl_bounce_sphere_once: a particle that crosses the sphere more than
+ * once in a step bounces at every exit for what is left of the step, from where it began;
+ * past 16 bounces it ends inside. Particles whose step ends inside are left as they are. */
+FL_INLINE void fl_bounce_sphere_again(FlReflect rf, float Cx, float Cy, float Cz, float R,
+                                      float R2, float invR, float dt, float* px, float* py,
+                                      float* pz, float* vxs, float* vys, float* vzs) {
+  const float x = *px, y = *py, z = *pz;
+  float vx = *vxs, vy = *vys, vz = *vzs;
+  const float speed = sqrt(vx * vx + vy * vy + vz * vz);
+  const float slack = 4e-7f * (R + speed * dt);
+  const float ex = x + vx * dt - Cx, ey = y + vy * dt - Cy, ez = z + vz * dt - Cz;
+  const float bx = x - Cx, by = y - Cy, bz = z - Cz;
+  /* Bounced already (its end is inside), or outside to begin with: not ours. */
+  if (!(sqrt(ex * ex + ey * ey + ez * ez) > R - slack) ||
+      sqrt(bx * bx + by * by + bz * bz) > R + slack)
+    return;
+  float cx = x, cy = y, cz = z;
+  float left = dt;
+  for (int bounce = 0; bounce < 16; ++bounce) {
+    const float rx = cx - Cx, ry = cy - Cy, rz = cz - Cz;
+    const float bb = rx * vx + ry * vy + rz * vz, aa = vx * vx + vy * vy + vz * vz,
+                c2 = rx * rx + ry * ry + rz * rz - R2;
+    const float root = sqrt(fl_maxf(bb * bb - aa * c2, 0.0f));
+    /* The exit root, in the form without cancellation for either sign of bb. */
+    const float t = fl_maxf(bb > 0.0f ? -c2 / (bb + root) : (root - bb) / aa, 0.0f);
+    if (!(t < left)) break; /* stays inside for the rest of the step */
+    cx += vx * t;
+    cy += vy * t;
+    cz += vz * t;
+    left -= t;
+    /* On the sphere: never the centre. */
+    const float nx = (cx - Cx) * invR, ny = (cy - Cy) * invR, nz = (cz - Cz) * invR;
+    float qx = cx, qy = cy, qz = cz;
+    fl_reflect(rf, &qx, &qy, &qz, &vx, &vy, &vz, cx, cy, cz, nx, ny, nz, 0.0f);
+  }
+  float ox = cx + vx * left, oy = cy + vy * left, oz = cz + vz * left;
+  /* Inside by more than Move's rounding of p + v·dt, which grows with |v|·dt. */
+  const float margin = 4e-6f * R + 1e-6f * sqrt(vx * vx + vy * vy + vz * vz) * dt;
+  const float dx = ox - Cx, dy = oy - Cy, dz = oz - Cz;
+  const float dist = sqrt(dx * dx + dy * dy + dz * dz);
+  if (dist > R - margin) {
+    const float k = fl_maxf(R - margin, 0.5f * R) / dist;
+    ox = Cx + dx * k;
+    oy = Cy + dy * k;
+    oz = Cz + dz * k;
+  }
+  *px = ox - vx * dt;
+  *py = oy - vy * dt;
+  *pz = oz - vz * dt;
+  *vxs = vx;
+  *vys = vy;
+  *vzs = vz;
+}
+
+/* A box (lo, hi: its corners as arrays of three) keeping particles inside: each axis is its
+ * own pair of walls (exact for an axis-aligned box, also in corners); friction acts on the
+ * other two axes on a hit. */
+FL_INLINE void fl_bounce_box_inside(FlReflect rf, const float* lo, const float* hi, float dt,
+                                    float* px, float* py, float* pz, float* vxs, float* vys,
+                                    float* vzs) {
+  float* p[3] = {px, py, pz};
+  const float v[3] = {*vxs, *vys, *vzs};
+  int hit[3];
+  float wall[3], tau[3];
+  for (int k = 0; k < 3; ++k) {
+    const float x = *p[k], vk = v[k];
+    const float q = x + vk * dt;
+    hit[k] = q < lo[k] || q > hi[k];
+    wall[k] = q > hi[k] ? hi[k] : lo[k];
+    tau[k] = hit[k] ? fl_clampf((wall[k] - x) / vk, 0.0f, dt) : 0.0f;
+  }
+  if (!(hit[0] || hit[1] || hit[2])) return;
+  /* The final velocity first: reflected on the axes that hit, slowed by friction on the
+   * others; then positions that Move will carry to their reflected places. */
+  float nv[3];
+  for (int k = 0; k < 3; ++k) {
+    nv[k] = hit[k] ? -v[k] * rf.restitution : v[k];
+    for (int j = 0; j < 3; ++j) {
+      if (j == k || !hit[j]) continue;
+      const int a1 = (j + 1) % 3, a2 = (j + 2) % 3;
+      const float t2 = v[a1] * v[a1] + v[a2] * v[a2];
+      if (t2 > rf.cutoff2) nv[k] *= rf.keep;
+    }
+  }
+  for (int k = 0; k < 3; ++k) {
+    if (hit[k]) {
+      const float margin = 4e-7f * (fabs(wall[k]) + fabs(nv[k] * dt)) + 1e-30f;
+      const float end = fl_clampf(wall[k] + nv[k] * (dt - tau[k]), lo[k] + margin, hi[k] - margin);
+      *p[k] = end - nv[k] * dt;
+    }
+  }
+  /* A slower velocity on an axis that did not hit stays between here and the old end. */
+  *vxs = nv[0];
+  *vys = nv[1];
+  *vzs = nv[2];
+}
+
+/* A box deflecting from outside: the segment's entry face (slab method). */
+FL_INLINE void fl_bounce_box_outside(FlReflect rf, const float* lo, const float* hi, float dt,
+                                     float* px, float* py, float* pz, float* vxs, float* vys,
+                                     float* vzs) {
+  const float p[3] = {*px, *py, *pz}, v[3] = {*vxs, *vys, *vzs};
+  /* Already in: not this deflector's business. */
+  if ((p[0] >= lo[0]) & (p[0] <= hi[0]) & (p[1] >= lo[1]) & (p[1] <= hi[1]) & (p[2] >= lo[2]) &
+      (p[2] <= hi[2]))
+    return;
+  float tEnter = 0.0f, tExit = dt;
+  int axis = -1;
+  int miss = 0;
+  for (int k = 0; k < 3 && !miss; ++k) {
+    if (v[k] == 0.0f) {
+      miss = p[k] < lo[k] || p[k] > hi[k];
+      continue;
+    }
+    float t0 = (lo[k] - p[k]) / v[k], t1 = (hi[k] - p[k]) / v[k];
+    if (t0 > t1) {
+      const float s = t0;
+      t0 = t1;
+      t1 = s;
+    }
+    if (t0 > tEnter) {
+      tEnter = t0;
+      axis = k;
+    }
+    tExit = fl_minf(tExit, t1);
+    miss = tEnter > tExit;
+  }
+  if (miss || axis < 0) return;
+  float nrm[3] = {0.0f, 0.0f, 0.0f};
+  nrm[axis] = v[axis] > 0.0f ? -1.0f : 1.0f;
+  const float hx = p[0] + v[0] * tEnter, hy = p[1] + v[1] * tEnter, hz = p[2] + v[2] * tEnter;
+  float np[3] = {p[0], p[1], p[2]}, nv[3] = {v[0], v[1], v[2]};
+  fl_reflect(rf, &np[0], &np[1], &np[2], &nv[0], &nv[1], &nv[2], hx, hy, hz, nrm[0], nrm[1],
+             nrm[2], tEnter);
+  /* Keep the end of the step outside the entry face. */
+  const float face = nrm[axis] > 0.0f ? hi[axis] : lo[axis];
+  const float q = np[axis] + nv[axis] * dt;
+  const float margin = 4e-7f * (fabs(face) + fabs(q)) + 1e-30f;
+  const float clearance = (q - face) * nrm[axis];
+  if (clearance < margin) np[axis] += (2.0f * margin - clearance) * nrm[axis];
+  *px = np[0];
+  *py = np[1];
+  *pz = np[2];
+  *vxs = nv[0];
+  *vys = nv[1];
+  *vzs = nv[2];
+}
+
+#endif /* FLURRY_KERNELS_DEFLECT_H */
