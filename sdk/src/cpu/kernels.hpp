@@ -479,9 +479,14 @@ inline void bounceSphereLoop(float* __restrict px, float* __restrict py, float* 
   const Vec3 C = s.center;
   const float R = s.outerRadius, R2 = R * R, invR = 1.0f / R;
   const float scaleC = std::abs(C.x) + std::abs(C.y) + std::abs(C.z) + R;
-  for (std::size_t i = 0; i < n; ++i)
-    kernel::fl_bounce_sphere_once(rf, C.x, C.y, C.z, R, R2, invR, scaleC, Inside, dts[i], &px[i],
-                                  &py[i], &pz[i], &vxs[i], &vys[i], &vzs[i]);
+  // Through locals: the kernel's pointers would hide the arrays' __restrict from the
+  // vectoriser.
+  for (std::size_t i = 0; i < n; ++i) {
+    float x = px[i], y = py[i], z = pz[i], vx = vxs[i], vy = vys[i], vz = vzs[i];
+    kernel::fl_bounce_sphere_once(rf, C.x, C.y, C.z, R, R2, invR, scaleC, Inside, dts[i], &x, &y,
+                                  &z, &vx, &vy, &vz);
+    px[i] = x, py[i] = y, pz[i] = z, vxs[i] = vx, vys[i] = vy, vzs[i] = vz;
+  }
   if constexpr (Inside)
     for (std::size_t i = 0; i < n; ++i)
       kernel::fl_bounce_sphere_again(rf, C.x, C.y, C.z, R, R2, invR, dts[i], &px[i], &py[i], &pz[i],
