@@ -5,13 +5,21 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
-cmake --preset release >/dev/null
+# Quiet unless it fails (Debian's FindOpenVDB prints "COMPONENT = openvdb" on every run).
+if ! log=$(cmake --preset release 2>&1); then
+  echo "$log" >&2
+  exit 1
+fi
 cmake --build --preset release -j "$(nproc)" --target flurry_cli
 # Progress as a bar on a terminal, as ten whole lines in a log (not a line per frame).
 export FLURRY_PROGRESS="${FLURRY_PROGRESS:-1}"
 out=out/fountain
-./build/release/bin/flurry run fountain --frames 300 --every 30 --out "$out" \
-  --png "$out" --vdb "$out" --vdb-every 30 "$@"
+# The defaults below, each unless an extra argument gives it (the tool takes an option once).
+args=()
+for d in "--frames 300" "--every 30" "--out $out" "--png $out" "--vdb $out" "--vdb-every 30"; do
+  case " $* " in *" ${d%% *} "*) ;; *) read -ra kv <<<"$d" && args+=("${kv[@]}") ;; esac
+done
+./build/release/bin/flurry run fountain "${args[@]}" "$@"
 # The newest PNG is this run's last frame (extra arguments may change the frame count).
 last=$(ls -t "$out"/fountain.*.png 2>/dev/null | head -n 1 || true)
 echo

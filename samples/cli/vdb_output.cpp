@@ -21,14 +21,18 @@ using Clock = std::chrono::steady_clock;
 class VdbPlugin final : public Plugin {
  public:
   void addOptions(CLI::App&, CLI::App& run) override {
-    run.add_option("--vdb", folder_, "write OpenVDB files (EFFECT.0001.vdb, ...) to this folder");
+    run.add_option("--vdb", folder_,
+                   "write OpenVDB files (EFFECT.0001.vdb, ...) to this folder: fog grids density, "
+                   "vel, Cd and the point grid 'points'; hair also as curves, the point grid "
+                   "'strands' whose strand_id and strand_vertex rebuild them (docs/vdb-export.md); "
+                   "static hair is written once, not every frame");
     run.add_option("--vdb-every", every_, "write a VDB file every N frames (and the last)")
         ->check(CLI::Range(1, 1000000));
     run.add_flag("--vdb-fog", fogOnly_, "write only the fog volume (density, vel, Cd)");
     run.add_flag("--vdb-points", pointsOnly_, "write only the points (PointDataGrid 'points')");
     run.add_option("--voxel-size", options_.fogVoxelSize,
                    "fog voxel size in world units (default: half the median particle radius, "
-                   "or for hair half a strand segment)")
+                   "or for hair half a strand segment; coarser if the fog would pass 2^24 voxels)")
         ->check(CLI::PositiveNumber);
     run.add_option("--points-voxel-size", options_.pointsVoxelSize,
                    "voxel size of the points and strands grids (default: about 8 points per voxel)")

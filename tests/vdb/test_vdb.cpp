@@ -540,11 +540,11 @@ TEST(VdbStrands, PointsRebuildTheCurves) {
 TEST(VdbStrands, AutomaticVoxelSizeSuitsThinStrands) {
   // Thin strands (radius 0.002) with vertices 0.05 apart: voxels of half a segment, not of
   // half the radius (which would be 25 times finer: millions of voxels for a head of hair).
-  auto strands = [](float radius, float segment) {
+  auto strands = [](float radius, float segment, float apart = 0.1f) {
     Strands s;
     for (int k = 0; k < 20; ++k) {
       std::vector<Vec3> p;
-      for (int i = 0; i < 10; ++i) p.push_back(Vec3(0.1f * float(k), segment * float(i), 0.0f));
+      for (int i = 0; i < 10; ++i) p.push_back(Vec3(apart * float(k), segment * float(i), 0.0f));
       s.add(p, std::vector<Vec4>(p.size(), Vec4(1.0f)), std::vector<float>(p.size(), radius));
     }
     return s;
@@ -552,6 +552,10 @@ TEST(VdbStrands, AutomaticVoxelSizeSuitsThinStrands) {
   vdb::Frame thin;
   thin.strands.push_back(strands(0.002f, 0.05f));
   EXPECT_FLOAT_EQ(vdb::fogVoxelSize(thin), 0.025f);
+  // The strands set it, not how far apart they lie (the scene's extent).
+  vdb::Frame spread;
+  spread.strands.push_back(strands(0.002f, 0.05f, 10.0f));
+  EXPECT_FLOAT_EQ(vdb::fogVoxelSize(spread), 0.025f);
   // A thick strand still gets four voxels across.
   vdb::Frame thick;
   thick.strands.push_back(strands(0.1f, 0.05f));
@@ -574,6 +578,50 @@ TEST(VdbStrands, AutomaticVoxelSizeSuitsThinStrands) {
   EXPECT_FLOAT_EQ(st.fogVoxelSize, 0.025f);
   const double tube = 20 * 9 * std::numbers::pi * 0.002 * 0.002 * 0.05;
   EXPECT_NEAR(st.mass, tube, 1e-6 * tube);  // float vertices and radii
+  EXPECT_NEAR(integral(*VdbFile(path).get<openvdb::FloatGrid>("density")), tube,
+              kMassTolerance * tube);
+}
+
+TEST(VdbStrands, AutomaticVoxelSizeFitsTheMemoryCap) {
+  // Fine strands, n of 500 vertices 0.001 apart on a grid 0.01 apart (no two kernels
+  // overlap): half a segment is 0.0005, and each segment then covers ~14 voxels.
+  auto strands = [](int n) {
+    Strands s;
+    for (int k = 0; k < n; ++k) {
+      for (int i = 0; i < 500; ++i)
+        s.position.push_back(Vec3(0.01f * float(k % 64), 0.001f * float(i), 0.01f * float(k / 64)));
+      s.radius.insert(s.radius.end(), 500, 0.0004f);
+      s.start.push_back(std::uint32_t(s.position.size()));
+    }
+    return s;
+  };
+  // 3000 strands: ~21 million voxels at 0.0005, over the default cap of 2^24: coarser.
+  vdb::Frame big;
+  big.strands.push_back(strands(3000));
+  const float capped = vdb::fogVoxelSize(big);
+  EXPECT_GT(capped, 0.0005f * 1.05f);
+  // Just coarse enough: a tube at the least kernel width has voxels as 1/size, so ~21/16.8.
+  EXPECT_LT(capped, 0.0005f * 1.5f);
+  vdb::ExportOptions uncapped;
+  uncapped.fogMaxVoxels = 0;
+  EXPECT_NEAR(vdb::fogVoxelSize(big, uncapped), 0.0005f, 1e-8f);  // float vertices
+  // Under the cap the size is the strands' own.
+  vdb::Frame few;
+  few.strands.push_back(strands(40));
+  EXPECT_NEAR(vdb::fogVoxelSize(few), 0.0005f, 1e-8f);
+  // A small cap, written: the active voxels fit it without being far under it (the count is
+  // estimated: voxel centres against a tube vary by a few percent), and the strands keep
+  // their whole tube volume.
+  vdb::ExportOptions o;
+  o.points = false;
+  o.fogMaxVoxels = 40'000;  // 40 strands ask for ~280k
+  const fs::path path = scratch("capped_strands") / "hair.vdb";
+  const vdb::FileStats st = vdb::writeFile(path, few, o);
+  EXPECT_EQ(st.fogVoxelSize, vdb::fogVoxelSize(few, o));
+  EXPECT_GT(st.fogVoxelSize, 0.001f);
+  EXPECT_LE(st.fogVoxels, o.fogMaxVoxels * 11 / 10);
+  EXPECT_GT(st.fogVoxels, o.fogMaxVoxels / 4);
+  const double tube = 40 * 499 * std::numbers::pi * 0.0004 * 0.0004 * 0.001;
   EXPECT_NEAR(integral(*VdbFile(path).get<openvdb::FloatGrid>("density")), tube,
               kMassTolerance * tube);
 }

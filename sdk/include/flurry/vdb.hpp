@@ -44,6 +44,13 @@ struct ExportOptions {
   /// for a strand vertex, half its radius or half its segment's length, the larger (a thin
   /// strand keeps its volume in voxels wider than it; finer ones add nothing along it).
   float fogVoxelSize = 0.0f;
+  /// Memory cap of the automatic fog voxel size: where the voxel size above would make more
+  /// active voxels than this (estimated from the kernels' volumes, at most the bounding
+  /// box's voxel count; overlaps make it an overestimate, the voxel lattice can add a few
+  /// percent), it is made just coarse enough to fit (0: no cap). Each voxel costs
+  /// 28 bytes in the grids while building and about 13 in the file: 2^24 voxels are about
+  /// 470 MB and 200 MB. An explicit fogVoxelSize is not capped.
+  std::uint64_t fogMaxVoxels = std::uint64_t(1) << 24;
   /// Points voxel edge (of `points` and `strands`); 0 picks, per grid, a size giving about
   /// pointsPerVoxel points per voxel.
   float pointsVoxelSize = 0.0f;

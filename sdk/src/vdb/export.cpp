@@ -12,6 +12,7 @@
 #include <cstring>
 #include <deque>
 #include <exception>
+#include <limits>
 #include <mutex>
 #include <numbers>
 #include <thread>
@@ -142,41 +143,110 @@ Particles Particles::capture(const Group& group, const ExportOptions& o) {
   return out;
 }
 
+namespace {
+
+/// What one sampled particle or strand vertex adds to the fog's active voxels.
+struct Footprint {
+  float r;    ///< its radius
+  float len;  ///< a strand vertex: its segment's length (to the next vertex); particle: < 0
+  bool root;  ///< a strand's first vertex: the tube's two end caps, one ball
+};
+
+/// Active voxels of the fog at voxel size v, estimated from above: each kernel's volume in
+/// voxels (a ball per particle, a tube per segment; overlaps counted twice), and at most the
+/// voxels of the bounding box grown by the largest kernel.
+double estimateVoxels(const std::vector<Footprint>& fp, double weight, Vec3 lo, Vec3 hi, float maxR,
+                      double v, double minKernel) {
+  double sum = 0.0;
+  for (const Footprint& f : fp) {
+    const double h = std::max(double(f.r) / v, minKernel);  // kernel radius in voxels
+    double n = 0.0;
+    if (f.len < 0.0f || f.root) n += std::max(1.0, 4.0 / 3.0 * std::numbers::pi * h * h * h);
+    if (f.len > 0.0f) n += std::numbers::pi * h * h * double(f.len) / v;
+    sum += n;
+  }
+  sum *= weight;
+  const double pad = 2.0 * std::max(double(maxR), minKernel * v);
+  double box = 1.0;
+  for (int a = 0; a < 3; ++a) box *= std::floor((double(hi[a]) - lo[a] + pad) / v) + 1.0;
+  return std::min(sum, box);
+}
+
+}  // namespace
+
 float fogVoxelSize(const Frame& frame, const ExportOptions& o) {
   if (o.fogVoxelSize > 0.0f) return o.fogVoxelSize;
   // The median of what each sample asks for; a strided sample of at most ~64k is plenty.
   // A particle asks for half its radius (four voxels across). A strand vertex asks for no
   // less than half its segment: finer voxels add nothing along a polyline, and a strand
   // thinner than a voxel still deposits its whole tube volume (the kernel spreads it), so
-  // thin hair is not resolved across at the cost of millions of voxels.
+  // thin hair is not resolved across at the cost of millions of voxels. What the strands
+  // and particles are, not how far apart they lie, sets the size; fogMaxVoxels bounds it.
   std::vector<float> wanted;
+  std::vector<Footprint> fp;
   std::size_t total = 0;
   for (const Particles& g : frame.groups) total += g.size();
   for (const Strands& s : frame.strands) total += s.vertexCount();
   const std::size_t stride = std::max<std::size_t>(1, total / 65536);
+  constexpr float kHuge = std::numeric_limits<float>::max();
+  Vec3 lo(kHuge), hi(-kHuge);
+  float maxR = 0.0f;
+  auto extend = [&](Vec3 p, float r) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return;
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+    if (std::isfinite(r)) maxR = std::max(maxR, r);
+  };
   std::size_t k = 0;
   for (const Particles& g : frame.groups)
-    for (std::size_t i = 0; i < g.size(); ++i, ++k)
-      if (k % stride == 0)
-        wanted.push_back(0.5f * (g.radius.empty() ? o.defaultRadius : g.radius[i]));
+    for (std::size_t i = 0; i < g.size(); ++i, ++k) {
+      const float r = g.radius.empty() ? o.defaultRadius : g.radius[i];
+      extend(g.position[i], r);
+      if (k % stride != 0) continue;
+      wanted.push_back(0.5f * r);
+      fp.push_back({r, -1.0f, false});
+    }
   for (const Strands& s : frame.strands)
     for (std::size_t j = 0; j + 1 < s.start.size(); ++j) {
       const std::uint32_t a = s.start[j],
                           b = std::min<std::size_t>(s.start[j + 1], s.vertexCount());
       for (std::uint32_t i = a; i < b; ++i, ++k) {
-        if (k % stride != 0) continue;
         const float r = s.radius.size() > i ? s.radius[i] : o.defaultRadius;
+        extend(s.position[i], r);
+        if (k % stride != 0) continue;
         // The segment that starts here, or for the last vertex the one that ends here.
         const std::uint32_t n = i + 1 < b ? i + 1 : (i > a ? i - 1 : i);
-        const float seg = glm::length(s.position[n] - s.position[i]);
-        wanted.push_back(0.5f * std::max(r, std::isfinite(seg) ? seg : 0.0f));
+        float seg = glm::length(s.position[n] - s.position[i]);
+        if (!std::isfinite(seg)) seg = 0.0f;
+        wanted.push_back(0.5f * std::max(r, seg));
+        fp.push_back({r, i + 1 < b ? seg : 0.0f, i == a});
       }
     }
   std::erase_if(wanted, [](float w) { return !(w > 0.0f) || !std::isfinite(w); });
   if (wanted.empty()) return o.defaultRadius > 0.0f ? 0.5f * o.defaultRadius : 0.025f;
   auto mid = wanted.begin() + std::ptrdiff_t(wanted.size() / 2);
   std::nth_element(wanted.begin(), mid, wanted.end());
-  return *mid;
+  const double v = *mid;
+  if (o.fogMaxVoxels == 0) return float(v);
+  // The memory cap: the coarsest voxel that still fits would waste detail; find the finest
+  // one that fits, by bisection on a log scale (the estimate falls as the voxel grows).
+  const double cap = double(o.fogMaxVoxels), minK = o.fogMinKernelVoxels;
+  auto fits = [&](double x) {
+    return estimateVoxels(fp, double(stride), lo, hi, maxR, x, minK) <= cap;
+  };
+  if (fits(v)) return float(v);
+  double fine = v, coarse = 2.0 * v;
+  // The bounding box's count falls as coarse³ down to a few voxels: a cap below that is met
+  // as nearly as it can be.
+  for (int i = 0; i < 64 && !fits(coarse); ++i) {
+    fine = coarse;
+    coarse *= 2.0;
+  }
+  for (int i = 0; i < 24; ++i) {
+    const double m = std::sqrt(fine * coarse);
+    (fits(m) ? coarse : fine) = m;
+  }
+  return float(coarse);
 }
 
 namespace {
