@@ -223,4 +223,110 @@ FL_INLINE void fl_bounce_box_outside(FlReflect rf, const float* lo, const float*
   *vzs = nv[2];
 }
 
+/* ---- Planar pieces: planes, rectangles, triangles, discs, 2-D segments --------------------
+ * A piece is a point P of its plane and a unit normal N, and a test of whether a point of the
+ * plane lies on it, taken at w = point - P (the fl_on_* below). Deflection is two-sided. */
+
+/* Whether the straight path from (x, y, z) over dt approaches the plane and reaches it.
+ * Ending within a few ulps of the plane counts as arriving on it (Move's p + v·dt may round
+ * onto the plane where d1 does not): bounced at the end of the step and pushed out, so that no
+ * particle comes to rest on a piece by moving. */
+FL_INLINE int fl_planar_reaches(float x, float y, float z, float vx, float vy, float vz, float dt,
+                                float Px, float Py, float Pz, float Nx, float Ny, float Nz) {
+  const float d0 = (x - Px) * Nx + (y - Py) * Ny + (z - Pz) * Nz;
+  const float vn = vx * Nx + vy * Ny + vz * Nz;
+  const float d1 = d0 + vn * dt;
+  const float side = d0 >= 0.0f ? 1.0f : -1.0f;
+  const float reach = 1.2e-7f * (fabs(Nx) * (fabs(x) + fabs(Px) + 2.0f * fabs(vx * dt)) +
+                                 fabs(Ny) * (fabs(y) + fabs(Py) + 2.0f * fabs(vy * dt)) +
+                                 fabs(Nz) * (fabs(z) + fabs(Pz) + 2.0f * fabs(vz * dt))) +
+                      1e-30f;
+  return (side * d1 <= reach) & (side * vn < 0.0f);
+}
+
+/* Where the path meets the plane (the time of impact *tau and the point *h, computed for
+ * every particle: they may be inf where it does not), the side it starts on (±1), and
+ * whether it hits the plane: reaching it, and not born or placed exactly on it (d0 = 0: such
+ * a particle belongs to neither side and leaves freely, whichever way the normal points, so
+ * an emitter on a floor emits through it). The caller adds whether h is on the piece. */
+FL_INLINE int fl_planar_hit(float x, float y, float z, float vx, float vy, float vz, float dt,
+                            float Px, float Py, float Pz, float Nx, float Ny, float Nz, float* side,
+                            float* tau, float* hx, float* hy, float* hz) {
+  const float d0 = (x - Px) * Nx + (y - Py) * Ny + (z - Pz) * Nz;
+  const float vn = vx * Nx + vy * Ny + vz * Nz;
+  const float d1 = d0 + vn * dt;
+  *side = d0 >= 0.0f ? 1.0f : -1.0f;
+  *tau = fl_minf(d0 / (d0 - d1), 1.0f) * dt;
+  *hx = x + vx * *tau;
+  *hy = y + vy * *tau;
+  *hz = z + vz * *tau;
+  return fl_planar_reaches(x, y, z, vx, vy, vz, dt, Px, Py, Pz, Nx, Ny, Nz) & (d0 != 0.0f);
+}
+
+/* The bounce of a particle that hits (hit != 0; the others are left as they are) at h after
+ * tau: reflected, and pushed out if rounding would leave Move's p + v·dt on or behind the
+ * plane. The margin is a few ulps of what decides the side: the coordinates along the normal
+ * and the step Move adds to them; far from the origin along the plane it stays small, so
+ * bounces do not gain height. One if-block (GCC vectorises it; not several selects). */
+FL_INLINE void fl_planar_bounce(FlReflect rf, int hit, float side, float tau, float hx, float hy,
+                                float hz, float dt, float Px, float Py, float Pz, float Nx,
+                                float Ny, float Nz, float* px, float* py, float* pz, float* vxs,
+                                float* vys, float* vzs) {
+  const float x = *px, y = *py, z = *pz, vx = *vxs, vy = *vys, vz = *vzs;
+  float nx = x, ny = y, nz = z, nvx = vx, nvy = vy, nvz = vz;
+  fl_reflect(rf, &nx, &ny, &nz, &nvx, &nvy, &nvz, hx, hy, hz, Nx, Ny, Nz, tau);
+  const float qx = nx + nvx * dt, qy = ny + nvy * dt, qz = nz + nvz * dt;
+  const float qd = side * ((qx - Px) * Nx + (qy - Py) * Ny + (qz - Pz) * Nz);
+  const float margin = 1.2e-7f * (fabs(Nx) * (fabs(qx) + fabs(Px) + fabs(nvx * dt)) +
+                                  fabs(Ny) * (fabs(qy) + fabs(Py) + fabs(nvy * dt)) +
+                                  fabs(Nz) * (fabs(qz) + fabs(Pz) + fabs(nvz * dt))) +
+                       1e-30f;
+  const float push = fl_maxf(margin - qd, 0.0f) * side;
+  float ox = x, oy = y, oz = z, ovx = vx, ovy = vy, ovz = vz;
+  if (hit) {
+    ox = nx + push * Nx;
+    oy = ny + push * Ny;
+    oz = nz + push * Nz;
+    ovx = nvx;
+    ovy = nvy;
+    ovz = nvz;
+  }
+  *px = ox;
+  *py = oy;
+  *pz = oz;
+  *vxs = ovx;
+  *vys = ovy;
+  *vzs = ovz;
+}
+
+/* A rectangle: (s, t) = (w·du, w·dv) in [0, 1]² (du, dv: the dual vectors of its edges,
+ * which also serve a rhombus). */
+FL_INLINE int fl_on_rectangle(float wx, float wy, float wz, float dux, float duy, float duz,
+                              float dvx, float dvy, float dvz) {
+  const float s = wx * dux + wy * duy + wz * duz;
+  const float t = wx * dvx + wy * dvy + wz * dvz;
+  return (s >= 0.0f) & (s <= 1.0f) & (t >= 0.0f) & (t <= 1.0f);
+}
+
+/* A triangle: barycentric (s, u) from the dual vectors d1, d2 of its edges from p0. */
+FL_INLINE int fl_on_triangle(float wx, float wy, float wz, float d1x, float d1y, float d1z,
+                             float d2x, float d2y, float d2z) {
+  const float s = wx * d1x + wy * d1y + wz * d1z;
+  const float u = wx * d2x + wy * d2y + wz * d2z;
+  return (s >= 0.0f) & (u >= 0.0f) & (s + u <= 1.0f);
+}
+
+/* A disc or annulus: outer and inner radii squared. */
+FL_INLINE int fl_on_disc(float wx, float wy, float wz, float outer2, float inner2) {
+  const float r2 = wx * wx + wy * wy + wz * wz;
+  return (r2 <= outer2) & (r2 >= inner2);
+}
+
+/* A 2-D segment (a wall standing on the group's plane): from p0 along dir, len2 = |dir|². */
+FL_INLINE int fl_on_segment(float wx, float wy, float wz, float dx, float dy, float dz,
+                            float len2) {
+  const float t = (wx * dx + wy * dy + wz * dz) / len2;
+  return (t >= 0.0f) & (t <= 1.0f);
+}
+
 #endif /* FLURRY_KERNELS_DEFLECT_H */

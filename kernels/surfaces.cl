@@ -39,71 +39,34 @@ FL_INLINE FlReflect fl_reflect_of(__global const FlActionParams* a) {
 #define FL_PIECE_DISC 3
 #define FL_PIECE_SEGMENT 4
 
-/* Whether a point of the plane lies on the piece (piece is a literal: folded away). */
+/* Whether a point of the plane lies on the piece (piece is a literal: folded away); the
+ * tests are kernels/deflect.h's. f[0..2] the piece's point; rectangle f[10..15] its dual
+ * vectors, triangle f[10..15] its edges' dual vectors, disc f[10] outer² f[11] inner²,
+ * segment f[10..12] its direction f[13] its length². */
 FL_INLINE int fl_on_piece(__global const FlActionParams* a, int piece, float x, float y, float z) {
-  const float wx = x - a->f[0], wy = y - a->f[1], wz = z - a->f[2];
-  if (piece == FL_PIECE_RECTANGLE) {
-    const float s = wx * a->f[10] + wy * a->f[11] + wz * a->f[12];
-    const float t = wx * a->f[13] + wy * a->f[14] + wz * a->f[15];
-    return (s >= 0.0f) & (s <= 1.0f) & (t >= 0.0f) & (t <= 1.0f);
-  }
-  if (piece == FL_PIECE_TRIANGLE) {
-    const float s = wx * a->f[10] + wy * a->f[11] + wz * a->f[12];
-    const float u = wx * a->f[13] + wy * a->f[14] + wz * a->f[15];
-    return (s >= 0.0f) & (u >= 0.0f) & (s + u <= 1.0f);
-  }
-  if (piece == FL_PIECE_DISC) {
-    const float r2 = wx * wx + wy * wy + wz * wz;
-    return (r2 <= a->f[10]) & (r2 >= a->f[11]);
-  }
-  if (piece == FL_PIECE_SEGMENT) {
-    const float t = (wx * a->f[10] + wy * a->f[11] + wz * a->f[12]) / a->f[13];
-    return (t >= 0.0f) & (t <= 1.0f);
-  }
+  __global const float* f = a->f;
+  const float wx = x - f[0], wy = y - f[1], wz = z - f[2];
+  if (piece == FL_PIECE_RECTANGLE)
+    return fl_on_rectangle(wx, wy, wz, f[10], f[11], f[12], f[13], f[14], f[15]);
+  if (piece == FL_PIECE_TRIANGLE)
+    return fl_on_triangle(wx, wy, wz, f[10], f[11], f[12], f[13], f[14], f[15]);
+  if (piece == FL_PIECE_DISC) return fl_on_disc(wx, wy, wz, f[10], f[11]);
+  if (piece == FL_PIECE_SEGMENT) return fl_on_segment(wx, wy, wz, f[10], f[11], f[12], f[13]);
   return 1;
 }
 
-/* A two-sided planar deflector (kernels.hpp bouncePlanarLoop). f[0..2] a point of the
+/* A two-sided planar deflector (kernels/deflect.h, as on the CPU). f[0..2] a point of the
  * plane, f[3..5] its unit normal. */
 FL_INLINE void fl_bounce_planar(__global const FlActionParams* a, int piece, float dt, float* px,
                                 float* py, float* pz, float* vxs, float* vys, float* vzs) {
   const float Px = a->f[0], Py = a->f[1], Pz = a->f[2];
   const float Nx = a->f[3], Ny = a->f[4], Nz = a->f[5];
-  const float x = *px, y = *py, z = *pz, vx = *vxs, vy = *vys, vz = *vzs;
-  const float d0 = (x - Px) * Nx + (y - Py) * Ny + (z - Pz) * Nz;
-  const float vn = vx * Nx + vy * Ny + vz * Nz;
-  const float d1 = d0 + vn * dt;
-  const float side = d0 >= 0.0f ? 1.0f : -1.0f;
-  /* Ending within a few ulps of the plane counts as arriving on it (kernels.hpp
-   * bouncePlanarLoop). */
-  const float reach =
-      1.2e-7f * (fabs(Nx) * (fabs(x) + fabs(Px) + 2.0f * fabs(vx * dt)) +
-                 fabs(Ny) * (fabs(y) + fabs(Py) + 2.0f * fabs(vy * dt)) +
-                 fabs(Nz) * (fabs(z) + fabs(Pz) + 2.0f * fabs(vz * dt))) +
-      1e-30f;
-  const float tau = fl_minf(d0 / (d0 - d1), 1.0f) * dt;
-  const float hx = x + vx * tau, hy = y + vy * tau, hz = z + vz * tau;
-  /* A crossing or an arrival, approaching; one born or placed exactly on the plane (d0 = 0)
-   * belongs to neither side. */
-  const int hit = (side * d1 <= reach) & (side * vn < 0.0f) & (d0 != 0.0f) &
-                  fl_on_piece(a, piece, hx, hy, hz);
-  if (!hit) return;
-  float nx = x, ny = y, nz = z, nvx = vx, nvy = vy, nvz = vz;
-  fl_reflect(fl_reflect_of(a), &nx, &ny, &nz, &nvx, &nvy, &nvz, hx, hy, hz, Nx, Ny, Nz, tau);
-  /* Where Move will put it; pushed out if rounding left it on or behind the plane. */
-  const float qx = nx + nvx * dt, qy = ny + nvy * dt, qz = nz + nvz * dt;
-  const float qd = side * ((qx - Px) * Nx + (qy - Py) * Ny + (qz - Pz) * Nz);
-  const float margin = 1.2e-7f * (fabs(Nx) * (fabs(qx) + fabs(Px) + fabs(nvx * dt)) +
-                                  fabs(Ny) * (fabs(qy) + fabs(Py) + fabs(nvy * dt)) +
-                                  fabs(Nz) * (fabs(qz) + fabs(Pz) + fabs(nvz * dt))) +
-                       1e-30f;
-  const float push = fl_maxf(margin - qd, 0.0f) * side;
-  *px = nx + push * Nx;
-  *py = ny + push * Ny;
-  *pz = nz + push * Nz;
-  *vxs = nvx;
-  *vys = nvy;
-  *vzs = nvz;
+  float side, tau, hx, hy, hz;
+  const int reaches = fl_planar_hit(*px, *py, *pz, *vxs, *vys, *vzs, dt, Px, Py, Pz, Nx, Ny, Nz,
+                                    &side, &tau, &hx, &hy, &hz);
+  if (!(reaches && fl_on_piece(a, piece, hx, hy, hz))) return;
+  fl_planar_bounce(fl_reflect_of(a), 1, side, tau, hx, hy, hz, dt, Px, Py, Pz, Nx, Ny, Nz, px, py,
+                   pz, vxs, vys, vzs);
 }
 
 /* The same deflector when the following Move integrates with the acceleration (ax, ay, az)

@@ -251,78 +251,25 @@ struct Reflect {
   }
 };
 
-/// Where a particle is against a plane (point P, unit normal N) over a step of dt: its
-/// distances at the start and end of the straight path, and how close to the plane its end
-/// counts as arriving on it.
-struct PlanarPath {
-  float d0, vn, d1, side, reach;
-  PlanarPath(float x, float y, float z, float vx, float vy, float vz, float dt, Vec3 P, Vec3 N) {
-    d0 = (x - P.x) * N.x + (y - P.y) * N.y + (z - P.z) * N.z;
-    vn = vx * N.x + vy * N.y + vz * N.z;
-    d1 = d0 + vn * dt;
-    side = d0 >= 0.0f ? 1.0f : -1.0f;
-    // Ending within a few ulps of the plane counts as arriving on it (Move's p + v·dt may
-    // round onto the plane where d1 does not): bounced at the end of the step and pushed
-    // out, so that no particle comes to rest on a piece by moving.
-    reach = 1.2e-7f * (std::abs(N.x) * (std::abs(x) + std::abs(P.x) + 2.0f * std::abs(vx * dt)) +
-                       std::abs(N.y) * (std::abs(y) + std::abs(P.y) + 2.0f * std::abs(vy * dt)) +
-                       std::abs(N.z) * (std::abs(z) + std::abs(P.z) + 2.0f * std::abs(vz * dt))) +
-            1e-30f;
-  }
-  /// Approaching the plane and reaching it within the step: a hit where the piece is.
-  bool reaches() const { return (side * d1 <= reach) & (side * vn < 0.0f); }
-};
-
 /// The hit and the reflection of a two-sided planar deflector, over particles [0, n) all of
-/// which may reach the plane: computed for every one and kept only on a hit.
+/// which may reach the plane: computed for every one and kept only on a hit (kernels/deflect.h,
+/// shared with the device; through locals, which keep the arrays' __restrict visible).
 template <class Dt, class OnPiece>
 inline void bouncePlanarAll(float* __restrict px, float* __restrict py, float* __restrict pz,
                             float* __restrict vxs, float* __restrict vys, float* __restrict vzs,
                             std::size_t n, Dt dts, Vec3 P, Vec3 N, OnPiece onPiece,
                             const Reflect& reflect) {
+  const kernel::FlReflect rf{reflect.restitution, reflect.keep, reflect.cutoff2};
   for (std::size_t i = 0; i < n; ++i) {
     const float dt = dts[i];
-    const float x = px[i], y = py[i], z = pz[i];
-    const float vx = vxs[i], vy = vys[i], vz = vzs[i];
-    const PlanarPath path(x, y, z, vx, vy, vz, dt, P, N);
-    const float d0 = path.d0, d1 = path.d1, side = path.side;
-    // Computed for every particle and kept only on a hit (one if-block: GCC 12 vectorises
-    // that, but not several selects on the same condition). Lanes that miss may hold inf.
-    const float tau = std::min(d0 / (d0 - d1), 1.0f) * dt;
-    const float hx = x + vx * tau, hy = y + vy * tau, hz = z + vz * tau;
-    // A crossing or an arrival, approaching the plane. A particle born or placed exactly on
-    // the plane (d0 = 0) belongs to neither side and leaves it freely, whichever way the
-    // piece's normal points: an emitter on a floor emits through it.
-    const bool hit = path.reaches() & (d0 != 0.0f) & onPiece(hx, hy, hz);
-    float nx = x, ny = y, nz = z, nvx = vx, nvy = vy, nvz = vz;
-    reflect(nx, ny, nz, nvx, nvy, nvz, hx, hy, hz, N.x, N.y, N.z, tau);
-    // Where Move will put it; push it out if rounding left it on or behind the plane.
-    const float qx = nx + nvx * dt, qy = ny + nvy * dt, qz = nz + nvz * dt;
-    const float qd = side * ((qx - P.x) * N.x + (qy - P.y) * N.y + (qz - P.z) * N.z);
-    // A few ulps of what decides the side: the coordinates along the normal, and the step
-    // Move adds to them (p + v·dt loses bits to cancellation when |v·dt| is large). Far from
-    // the origin along the plane this stays small, so bounces do not gain height.
-    const float margin =
-        1.2e-7f * (std::abs(N.x) * (std::abs(qx) + std::abs(P.x) + std::abs(nvx * dt)) +
-                   std::abs(N.y) * (std::abs(qy) + std::abs(P.y) + std::abs(nvy * dt)) +
-                   std::abs(N.z) * (std::abs(qz) + std::abs(P.z) + std::abs(nvz * dt))) +
-        1e-30f;
-    const float push = std::max(margin - qd, 0.0f) * side;
-    float ox = x, oy = y, oz = z, ovx = vx, ovy = vy, ovz = vz;
-    if (hit) {
-      ox = nx + push * N.x;
-      oy = ny + push * N.y;
-      oz = nz + push * N.z;
-      ovx = nvx;
-      ovy = nvy;
-      ovz = nvz;
-    }
-    px[i] = ox;
-    py[i] = oy;
-    pz[i] = oz;
-    vxs[i] = ovx;
-    vys[i] = ovy;
-    vzs[i] = ovz;
+    float x = px[i], y = py[i], z = pz[i], vx = vxs[i], vy = vys[i], vz = vzs[i];
+    float side, tau, hx, hy, hz;
+    const int reaches = kernel::fl_planar_hit(x, y, z, vx, vy, vz, dt, P.x, P.y, P.z, N.x, N.y, N.z,
+                                              &side, &tau, &hx, &hy, &hz);
+    const int hit = reaches & int(onPiece(hx, hy, hz));
+    kernel::fl_planar_bounce(rf, hit, side, tau, hx, hy, hz, dt, P.x, P.y, P.z, N.x, N.y, N.z, &x,
+                             &y, &z, &vx, &vy, &vz);
+    px[i] = x, py[i] = y, pz[i] = z, vxs[i] = vx, vys[i] = vy, vzs[i] = vz;
   }
 }
 
@@ -347,8 +294,8 @@ inline void bouncePlanarLoop(float* __restrict px, float* __restrict py, float* 
     const std::size_t m = std::min(kChunk, n - c0);
     float *x = px + c0, *y = py + c0, *z = pz + c0, *vx = vxs + c0, *vy = vys + c0, *vz = vzs + c0;
     for (std::size_t i = 0; i < m; ++i)
-      reaches[i] = std::uint8_t(
-          PlanarPath(x[i], y[i], z[i], vx[i], vy[i], vz[i], dts[c0 + i], P, N).reaches());
+      reaches[i] = std::uint8_t(kernel::fl_planar_reaches(
+          x[i], y[i], z[i], vx[i], vy[i], vz[i], dts[c0 + i], P.x, P.y, P.z, N.x, N.y, N.z));
     // The candidates' indices, eight flags at a time (most words are zero).
     std::size_t k = 0, i = 0;
     for (; i + 8 <= m; i += 8) {
@@ -522,10 +469,7 @@ inline bool withPlanarPiece(const Bounce& a, F&& f) {
     const Vec3 du = cu / glm::dot(r->u, cu), dv = cv / glm::dot(r->v, cv);
     const Vec3 o = r->origin;
     f(o, r->normal, [=](float x, float y, float z) {
-      const float wx = x - o.x, wy = y - o.y, wz = z - o.z;
-      const float s = wx * du.x + wy * du.y + wz * du.z;
-      const float t = wx * dv.x + wy * dv.y + wz * dv.z;
-      return (s >= 0.0f) & (s <= 1.0f) & (t >= 0.0f) & (t <= 1.0f);
+      return kernel::fl_on_rectangle(x - o.x, y - o.y, z - o.z, du.x, du.y, du.z, dv.x, dv.y, dv.z);
     });
   } else if (const auto* t = std::get_if<TriangleDomain>(&shape)) {
     const Vec3 e1 = t->p1 - t->p0, e2 = t->p2 - t->p0;
@@ -533,18 +477,13 @@ inline bool withPlanarPiece(const Bounce& a, F&& f) {
     const Vec3 d1 = c1 / glm::dot(e1, c1), d2 = c2 / glm::dot(e2, c2);
     const Vec3 o = t->p0;
     f(o, t->normal, [=](float x, float y, float z) {
-      const float wx = x - o.x, wy = y - o.y, wz = z - o.z;
-      const float s = wx * d1.x + wy * d1.y + wz * d1.z;
-      const float u = wx * d2.x + wy * d2.y + wz * d2.z;
-      return (s >= 0.0f) & (u >= 0.0f) & (s + u <= 1.0f);
+      return kernel::fl_on_triangle(x - o.x, y - o.y, z - o.z, d1.x, d1.y, d1.z, d2.x, d2.y, d2.z);
     });
   } else if (const auto* d = std::get_if<DiscDomain>(&shape)) {
     const Vec3 o = d->center;
     const float ro2 = d->outerRadius * d->outerRadius, ri2 = d->innerRadius * d->innerRadius;
     f(o, d->normal, [=](float x, float y, float z) {
-      const float wx = x - o.x, wy = y - o.y, wz = z - o.z;
-      const float r2 = wx * wx + wy * wy + wz * wz;
-      return (r2 <= ro2) & (r2 >= ri2);
+      return kernel::fl_on_disc(x - o.x, y - o.y, z - o.z, ro2, ri2);
     });
   } else if (const auto* ln = std::get_if<LineDomain>(&shape)) {
     // 2-D: the segment is a wall standing on the group's plane; its normal lies in the plane.
@@ -553,8 +492,7 @@ inline bool withPlanarPiece(const Bounce& a, F&& f) {
     const Vec3 nrm = glm::normalize(glm::cross(dir, a.planeNormal));
     const Vec3 o = ln->p0;
     f(o, nrm, [=](float x, float y, float z) {
-      const float t = ((x - o.x) * dir.x + (y - o.y) * dir.y + (z - o.z) * dir.z) / len2;
-      return (t >= 0.0f) & (t <= 1.0f);
+      return kernel::fl_on_segment(x - o.x, y - o.y, z - o.z, dir.x, dir.y, dir.z, len2);
     });
   } else {
     return false;
