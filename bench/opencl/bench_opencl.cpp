@@ -127,7 +127,7 @@ ActionList heavyActions() {
           OrbitPoint{Vec3(0.0f, 2.0f, 0.0f), 4.0f, 0.05f},
           Gravity{Vec3(0.0f, -9.81f, 0.0f)},
           Bounce{Domain::plane(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f)), 0.5f, 0.1f, 0.0f},
-          Sink{Domain::sphere(Vec3(0.0f, 2.0f, 0.0f), 0.1f), true, 0.0f},
+          Sink{Domain::sphere(Vec3(0.0f, 2.0f, 0.0f), 0.1f), 0.0f},
           Move{},
           KillOld{}};
 }
