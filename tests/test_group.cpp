@@ -366,3 +366,14 @@ TEST(Context, EffectInstancesAndDestroyedGroups) {
   EXPECT_EQ(d.stats().emitted, emitted);
   EXPECT_EQ(ctx.groups().size(), 3u);
 }
+
+// The public Group says only what users need: its internals are reached by the library
+// through detail::implOf (sdk/src/group_impl.hpp), not through a public impl().
+template <class G>
+constexpr bool kHasPublicImpl = requires(G& g) {
+  g.impl();
+};
+TEST(Group, InternalsAreNotPublic) {
+  EXPECT_FALSE(kHasPublicImpl<Group>);
+  EXPECT_FALSE(kHasPublicImpl<const Group>);
+}

@@ -66,7 +66,7 @@ ContextOptions options(Backend b) {
 }
 
 void finish(Group& g) {
-  detail::ocl::finishGroup(g.impl());
+  detail::ocl::finishGroup(detail::implOf(g));
 }
 
 // Runs `steps` steps per timed iteration, then waits for the device.

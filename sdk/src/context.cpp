@@ -86,7 +86,7 @@ Group& Context::createGroup(std::string name, std::size_t capacity) {
   std::uint32_t index = 0;
   for (bool taken = true; taken; ++index) {
     taken = false;
-    for (auto& g : impl_->groups) taken |= g->impl().index == index;
+    for (auto& g : impl_->groups) taken |= g->impl_->index == index;
     if (!taken) break;
   }
   gi->index = index;
@@ -127,7 +127,7 @@ void Context::step() {
   sp.cull = impl_->options.cull;
   sp.pool = impl_->pool.get();
   for (auto& g : impl_->groups) {
-    auto& gi = g->impl();
+    auto& gi = *g->impl_;
     gi.ensureStorage();
     if (gi.stats.killedByAction.size() != gi.actions.size())
       gi.stats.killedByAction.assign(gi.actions.size(), 0);
