@@ -387,6 +387,7 @@ int main(int argc, char** argv) {
   // Cold compile times mean PoCL's own kernel cache off too; it is read when PoCL loads.
   ::setenv("POCL_KERNEL_CACHE", "0", 1);
   ::setenv("FLURRY_OPENCL_CACHE", "off", 1);
+  setLogCallback(logToStderr);  // FLURRY_OPENCL_PROFILE=1's per-kernel times
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   measureCompileTimes();

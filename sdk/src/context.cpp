@@ -8,6 +8,7 @@
 #include "backend.hpp"
 #include "flurry/error.hpp"
 #include "flurry/version.hpp"
+#include "log.hpp"
 
 namespace flurry {
 
@@ -60,6 +61,8 @@ Context::Context(ContextOptions options) : impl_(std::make_unique<Impl>()) {
         impl_->backendKind = Backend::OpenCL;
       } catch (const Error& e) {
         impl_->backendFallback = e.what();
+        detail::log(LogLevel::Info, "backend auto: running on the CPU, as OpenCL is not usable: " +
+                                        impl_->backendFallback);
       }
 #endif
       break;
