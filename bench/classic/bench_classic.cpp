@@ -100,7 +100,7 @@ void buildEffect(Group& g, Effect effect) {
                     Bounce{Domain::disc(Vec3(0.0f), Vec3(0.0f, 0.0f, 1.0f), 5.0f), 0.35f, 0.0f},
                     Move{},
                     Sink{.region = Domain::plane(Vec3(0.0f, 0.0f, -3.0f), Vec3(0.0f, 0.0f, 1.0f)),
-                         .killInside = false},
+                         .mode = Sink::Mode::Outside},
                     SinkVelocity{Domain::sphere(Vec3(0.0f), 0.01f), true}, KillOld{}});
       break;
     }
@@ -110,16 +110,17 @@ void buildEffect(Group& g, Effect effect) {
       t.size = 1.5f;
       g.addEmitter(emitter(Domain::line(Vec3(-5.0f, -1.0f, 8.0f), Vec3(-5.0f, -3.0f, 8.0f)), t));
       // Classic friction -0.01 on the ground plane: 0 here, as for the fountain.
-      g.setActions({Gravity{kGravity},
-                    Bounce{Domain::rectangle(Vec3(-7.0f, -4.0f, 7.0f), Vec3(3.0f, 0.0f, 0.0f),
-                                             Vec3(0.0f, 3.0f, 0.0f)),
-                           0.35f, 0.0f},
-                    Bounce{Domain::sphere(Vec3(-4.0f, -2.0f, 4.0f), 0.2f), 0.5f, 0.0f},
-                    Bounce{Domain::sphere(Vec3(-3.5f, 0.0f, 2.0f), 2.0f), 0.5f, 0.0f},
-                    Bounce{Domain::sphere(Vec3(3.8f, 0.0f, 0.0f), 2.0f), 0.5f, 0.0f},
-                    Bounce{Domain::plane(Vec3(0.0f), Vec3(0.0f, 0.0f, 1.0f)), 0.35f, 0.0f}, Move{},
-                    KillOld{},
-                    Sink{.region = Domain::sphere(Vec3(0.0f), 20.0f), .killInside = false}});
+      g.setActions(
+          {Gravity{kGravity},
+           Bounce{Domain::rectangle(Vec3(-7.0f, -4.0f, 7.0f), Vec3(3.0f, 0.0f, 0.0f),
+                                    Vec3(0.0f, 3.0f, 0.0f)),
+                  0.35f, 0.0f},
+           Bounce{Domain::sphere(Vec3(-4.0f, -2.0f, 4.0f), 0.2f), 0.5f, 0.0f},
+           Bounce{Domain::sphere(Vec3(-3.5f, 0.0f, 2.0f), 2.0f), 0.5f, 0.0f},
+           Bounce{Domain::sphere(Vec3(3.8f, 0.0f, 0.0f), 2.0f), 0.5f, 0.0f},
+           Bounce{Domain::plane(Vec3(0.0f), Vec3(0.0f, 0.0f, 1.0f)), 0.35f, 0.0f}, Move{},
+           KillOld{},
+           Sink{.region = Domain::sphere(Vec3(0.0f), 20.0f), .mode = Sink::Mode::Outside}});
       break;
     }
     case Effect::Orbit2: {
@@ -151,8 +152,8 @@ void buildEffect(Group& g, Effect effect) {
       // TargetColor stores colour even when the renderer's attributes are not asked for.
       g.setActions({OrbitPoint{Vec3(0.0f), 0.05f, 1.5f},
                     TargetColor{Vec3(0.0f, 1.0f, 0.0f), 1.0f, approachRate(0.001f)}, Move{},
-                    Sink{.region = Domain::sphere(Vec3(0.0f), 1.0f), .killInside = true},
-                    Sink{.region = Domain::sphere(Vec3(0.0f), 8.0f), .killInside = false},
+                    Sink{.region = Domain::sphere(Vec3(0.0f), 1.0f)},
+                    Sink{.region = Domain::sphere(Vec3(0.0f), 8.0f), .mode = Sink::Mode::Outside},
                     KillOld{}});
       break;
     }

@@ -66,7 +66,7 @@ ContextOptions options(Backend b) {
 }
 
 void finish(Group& g) {
-  detail::ocl::finishGroup(g.impl());
+  detail::ocl::finishGroup(detail::implOf(g));
 }
 
 // Runs `steps` steps per timed iteration, then waits for the device.
@@ -127,7 +127,7 @@ ActionList heavyActions() {
           OrbitPoint{Vec3(0.0f, 2.0f, 0.0f), 4.0f, 0.05f},
           Gravity{Vec3(0.0f, -9.81f, 0.0f)},
           Bounce{Domain::plane(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f)), 0.5f, 0.1f, 0.0f},
-          Sink{Domain::sphere(Vec3(0.0f, 2.0f, 0.0f), 0.1f), true, 0.0f},
+          Sink{Domain::sphere(Vec3(0.0f, 2.0f, 0.0f), 0.1f), 0.0f},
           Move{},
           KillOld{}};
 }
@@ -387,6 +387,7 @@ int main(int argc, char** argv) {
   // Cold compile times mean PoCL's own kernel cache off too; it is read when PoCL loads.
   ::setenv("POCL_KERNEL_CACHE", "0", 1);
   ::setenv("FLURRY_OPENCL_CACHE", "off", 1);
+  setLogCallback(logToStderr);  // FLURRY_OPENCL_PROFILE=1's per-kernel times
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   measureCompileTimes();

@@ -338,6 +338,7 @@ int main(int argc, char** argv) {
   // Whole lines on stdout even into a pipe or a file: the progress lines on stderr then fall
   // between its lines, never inside one (a full buffer would be flushed mid-line).
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  flurry::setLogCallback(flurry::logToStderr);  // the library's messages, as the tool's own
   CLI::App app{"flurry: run particle effects"};
   app.require_subcommand(1);
   RunOptions o;

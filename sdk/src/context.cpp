@@ -8,6 +8,7 @@
 #include "backend.hpp"
 #include "flurry/error.hpp"
 #include "flurry/version.hpp"
+#include "log.hpp"
 
 namespace flurry {
 
@@ -60,6 +61,8 @@ Context::Context(ContextOptions options) : impl_(std::make_unique<Impl>()) {
         impl_->backendKind = Backend::OpenCL;
       } catch (const Error& e) {
         impl_->backendFallback = e.what();
+        detail::log(LogLevel::Info, "backend auto: running on the CPU, as OpenCL is not usable: " +
+                                        impl_->backendFallback);
       }
 #endif
       break;
@@ -86,7 +89,7 @@ Group& Context::createGroup(std::string name, std::size_t capacity) {
   std::uint32_t index = 0;
   for (bool taken = true; taken; ++index) {
     taken = false;
-    for (auto& g : impl_->groups) taken |= g->impl().index == index;
+    for (auto& g : impl_->groups) taken |= g->impl_->index == index;
     if (!taken) break;
   }
   gi->index = index;
@@ -127,7 +130,7 @@ void Context::step() {
   sp.cull = impl_->options.cull;
   sp.pool = impl_->pool.get();
   for (auto& g : impl_->groups) {
-    auto& gi = g->impl();
+    auto& gi = *g->impl_;
     gi.ensureStorage();
     if (gi.stats.killedByAction.size() != gi.actions.size())
       gi.stats.killedByAction.assign(gi.actions.size(), 0);

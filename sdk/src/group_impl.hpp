@@ -213,4 +213,16 @@ struct GroupImpl {
   void move(std::size_t from, std::size_t to);
 };
 
+/// A group's internals, for the library's own code: the public Group does not expose them.
+struct GroupAccess {
+  static GroupImpl& of(Group& g) { return *g.impl_; }
+  static const GroupImpl& of(const Group& g) { return *g.impl_; }
+};
+inline GroupImpl& implOf(Group& g) {
+  return GroupAccess::of(g);
+}
+inline const GroupImpl& implOf(const Group& g) {
+  return GroupAccess::of(g);
+}
+
 }  // namespace flurry::detail

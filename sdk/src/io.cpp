@@ -94,7 +94,7 @@ std::vector<std::filesystem::path> removeStaleTemporaries(
 }
 
 void writePly(const Group& group, const std::filesystem::path& path) {
-  const auto& g = group.impl();
+  const auto& g = detail::implOf(group);
   const detail::Lanes L = g.lanePointers();
   struct Column {
     const char* type;

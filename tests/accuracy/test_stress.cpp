@@ -36,7 +36,7 @@ ActionList mixedActions(Integrator integ) {
                   vortex,
                   Turbulence{2.0f, 0.5f, 1, Vec3(0.1f)},
                   Bounce{Domain::plane(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f)), 0.5f, 0.1f, 0.0f},
-                  Sink{Domain::sphere(Vec3(0.0f), 1000.0f), /*killInside=*/false},  // outside
+                  Sink{Domain::sphere(Vec3(0.0f), 1000.0f), 0.0f, Sink::Mode::Outside},  // outside
                   Move{},
                   KillOld{}};
   list.setIntegrator(integ);

@@ -142,12 +142,27 @@ static void test_context(void) {
 
 /* OpenCL asked for where there is no such device (or no OpenCL in this build): a clear status
  * and message; Auto falls back to the CPU and says why. */
+/* What the log callback received. */
+typedef struct log_record {
+  int count;
+  flurry_log_level level;
+  char message[4096];
+} log_record;
+
+static void record_log(flurry_log_level level, const char* message, void* user_data) {
+  log_record* r = (log_record*)user_data;
+  ++r->count;
+  r->level = level;
+  snprintf(r->message, sizeof r->message, "%s", message);
+}
+
 static void test_missing_device(void) {
   flurry_context_options o;
   flurry_context* ctx = NULL;
   flurry_status s;
   flurry_backend b = FLURRY_BACKEND_OPENCL;
   const char* why = NULL;
+  log_record log = {0, FLURRY_LOG_DEBUG, ""};
 
   OK(flurry_context_options_init(&o));
   o.backend = FLURRY_BACKEND_OPENCL;
@@ -161,12 +176,23 @@ static void test_missing_device(void) {
     CHECK(strstr(flurry_last_error(), "no device matches 'no-such-device-anywhere'") ||
           strstr(flurry_last_error(), "no OpenCL platform or device found"));
   }
+  /* AUTO falls back to the CPU, and says why through the log callback when one is set. */
   o.backend = FLURRY_BACKEND_AUTO;
+  OK(flurry_set_log_callback(record_log, &log));
   OK(flurry_context_create(&o, &ctx));
   OK(flurry_context_backend(ctx, &b));
   CHECK(b == FLURRY_BACKEND_CPU);
   OK(flurry_context_backend_fallback(ctx, &why));
-  if (s == FLURRY_ERROR_NO_DEVICE) CHECK(strlen(why) > 0);
+  if (s == FLURRY_ERROR_NO_DEVICE) {
+    CHECK(strlen(why) > 0);
+    CHECK(log.count == 1 && log.level == FLURRY_LOG_INFO);
+    CHECK(strstr(log.message, "running on the CPU") && strstr(log.message, why));
+  }
+  OK(flurry_context_destroy(ctx));
+  OK(flurry_set_log_callback(NULL, NULL));
+  log.count = 0;
+  OK(flurry_context_create(&o, &ctx));
+  CHECK(log.count == 0);
   OK(flurry_context_destroy(ctx));
 }
 

@@ -192,16 +192,16 @@ TEST(Sink, EnterLeaveAndHitModes) {
     ctx.step();
     return g.size();
   };
-  Sink enter{box, true, 0.0f, Sink::Mode::Enter};
+  Sink enter{box, 0.0f, Sink::Mode::Enter};
   EXPECT_EQ(one(enter, Vec3(-1.5f, 0, 0), Vec3(10, 0, 0)), 0u);  // enters
   EXPECT_EQ(one(enter, Vec3(0, 0, 0), Vec3(1, 0, 0)), 1u);       // already in
-  Sink leave{box, true, 0.0f, Sink::Mode::Leave};
+  Sink leave{box, 0.0f, Sink::Mode::Leave};
   EXPECT_EQ(one(leave, Vec3(0.9f, 0, 0), Vec3(10, 0, 0)), 0u);
   EXPECT_EQ(one(leave, Vec3(0, 0, 0), Vec3(1, 0, 0)), 1u);
-  Sink hit{Domain::disc(Vec3(0), Vec3(0, 1, 0), 1.0f), true, 0.0f, Sink::Mode::Hit};
-  EXPECT_EQ(one(hit, Vec3(0, 0.5f, 0), Vec3(0, -10, 0)), 0u);   // crosses the disc
-  EXPECT_EQ(one(hit, Vec3(5, 0.5f, 0), Vec3(0, -10, 0)), 1u);   // crosses the plane, not the disc
-  Sink outside{box, true, 0.0f, Sink::Mode::Outside};
+  Sink hit{Domain::disc(Vec3(0), Vec3(0, 1, 0), 1.0f), 0.0f, Sink::Mode::Hit};
+  EXPECT_EQ(one(hit, Vec3(0, 0.5f, 0), Vec3(0, -10, 0)), 0u);  // crosses the disc
+  EXPECT_EQ(one(hit, Vec3(5, 0.5f, 0), Vec3(0, -10, 0)), 1u);  // crosses the plane, not the disc
+  Sink outside{box, 0.0f, Sink::Mode::Outside};
   EXPECT_EQ(one(outside, Vec3(5, 0, 0), Vec3(0)), 0u);
   EXPECT_EQ(one(outside, Vec3(0, 0, 0), Vec3(0)), 1u);
 }
@@ -230,23 +230,22 @@ TEST(Sink, PassThroughIsAFractionOfParticlesInEveryMode) {
   };
   using M = Sink::Mode;
   const Vec3 before(0, 0, 0);
-  EXPECT_NEAR(passing({Sink{slab, true, 0.3f, M::Inside}}, before, 60), p, 3 * sigma);
-  EXPECT_NEAR(passing({Sink{slab, true, 0.3f, M::Enter}}, before, 60), p, 3 * sigma);
-  EXPECT_NEAR(passing({Sink{slab, true, 0.3f, M::Leave}}, before, 60), p, 3 * sigma);
-  EXPECT_NEAR(passing({Sink{Domain::plane(Vec3(1.5f, 0, 0), Vec3(1, 0, 0)), true, 0.3f, M::Hit}},
-                      before, 60),
-              p, 3 * sigma);
+  EXPECT_NEAR(passing({Sink{slab, 0.3f, M::Inside}}, before, 60), p, 3 * sigma);
+  EXPECT_NEAR(passing({Sink{slab, 0.3f, M::Enter}}, before, 60), p, 3 * sigma);
+  EXPECT_NEAR(passing({Sink{slab, 0.3f, M::Leave}}, before, 60), p, 3 * sigma);
+  EXPECT_NEAR(
+      passing({Sink{Domain::plane(Vec3(1.5f, 0, 0), Vec3(1, 0, 0)), 0.3f, M::Hit}}, before, 60), p,
+      3 * sigma);
   // Outside a region the particles leave and stay out of, for 40 steps.
   EXPECT_NEAR(
-      passing({Sink{Domain::box(Vec3(-1, -100, -100), Vec3(1, 100, 100)), true, 0.3f, M::Outside}},
+      passing({Sink{Domain::box(Vec3(-1, -100, -100), Vec3(1, 100, 100)), 0.3f, M::Outside}},
               before, 60),
       p, 3 * sigma);
   // Two absorbers decide independently: 0.3 · 0.3 pass both.
   const Domain slab2 = Domain::box(Vec3(3, -100, -100), Vec3(4, 100, 100));
   const double p2 = p * p, sigma2 = std::sqrt(p2 * (1 - p2) / n);
-  EXPECT_NEAR(
-      passing({Sink{slab, true, 0.3f, M::Inside}, Sink{slab2, true, 0.3f, M::Inside}}, before, 100),
-      p2, 3 * sigma2);
+  EXPECT_NEAR(passing({Sink{slab, 0.3f, M::Inside}, Sink{slab2, 0.3f, M::Inside}}, before, 100), p2,
+              3 * sigma2);
 }
 
 TEST(Sink, EachAbsorberCountsWhatItTook) {

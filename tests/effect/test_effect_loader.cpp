@@ -316,6 +316,39 @@ TEST(EffectLoader, ActionErrors) {
   EXPECT_EQ(errorOf(withGroup(R"("actions": {"type": "Move"})")).path(), "groups[0].actions");
 }
 
+// A Sink says inside or outside by "mode" alone; the classic API's "killInside": false, once a
+// second switch beside it, still reads as mode "outside" (with a warning), and is refused
+// where it would contradict the mode.
+TEST(EffectLoader, SinkKillInsideIsADeprecatedAliasOfModeOutside) {
+  auto sink = [](const std::string& fields) {
+    return withGroup(
+        R"("actions": [{"type": "Sink", "region": {"type": "sphere", "outerRadius": 1})" + fields +
+        "}]");
+  };
+  const Effect fx = parseEffect(sink(R"(, "killInside": false)"), "k.json");
+  EXPECT_EQ(std::get<Sink>(fx.groups[0].actions.actions()[0]).mode, Sink::Mode::Outside);
+  bool warned = false;
+  for (const EffectWarning& w : fx.warnings)
+    warned |=
+        w.path == "groups[0].actions[0].killInside" && w.why.find("\"mode\"") != std::string::npos;
+  EXPECT_TRUE(warned);
+  EXPECT_EQ(
+      std::get<Sink>(
+          parseEffect(sink(R"(, "killInside": true)"), "k.json").groups[0].actions.actions()[0])
+          .mode,
+      Sink::Mode::Inside);
+  for (const char* mode : {"outside", "enter", "leave"}) {
+    const EffectError e =
+        errorOf(sink(R"(, "killInside": false, "mode": ")" + std::string(mode) + "\""));
+    EXPECT_EQ(e.path(), "groups[0].actions[0].killInside") << mode;
+    EXPECT_NE(e.why().find("use \"mode\""), std::string::npos) << e.why();
+  }
+  // Saved, it is the mode alone.
+  const std::string saved = saveEffect(fx);
+  EXPECT_EQ(saved.find("killInside"), std::string::npos) << saved;
+  EXPECT_NE(saved.find("\"outside\""), std::string::npos) << saved;
+}
+
 TEST(EffectLoader, EmittersAndPrimeEmitters) {
   const Effect fx = parseEffect(withGroup(R"(
     "emitters": [{"name": "e", "shape": {"type": "sphere", "outerRadius": 1}, "rate": 10.5,

@@ -2,6 +2,9 @@
 // cache, host reads and writes between steps, capacity.
 #include <cstdlib>
 #include <filesystem>
+#include <mutex>
+#include <string>
+#include <vector>
 
 #include "builtin.hpp"
 #include "opencl/backend.hpp"
@@ -89,6 +92,36 @@ TEST(OpenCLBackend, TheSecondContextPaysNoCompile) {
   EXPECT_EQ(after.builds, before.builds);
   EXPECT_EQ(after.diskHits, before.diskHits);
   EXPECT_GT(after.memoryHits, before.memoryHits);
+}
+
+// The library never prints: the profile FLURRY_OPENCL_PROFILE=1 asks for goes to the log
+// callback (when a group goes), and nowhere when none is set.
+TEST(OpenCLBackend, TheProfileGoesToTheLogNotToStderr) {
+  FLURRY_REQUIRE_OPENCL();
+  ::setenv("FLURRY_OPENCL_PROFILE", "1", 1);
+  auto run = [] {
+    Context ctx(openclOptions());
+    samples::buildFountain(ctx, 1000, 200, 2.0f);
+    ctx.run(3);
+  };
+  const LogCallback saved = setLogCallback({});
+  testing::internal::CaptureStderr();
+  run();
+  const std::string printed = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(printed.find("profile"), std::string::npos) << printed;
+  std::mutex m;
+  std::vector<std::pair<LogLevel, std::string>> got;
+  setLogCallback([&](LogLevel l, std::string_view s) {
+    std::lock_guard lock(m);
+    got.emplace_back(l, std::string(s));
+  });
+  run();
+  setLogCallback(saved);
+  ::unsetenv("FLURRY_OPENCL_PROFILE");
+  ASSERT_FALSE(got.empty());
+  EXPECT_EQ(got[0].first, LogLevel::Info);
+  EXPECT_EQ(got[0].second.rfind("opencl profile: ", 0), 0u) << got[0].second;
+  EXPECT_NE(got[0].second.find("launches"), std::string::npos) << got[0].second;
 }
 
 TEST(OpenCLBackend, ProgramsAreCachedOnDisk) {

@@ -157,8 +157,7 @@ TEST(OpenCLCore, HairStrandsMatchTheCpu) {
     g.require({Attribute::Color, Attribute::Size});
     g.setActions({Gravity{kDown}, Damping{Vec3(0.2f)},
                   Bounce{Domain::plane(Vec3(0.0f, -0.5f, 0.0f), Vec3(0.0f, 1.0f, 0.0f)), 0.5f},
-                  Sink{Domain::sphere(Vec3(1.0f, 0.0f, 0.0f), 0.5f), true, 0.0f}, Move{},
-                  KillOld{}});
+                  Sink{Domain::sphere(Vec3(1.0f, 0.0f, 0.0f), 0.5f), 0.0f}, Move{}, KillOld{}});
     g.setHair({true, 2, 24});
     ctx.run(30);
     return Out{g.strands(), g.stats()};

@@ -64,14 +64,15 @@ TEST(OpenCLParity, SinkInsideEveryRegion) {
   };
   for (const Domain& r : regions) {
     SCOPED_TRACE(r.name());
-    checkParity(withActions({Gravity{kDown}, Sink{r, true, 0.0f}, Move{}, KillOld{}}));
+    checkParity(withActions({Gravity{kDown}, Sink{r, 0.0f}, Move{}, KillOld{}}));
   }
 }
 
 TEST(OpenCLParity, SinkOutsideWithPassThrough) {
   checkParity(
-      withActions({Gravity{kDown}, Sink{Domain::sphere(Vec3(0.0f, 1.5f, 0.0f), 2.0f), false, 0.3f},
-                   Sink{Domain::box(Vec3(-2.0f, 1.0f, -2.0f), Vec3(2.0f, 2.0f, 2.0f)), true, 0.7f},
+      withActions({Gravity{kDown},
+                   Sink{Domain::sphere(Vec3(0.0f, 1.5f, 0.0f), 2.0f), 0.3f, Sink::Mode::Outside},
+                   Sink{Domain::box(Vec3(-2.0f, 1.0f, -2.0f), Vec3(2.0f, 2.0f, 2.0f)), 0.7f},
                    Move{}, KillOld{}}));
 }
 
@@ -163,8 +164,7 @@ TEST(OpenCLParity, TypesBurstsPathsAndCapacity) {
     g.addEmitter(second);
     g.setActions({Gravity{kDown},
                   Bounce{Domain::plane(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f)), 0.5f, 0.1f, 0.0f},
-                  Sink{Domain::sphere(Vec3(1.0f, 2.0f, 1.0f), 0.7f), true, 0.25f}, Move{},
-                  KillOld{}});
+                  Sink{Domain::sphere(Vec3(1.0f, 2.0f, 1.0f), 0.7f), 0.25f}, Move{}, KillOld{}});
     g.require({Attribute::Size, Attribute::Color});
     return g;
   });

@@ -124,7 +124,7 @@ Emitter spinning() {
 TEST(OpenCLRegions, SinkInside) {
   for (const Domain& r : regions()) {
     SCOPED_TRACE(r.name());
-    check({Gravity{kDown}, Sink{r, true, 0.0f, Sink::Mode::Inside}, Move{}, KillOld{}}, 1);
+    check({Gravity{kDown}, Sink{r, 0.0f, Sink::Mode::Inside}, Move{}, KillOld{}}, 1);
   }
 }
 
@@ -138,16 +138,16 @@ TEST(OpenCLRegions, SinkOutside) {
   };
   for (const Domain& r : around) {
     SCOPED_TRACE(r.name());
-    check({Gravity{kDown}, Sink{r, true, 0.0f, Sink::Mode::Outside}, Move{}, KillOld{}}, 1);
-    check({Gravity{kDown}, Sink{r, false, 0.3f, Sink::Mode::Inside}, Move{}, KillOld{}}, 1);
+    check({Gravity{kDown}, Sink{r, 0.0f, Sink::Mode::Outside}, Move{}, KillOld{}}, 1);
+    check({Gravity{kDown}, Sink{r, 0.3f, Sink::Mode::Outside}, Move{}, KillOld{}}, 1);
   }
 }
 
 TEST(OpenCLRegions, SinkEnterLeave) {
   for (const Domain& r : regions()) {
     SCOPED_TRACE(r.name());
-    check({Gravity{kDown}, Sink{r, true, 0.0f, Sink::Mode::Enter}, Move{}, KillOld{}}, 1);
-    check({Gravity{kDown}, Sink{r, true, 0.2f, Sink::Mode::Leave}, Move{}, KillOld{}}, 1);
+    check({Gravity{kDown}, Sink{r, 0.0f, Sink::Mode::Enter}, Move{}, KillOld{}}, 1);
+    check({Gravity{kDown}, Sink{r, 0.2f, Sink::Mode::Leave}, Move{}, KillOld{}}, 1);
   }
 }
 
@@ -160,7 +160,7 @@ TEST(OpenCLRegions, SinkHitRefused) {
       o.backend = b;
       Context ctx(o);
       Group& g = ctx.createGroup("hit", 100);
-      EXPECT_THROW(g.setActions({Sink{r, true, 0.0f, Sink::Mode::Hit}, Move{}}), InvalidArgument);
+      EXPECT_THROW(g.setActions({Sink{r, 0.0f, Sink::Mode::Hit}, Move{}}), InvalidArgument);
     }
 }
 
@@ -247,7 +247,7 @@ TEST(OpenCLRegions, SampledUnderIntegrators) {
                  Jet{Vec3(0.0f, 2.0f, 0.0f), 1.5f, nestedUnion(Vec3(0.0f, 5.0f, 0.0f))},
                  RandomAccel{octahedron(Vec3(0.0f), 3.0f)},
                  Move{},
-                 Sink{regions()[3], true, 0.0f, Sink::Mode::Enter},
+                 Sink{regions()[3], 0.0f, Sink::Mode::Enter},
                  KillOld{}};
     l.setIntegrator(in);
     l.setSubsteps(Substeps{1.0 / 75.0});

@@ -105,24 +105,24 @@ TEST(OpenCLSurfaces, SinkEnter) {
   };
   for (const Domain& r : regions) {
     SCOPED_TRACE(r.name());
-    Sink k{r, true, 0.0f, Sink::Mode::Enter};
+    Sink k{r, 0.0f, Sink::Mode::Enter};
     checkAction({Gravity{kDown}, k, Move{}, KillOld{}}, 1);
   }
 }
 
 TEST(OpenCLSurfaces, SinkLeaveWithPassThrough) {
-  Sink k{Domain::sphere(Vec3(0.0f, 1.0f, 0.0f), 1.2f), true, 0.4f, Sink::Mode::Leave};
+  Sink k{Domain::sphere(Vec3(0.0f, 1.0f, 0.0f), 1.2f), 0.4f, Sink::Mode::Leave};
   checkAction({Gravity{kDown}, k, Move{}, KillOld{}}, 1);
 }
 
 // Inside a region the spray crosses for many steps: the once-per-particle decision (the same
 // hash of seed, id, group and index on both backends), also across sub-steps.
 TEST(OpenCLSurfaces, SinkInsideWithPassThrough) {
-  ActionList list{Gravity{kDown},
-                  Sink{Domain::box(Vec3(-3.0f, 0.8f, -3.0f), Vec3(3.0f, 1.4f, 3.0f)), true, 0.3f,
-                       Sink::Mode::Inside},
-                  Sink{Domain::sphere(Vec3(0.0f, 0.5f, 0.0f), 0.8f), true, 0.6f, Sink::Mode::Enter},
-                  Move{}, KillOld{}};
+  ActionList list{
+      Gravity{kDown},
+      Sink{Domain::box(Vec3(-3.0f, 0.8f, -3.0f), Vec3(3.0f, 1.4f, 3.0f)), 0.3f, Sink::Mode::Inside},
+      Sink{Domain::sphere(Vec3(0.0f, 0.5f, 0.0f), 0.8f), 0.6f, Sink::Mode::Enter}, Move{},
+      KillOld{}};
   checkAction(list, 1);
   list.setSubsteps(Substeps{1.0 / 90.0});
   checkAction(list, 1);
@@ -137,15 +137,15 @@ TEST(OpenCLSurfaces, SinkHitEveryPiece) {
   };
   for (const Domain& r : pieces) {
     SCOPED_TRACE(r.name());
-    Sink k{r, true, 0.0f, Sink::Mode::Hit};
+    Sink k{r, 0.0f, Sink::Mode::Hit};
     checkAction({Gravity{kDown}, k, Move{}, KillOld{}}, 1);
   }
 }
 
 TEST(OpenCLSurfaces, SinkHitWithPassThroughAndSubsteps) {
   ActionList list{Gravity{kDown},
-                  Sink{Domain::disc(Vec3(0.0f, 1.5f, 0.0f), Vec3(0.0f, 1.0f, 0.0f), 1.0f), true,
-                       0.5f, Sink::Mode::Hit},
+                  Sink{Domain::disc(Vec3(0.0f, 1.5f, 0.0f), Vec3(0.0f, 1.0f, 0.0f), 1.0f), 0.5f,
+                       Sink::Mode::Hit},
                   kFloor, Move{}, KillOld{}};
   list.setSubsteps(Substeps{1.0 / 90.0});
   checkAction(list, 1);

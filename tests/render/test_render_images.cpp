@@ -534,9 +534,9 @@ TEST(RenderImage, SceneGeometry) {
     return n;
   };
   const ActionList scene{
-      Bounce{Domain::line(Vec3(-2, -1, 0), Vec3(-0.5f, -1, 0)), 0.5f},           // left
-      Sink{Domain::box(Vec3(0.5f, -0.5f, -0.5f), Vec3(2, 0.5f, 0.5f))},          // right
-      Sink{Domain::sphere(Vec3(0.0f), 1.0f), false, 0.0f, Sink::Mode::Outside},  // a bound
+      Bounce{Domain::line(Vec3(-2, -1, 0), Vec3(-0.5f, -1, 0)), 0.5f},    // left
+      Sink{Domain::box(Vec3(0.5f, -0.5f, -0.5f), Vec3(2, 0.5f, 0.5f))},   // right
+      Sink{Domain::sphere(Vec3(0.0f), 1.0f), 0.0f, Sink::Mode::Outside},  // a bound
       Move{}};
   EXPECT_EQ(drawn(scene, 0, kSize), 0);  // off by default
   r.settings().geometry.show = true;

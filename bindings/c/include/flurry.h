@@ -95,6 +95,22 @@ FLURRY_C_EXPORT const char* flurry_last_error(void);
 /** A status's name: "FLURRY_ERROR_EFFECT", ... */
 FLURRY_C_EXPORT const char* flurry_status_name(flurry_status status);
 
+/* ---- log (flurry::setLogCallback) --------------------------------------------------------- */
+
+typedef enum flurry_log_level {
+  FLURRY_LOG_DEBUG = 0,
+  FLURRY_LOG_INFO = 1,
+  FLURRY_LOG_WARNING = 2,
+  FLURRY_LOG_ERROR = 3
+} flurry_log_level;
+
+/** Receives one message of the library (one line, valid during the call) and the user_data
+ * given with it. It may be called from any thread, from several at once. */
+typedef void (*flurry_log_fn)(flurry_log_level level, const char* message, void* user_data);
+/** Sends the library's messages to `fn`; NULL (the default) drops them: the library never
+ * prints. Process-wide (every context), thread-safe. */
+FLURRY_C_EXPORT flurry_status flurry_set_log_callback(flurry_log_fn fn, void* user_data);
+
 /* ---- context ----------------------------------------------------------------------------- */
 
 typedef struct flurry_context_options {

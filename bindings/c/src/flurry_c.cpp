@@ -20,6 +20,7 @@
 #include "flurry/error.hpp"
 #include "flurry/group.hpp"
 #include "flurry/interop.hpp"
+#include "flurry/log.hpp"
 #include "flurry/version.hpp"
 #ifdef FLURRY_C_HAS_OPENCL
 #include "flurry/opencl.hpp"
@@ -321,6 +322,24 @@ const char* flurry_status_name(flurry_status status) {
       return "FLURRY_ERROR_OTHER";
   }
   return "unknown flurry_status";
+}
+
+// ---- log ------------------------------------------------------------------------------------
+
+static_assert(int(FLURRY_LOG_DEBUG) == int(flurry::LogLevel::Debug));
+static_assert(int(FLURRY_LOG_ERROR) == int(flurry::LogLevel::Error));
+
+flurry_status flurry_set_log_callback(flurry_log_fn fn, void* user_data) {
+  return guard([&] {
+    if (!fn) {
+      flurry::setLogCallback({});
+      return;
+    }
+    flurry::setLogCallback([fn, user_data](flurry::LogLevel level, std::string_view message) {
+      const std::string text(message);  // C wants it NUL-terminated
+      fn(flurry_log_level(int(level)), text.c_str(), user_data);
+    });
+  });
 }
 
 // ---- context --------------------------------------------------------------------------------

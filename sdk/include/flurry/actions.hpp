@@ -285,15 +285,14 @@ struct Bounce {
 struct Sink {
   enum class Mode { Inside, Outside, Enter, Leave, Hit };
   Domain region;
-  bool killInside = true;  ///< the classic API's switch: false means Mode::Outside
   float passThrough = 0.0f;
-  Mode mode = Mode::Inside;
+  Mode mode = Mode::Inside;  ///< the classic API's killInside = false is Mode::Outside
 };
 
 /// Kills particles whose velocity lies inside (or outside) a domain of velocities.
 struct SinkVelocity {
   Domain velocity = Domain::sphere(Vec3(0.0f), 0.01f);
-  bool killInside = true;
+  bool killInside = true;  ///< false: kills those outside (its only switch, unlike Sink's mode)
 };
 
 /// A blocker: particles inside `region` are not drawn (Visible = 0); they are still simulated

@@ -12,6 +12,7 @@
 #include "flurry/group.hpp"
 #include "flurry/interop.hpp"
 #include "flurry/io.hpp"
+#include "flurry/log.hpp"
 #include "flurry/math.hpp"
 #include "flurry/random.hpp"
 #include "flurry/strands.hpp"

@@ -17,7 +17,8 @@ namespace flurry {
 
 namespace detail {
 struct GroupImpl;
-}
+struct GroupAccess;  // the library's way in (sdk/src/group_impl.hpp)
+}  // namespace detail
 
 /// One particle gathered from the arrays (for tests, tools and small groups; hot code reads
 /// the arrays through Group::lane()).
@@ -157,11 +158,9 @@ class Group {
   /// Removes every particle (stats are kept).
   void clear();
 
-  detail::GroupImpl& impl() { return *impl_; }
-  const detail::GroupImpl& impl() const { return *impl_; }
-
  private:
   friend class Context;
+  friend struct detail::GroupAccess;
   explicit Group(std::unique_ptr<detail::GroupImpl> impl);
   std::unique_ptr<detail::GroupImpl> impl_;
 };

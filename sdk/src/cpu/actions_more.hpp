@@ -141,10 +141,9 @@ inline void apply(const Sink& a, const Lanes& L, std::size_t n, const BlockConte
   const std::uint32_t code = c.action + 1;
   using M = Sink::Mode;
   if (a.mode == M::Inside || a.mode == M::Outside) {
-    const bool killInside = a.mode == M::Inside ? a.killInside : !a.killInside;
     std::visit(
         [&](const auto& shape) {
-          sinkLoop(shape, L.p[0], L.p[1], L.p[2], c.dead, n, code, killInside);
+          sinkLoop(shape, L.p[0], L.p[1], L.p[2], c.dead, n, code, a.mode == M::Inside);
         },
         a.region.shape());
   } else if (a.mode == M::Enter || a.mode == M::Leave) {

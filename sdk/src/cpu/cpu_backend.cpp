@@ -79,10 +79,7 @@ ActionPlan::Reach actionReach(const Action& a, const ActionPlan& plan, std::size
     if (sphere && box)
       r.quadratic = 1e-6f / std::max(std::get<SphereDomain>(s).outerRadius, 1e-30f);
   } else if (const auto* s = std::get_if<Sink>(&a)) {
-    using M = Sink::Mode;
-    const bool killsOutside =
-        (s->mode == M::Inside && !s->killInside) || (s->mode == M::Outside && s->killInside);
-    if (!killsOutside) box = shapeBox(s->region, lo, hi);
+    if (s->mode != Sink::Mode::Outside) box = shapeBox(s->region, lo, hi);
   } else if (const auto* b = std::get_if<Block>(&a)) {
     box = shapeBox(b->region, lo, hi);  // the first blocker's reset is done when culled
   } else if (const auto* g = std::get_if<Gravity>(&a)) {

@@ -486,10 +486,10 @@ struct Describe<Sink> {
   static constexpr auto fields = std::tuple{
       field("region", &Sink::region, "", kAny, "a domain",
             "the absorbing region or surface, a domain"),
-      field("killInside", &Sink::killInside, "", kAny, "false: kill outside"),
       field("passThrough", &Sink::passThrough, "", kUnitInterval,
             "the fraction of particles that pass"),
-      field("mode", &Sink::mode, "", kAny, "when a particle is absorbed"),
+      field("mode", &Sink::mode, "", kAny,
+            "when a particle is absorbed (the deprecated \"killInside\": false is \"outside\")"),
   };
 };
 template <>

@@ -624,12 +624,25 @@ void checkActionType(const std::string& type, const std::string& typePath, const
     L.fail(typePath, "unknown action \"" + type + "\"" + suggestion(type, kActionTypes));
 }
 
+/// A Sink's deprecated "killInside" (the classic API's switch, once a field beside "mode"):
+/// false reads as mode "outside"; with any mode but "inside" it is refused as ambiguous.
+void readSinkKillInside(Obj& o, Sink& s) {
+  const json* k = o.get("killInside");
+  bool inside = true;
+  if (k) read(*k, o.at("killInside"), o.loader(), inside);
+  if (inside) return;
+  if (s.mode != Sink::Mode::Inside)
+    o.loader().fail(o.at("killInside"), "deprecated, and contradicts \"mode\": use \"mode\" alone");
+  s.mode = Sink::Mode::Outside;
+}
+
 Action readAction(const json& j, const std::string& path, const Loader& L) {
   Obj o(j, path, L);
   std::string type;
   o.req("type", type, "the action's name, e.g. \"Gravity\"");
   checkActionType(type, o.at("type"), L);
   Action a = readActionBody(o, type);
+  if (auto* s = std::get_if<Sink>(&a)) readSinkKillInside(o, *s);
   o.finish();
   return a;
 }
@@ -874,6 +887,11 @@ EffectGroup readGroup(const json& j, const std::string& path, const Loader& L,
   }
   o.finish();
   warnGroup(g, asWritten, path, warnings);
+  if (const json* as = o.get("actions"))
+    for (std::size_t i = 0; i < as->size(); ++i)
+      if (std::holds_alternative<Sink>(asWritten[i]) && (*as)[i].contains("killInside"))
+        warnings.push_back({join(index(join(path, "actions"), i), "killInside"),
+                            "deprecated: say \"mode\": \"inside\" or \"outside\""});
   return g;
 }
 

@@ -127,9 +127,8 @@ bool generateSurfaceAction(const Action& act, ActionSource& s) {
     const std::string kind = kindOf(k->region);
     s.reads.insert(Attribute::Position);
     if (k->mode == M::Inside || k->mode == M::Outside) {
-      const bool killInside = k->mode == M::Inside ? k->killInside : !k->killInside;
-      s.apply = "fl_sink(" + ap + ", " + kind + ", " + (killInside ? "1" : "0") + ", px, py, pz, " +
-                s.in.code + ", &dead, extra);\n";
+      s.apply = "fl_sink(" + ap + ", " + kind + ", " + (k->mode == M::Inside ? "1" : "0") +
+                ", px, py, pz, " + s.in.code + ", &dead, extra);\n";
     } else if (k->mode == M::Enter || k->mode == M::Leave) {
       s.reads.insert(Attribute::Velocity);
       s.apply = "fl_sink_motion(" + ap + ", " + kind + ", " + (k->mode == M::Enter ? "1" : "0") +

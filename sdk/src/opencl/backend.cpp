@@ -27,6 +27,7 @@
 
 #include "codegen.hpp"
 #include "emission.hpp"
+#include "log.hpp"
 
 namespace flurry::detail::ocl {
 
@@ -64,7 +65,7 @@ void setArg(cl_kernel k, cl_uint i, const T& v) {
 struct Shared {
   std::shared_ptr<Runtime> runtime;
   Queue queue;
-  bool profile = false;  // FLURRY_OPENCL_PROFILE=1: per-kernel device times on stderr
+  bool profile = false;  // FLURRY_OPENCL_PROFILE=1: per-kernel device times, logged
   cl_device_id device() const { return runtime->device().id; }
   bool cpu() const { return runtime->device().cpu; }
   bool fp64() const { return runtime->device().info.fp64; }
@@ -139,11 +140,14 @@ class ClGroup final : public DeviceMirror {
     clFinish(shared_->queue.get());  // buffers must outlive queued work
     if (shared_->profile) {
       collectProfile();
-      for (const auto& [name, t] : profile_)
-        std::fprintf(stderr,
-                     "flurry opencl profile: %-14s %8llu launches %10.3f ms total %9.1f us each\n",
-                     name.c_str(), static_cast<unsigned long long>(t.second), t.first * 1e3,
-                     t.first * 1e6 / double(std::max<std::uint64_t>(t.second, 1)));
+      for (const auto& [name, t] : profile_) {
+        char line[160];
+        std::snprintf(line, sizeof line,
+                      "opencl profile: %-14s %8llu launches %10.3f ms total %9.1f us each",
+                      name.c_str(), static_cast<unsigned long long>(t.second), t.first * 1e3,
+                      t.first * 1e6 / double(std::max<std::uint64_t>(t.second, 1)));
+        detail::log(LogLevel::Info, line);
+      }
     }
   }
 

@@ -378,8 +378,7 @@ struct Renderer::Impl {
       if (const auto* x = std::get_if<Bounce>(&a); x && g.bounce) b.add(x->surface);
       if (const auto* x = std::get_if<Sink>(&a); x && g.sink) {
         // An `outside` or `leave` absorber bounds the scene; it is not an object in it.
-        const bool bounds =
-            !x->killInside || x->mode == Sink::Mode::Outside || x->mode == Sink::Mode::Leave;
+        const bool bounds = x->mode == Sink::Mode::Outside || x->mode == Sink::Mode::Leave;
         if (!bounds) b.add(x->region);
       }
       if (const auto* x = std::get_if<Block>(&a); x && g.block) b.add(x->region);
