@@ -158,7 +158,14 @@ INSTANTIATE_TEST_SUITE_P(
                       Expect{"tornado", 60, 0.02, 0.3, 0, 0.01, 0.999, 0},
                       // Snow falls across the whole view by design: not framed.
                       Expect{"snow", 40, 0.01, 0.3, 0, 1.0, 0.0, 300},
-                      Expect{"shockwave", 30, 0.02, 0.3, 1, 0.01, 0.999, 0}),
+                      Expect{"shockwave", 30, 0.02, 0.3, 1, 0.01, 0.999, 0},
+                      // Blue at the flames' base, orange, red: three hues.
+                      Expect{"campfire", 60, 0.02, 0.3, 3, 0.01, 0.999, 100},
+                      // A blue ion tail and a golden dust tail: two hues.
+                      Expect{"comet", 60, 0.005, 0.2, 2, 0.01, 0.999, 0},
+                      Expect{"waterfall", 60, 0.03, 0.4, 1, 0.01, 0.999, 300},
+                      // Grey-blue drops: no hue asked; the window frame is drawn.
+                      Expect{"rain_on_glass", 60, 0.01, 0.3, 0, 0.01, 0.999, 300}),
     [](const ::testing::TestParamInfo<Expect>& info) { return info.param.name; });
 
 }  // namespace
