@@ -307,7 +307,7 @@ std::string stepSource(const std::string& body, const Substeps& sub, bool byDist
     s << "  const uint nsub = 1u; (void)nsubStep;\n";
   if (byDistance) {
     char buf[64];
-    std::snprintf(buf, sizeof buf, "%.9g", double(sub.maxDistance));
+    std::snprintf(buf, sizeof buf, "%.9e", double(sub.maxDistance));  // "2f" is no literal
     s << "  {\n    const float vmax = sqrt(as_float(state[FL_STATE_MAX_SPEED2]));\n"
          "    if (isfinite(vmax)) {\n"
          "      const fl_real m = ceil((fl_real)vmax * fl_real_from_bits(dtBits) / (fl_real)"
