@@ -665,8 +665,14 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   // for the part of the step it still has to live, from its birth time on.
   // With culling (cull, and velocities for the swept bounds) fl_act and fl_small hold
   // barriers: every work-item runs the list, those past the live particles (fl_live == 0)
-  // on zeros, storing nothing. Without, the program has no trace of it.
-  g.culls = cull && stored.has(Attribute::Velocity);
+  // on zeros, storing nothing. Without (or with no action that may be culled) the program
+  // has no trace of it.
+  bool cullable = false;
+  for (std::size_t k = 0; k < acts.size(); ++k) {
+    std::string unused;
+    cullable |= placed[k] == 1 && culledCode(acts[k], k, unused);
+  }
+  g.culls = cull && cullable && stored.has(Attribute::Velocity);
   const char* live = g.culls ? "fl_live && " : "";
   std::ostringstream one;
   one << "  fl_real fl_len = fl_real_from_bits(dtBits), fl_t0 = t0;\n"
