@@ -63,3 +63,93 @@ FL_INLINE void fl_restore(__global const FlActionParams* a, float dt, fl_real ti
     *vz = 0.0f;
   }
 }
+
+/* ---- Spatial culling per work-group (fused_pass.cpp Culler) ------------------------------ */
+
+/* The work-group's swept bounds: the box its straight paths p .. p + v*dt lie in and the
+ * longest path |v|*dt, which it returns. Every work-item of the group calls it (it holds
+ * barriers); those past the live particles (live == 0) add nothing, and a NaN or infinite
+ * particle makes the box unbounded (nothing is culled then). Each work-item adds its own
+ * path: a newborn's dt is its own. The decisions are taken here, once per work-group: for
+ * each of the n actions (reach: their FL_REACH_FLOATS floats), red[FL_CULL_GAP + k] is how far
+ * the paths may leave the box with the action still out of their reach (-1: it is not). */
+#define FL_CULL_GAP (7 * FL_ACT_LOCAL + 56 + 1)
+#define FL_CULL_LOCAL_FLOATS FL_CULL_GAP /* plus one per action */
+FL_INLINE uint fl_cull_apart(const float* box, float grow, __global const float* r);
+FL_INLINE float fl_cull_gather(__local float* red, uint live, float dt, float px, float py,
+                               float pz, float vx, float vy, float vz,
+                               __global const float* reach, uint n) {
+  const uint lid = get_local_id(0);
+  const float p[3] = {px, py, pz}, v[3] = {vx, vy, vz};
+  int bad = 0;
+  for (int c = 0; c < 3; ++c) bad |= !isfinite(p[c]) | !isfinite(v[c]);
+  for (int c = 0; c < 3; ++c) {
+    const float s = fabs(v[c]) * dt;
+    const float lo = bad ? -INFINITY : p[c] - s, hi = bad ? INFINITY : p[c] + s;
+    red[c * FL_ACT_LOCAL + lid] = live ? lo : INFINITY;
+    red[(c + 3) * FL_ACT_LOCAL + lid] = live ? hi : -INFINITY;
+  }
+  const float len = sqrt(vx * vx + vy * vy + vz * vz) * dt;
+  red[6 * FL_ACT_LOCAL + lid] = live ? (bad ? INFINITY : len) : 0.0f;
+  /* Two levels: 56 work-items take 32 values each (7 bounds x 8 parts), then each work-item
+   * that decides for an action reduces the 56 itself. Three barriers in all: each costs PoCL
+   * a parallel region. The next call writes red (and the part, the decisions) only after
+   * barriers that follow every read of this one. */
+  barrier(CLK_LOCAL_MEM_FENCE);
+  __local float* part = red + 7 * FL_ACT_LOCAL;
+  if (lid < 56u) {
+    const uint c = lid >> 3;
+    __local const float* x = red + c * FL_ACT_LOCAL + (lid & 7u) * (FL_ACT_LOCAL / 8);
+    float m = x[0];
+    for (uint k = 1u; k < FL_ACT_LOCAL / 8; ++k)
+      m = c < 3u ? (x[k] < m ? x[k] : m) : (x[k] > m ? x[k] : m);
+    part[lid] = m;
+  }
+  barrier(CLK_LOCAL_MEM_FENCE);
+  if (lid < n || lid == 0u) {
+    float box[7];
+    for (uint c = 0u; c < 7u; ++c) {
+      __local const float* x = part + c * 8u;
+      float m = x[0];
+      for (uint k = 1u; k < 8u; ++k) m = c < 3u ? (x[k] < m ? x[k] : m) : (x[k] > m ? x[k] : m);
+      box[c] = m;
+    }
+    if (lid == 0u) red[FL_CULL_GAP - 1] = box[6];
+    for (uint k = lid; k < n; k += FL_ACT_LOCAL) {
+      __global const float* r = reach + k * FL_REACH_FLOATS;
+      float gap = -1.0f;
+      if (r[6] >= 0.0f && fl_cull_apart(box, 0.0f, r)) {
+        /* apart is monotonic in the widening: the largest of a few that still holds. */
+        float d = 0.0f;
+        for (int c = 0; c < 3; ++c) d = fmax(d, fmax(box[c] - r[3 + c], r[c] - box[3 + c]));
+        gap = 0.0f;
+        for (float f = 0.9f; f > 0.05f; f *= 0.5f)
+          if (fl_cull_apart(box, f * d, r)) {
+            gap = f * d;
+            break;
+          }
+      }
+      red[FL_CULL_GAP + k] = gap;
+    }
+  }
+  barrier(CLK_LOCAL_MEM_FENCE);
+  return red[FL_CULL_GAP - 1];
+}
+
+/* Whether no particle of the work-group can reach the action's reach box r (FL_REACH_FLOATS):
+ * the bounds, widened by grow on every side, are apart from it by more than the rounding of
+ * the action's own tests. The CPU's Culler::apart, the same margin. */
+FL_INLINE uint fl_cull_apart(const float* box, float grow, __global const float* r) {
+  float lo[3], hi[3], scale = 0.0f;
+  for (int c = 0; c < 3; ++c) {
+    lo[c] = box[c] - grow;
+    hi[c] = box[3 + c] + grow;
+    scale = fmax(scale, fmax(fabs(lo[c]), fabs(hi[c])));
+  }
+  if (!(scale < INFINITY)) return 0u; /* unbounded (or empty, or NaN): the bounds say nothing */
+  const float s = scale + r[6];
+  const float margin = 1e-4f * (1.0f + s) + r[7] * s * s;
+  int out = 0;
+  for (int c = 0; c < 3; ++c) out |= (lo[c] - margin > r[3 + c]) | (hi[c] + margin < r[c]);
+  return out ? 1u : 0u;
+}

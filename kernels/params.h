@@ -120,10 +120,21 @@ typedef struct FlActionParams {
 #define FL_STATE_SUBSTEPS 8 /* this step: sub-steps (Substeps::maxDistance), from fl_max_speed */
 #define FL_STATE_MAX_SPEED2 9 /* this step: the largest |v|^2, as float bits (atomic_max) */
 #define FL_STATE_HAIR_ALIVE 10 /* hair: strands whose particle outlived maxVertices (cumulative) */
-#define FL_STATE_KILLS 11   /* then one cumulative (wrapping) kill counter per kill code */
-#define FL_STATE_HEADER 11
+#define FL_STATE_CULLED 11 /* work-group x actions skipped by culling (cumulative, wraps) */
+#define FL_STATE_KILLS 12   /* then one cumulative (wrapping) kill counter per kill code */
+#define FL_STATE_HEADER 12
 #define FL_KILL_CODES 255   /* codes 1..255: 1 + the killing action, 255 non-finite */
 #define FL_NON_FINITE_CODE 255
+
+/* Work-items per work-group of fl_act and fl_small (their culling reduces over it). */
+#define FL_ACT_LOCAL 256
+
+/* Spatial culling: per action, FL_REACH_FLOATS floats in the list's `extra` (from the
+ * argument reachOff on): its reach box lo x y z, hi x y z, the box's max |coordinate| and the
+ * margin's quadratic term (ActionPlan::Reach), a scale < 0 when the action has no finite
+ * reach; [8] 1 when the bounds need not be gathered again after it (a Bounce that slows,
+ * a Damping, a Gravity of weight <= 1), [9] a Gravity's |acceleration|, summed over axes. */
+#define FL_REACH_FLOATS 10
 
 /* Particles per tile of the death count and the hole list (a multiple of 16: counted as
  * uint4 words). */

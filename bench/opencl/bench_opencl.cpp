@@ -160,7 +160,7 @@ void SmallStep(benchmark::State& state, Backend backend) {
 // Skip what a scene doesn't need (issue #17), on both backends: 1M particles bouncing on
 // floors of which each reaches one, with 32 floors in the list against 2
 // (bench/common/scenes.hpp; the CPU backend culls per block of particles, the OpenCL backend
-// does not cull: every particle tests every floor)...
+// per work-group)...
 void Deflectors(benchmark::State& state, Backend backend) {
   if (backend == Backend::OpenCL && !haveDevice()) return state.SkipWithError("no OpenCL device");
   const auto deflectors = int(state.range(0));

@@ -116,6 +116,14 @@ TEST(OpenCLCore, SubstepsByTimeAndByDistance) {
   checkParity(spraying(byDistance));
 }
 
+// A whole number as the distance: the program spelled it "1f", which is no OpenCL literal.
+TEST(OpenCLCore, SubstepsByAWholeDistance) {
+  ActionList list{Gravity{kDown}, Bounce{Domain::plane(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f)), 0.7f},
+                  Move{}, KillOld{}};
+  list.setSubsteps({0.0, 1.0f, 16});
+  checkParity(spraying(list));
+}
+
 TEST(OpenCLCore, NonFiniteParticlesAreKilledAndCounted) {
   // A callback that poisons some particles: both backends kill and count the same ones.
   auto build = [](bool device) {

@@ -2,6 +2,11 @@
 // (kernels/surfaces.cl). Each test runs the same build on the CPU and on the device
 // (tests/opencl/parity.hpp) and first checks that the action visibly changes the particles
 // (hits, kills), so that a device doing nothing could not pass.
+#include <algorithm>
+#include <bit>
+#include <random>
+#include <vector>
+
 #include "parity.hpp"
 
 using namespace flurry;
@@ -282,4 +287,194 @@ TEST(OpenCLSurfaces, NeighboursWhileParticlesDie) {
               spray(Vec3(0.0f, 1.0f, 0.0f), 150));
   checkAction({MatchVelocity{2.0f, 1e-3f, 0.6f}, Gravity{kDown}, kFloor, Move{}, KillOld{}}, 0,
               spray(Vec3(0.0f, 1.0f, 0.0f), 150));
+}
+
+// ---- Spatial culling per work-group (issue #17) ---------------------------------------------
+
+namespace {
+
+// Many finite deflectors, absorbers, blockers and falloff forces over [-50, 50]³ (as
+// tests/test_actions.cpp cullingScene), among particles 2 % of which cross several pieces in
+// one step; a stack of close discs; an emitter, so that newborns (each with its own step
+// length) share work-groups with the others.
+ActionList cullingScene(std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> pos(-50.0f, 50.0f), size(1.0f, 8.0f), unit(-1.0f, 1.0f);
+  auto point = [&] { return Vec3(pos(rng), pos(rng), pos(rng)); };
+  auto dir = [&] {
+    Vec3 d(unit(rng), unit(rng), unit(rng));
+    return glm::length(d) > 0.1f ? glm::normalize(d) : Vec3(0.0f, 1.0f, 0.0f);
+  };
+  ActionList list;
+  list.add(Gravity{Vec3(0.0f, -9.81f, 0.0f), {point(), size(rng) * 2.0f, 1.0f}});
+  list.add(Gravity{Vec3(3.0f, 0.0f, -2.0f), {point(), size(rng) * 2.0f, 2.0f}});
+  Damping d;
+  d.rate = Vec3(0.5f);
+  d.falloff = {point(), size(rng) * 2.0f, 1.0f};
+  list.add(d);
+  list.add(Block{Domain::box(point(), point())});
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 c = point();
+    const float s = size(rng);
+    list.add(Bounce{Domain::rectangle(c, dir() * s, dir() * s), 0.8f, 0.1f, 0.0f});
+    list.add(Bounce{Domain::disc(point(), dir(), s, 0.2f * s), 0.5f, 0.0f, 0.0f});
+    list.add(
+        Bounce{Domain::triangle(point(), point() * 0.1f + c, c + dir() * s), 1.0f, 0.2f, 0.1f});
+    list.add(Bounce{Domain::sphere(point(), s), 0.9f, 0.1f, 0.0f, k % 2 == 0});
+    const Vec3 b = point();
+    list.add(Bounce{Domain::box(b, b + Vec3(s)), 0.7f, 0.0f, 0.0f});
+  }
+  const Vec3 stack = point();
+  for (int k = 0; k < 4; ++k)
+    list.add(Bounce{
+        Domain::disc(stack + Vec3(0.7f * float(k), 0.0f, 0.0f), Vec3(1.0f, 0.0f, 0.0f), 10.0f),
+        0.9f, 0.0f, 0.0f});
+  list.add(Block{Domain::sphere(point(), size(rng))});
+  list.add(Sink{Domain::sphere(point(), size(rng)), true, 0.0f, Sink::Mode::Inside});
+  list.add(Sink{Domain::box(point(), point()), true, 0.3f, Sink::Mode::Enter});
+  list.add(Sink{Domain::cylinder(point(), point(), size(rng)), true, 0.0f, Sink::Mode::Leave});
+  list.add(Sink{Domain::disc(point(), dir(), size(rng)), true, 0.0f, Sink::Mode::Hit});
+  list.add(Move{});
+  return list;
+}
+
+struct CullRun {
+  std::vector<std::uint32_t> bits;  // every particle's position, velocity, age, visibility, id
+  GroupStats stats;
+};
+
+CullRun runCullingScene(std::uint32_t seed, bool cull, const Substeps* substeps,
+                        std::size_t count) {
+  ContextOptions o;
+  o.backend = Backend::OpenCL;
+  o.dt = 1.0 / 30.0;
+  o.seed = seed;
+  o.cull = cull;
+  Context ctx(o);
+  Group& g = ctx.createGroup("scene", count + 2000);
+  ActionList list = cullingScene(seed);
+  if (substeps) list.setSubsteps(*substeps);
+  g.setActions(list);
+  Emitter e = spray(Vec3(-20.0f, 0.0f, 10.0f), 600);
+  g.addEmitter(e);
+  std::mt19937 rng(seed + 1);
+  std::uniform_real_distribution<float> pos(-50.0f, 50.0f);
+  std::normal_distribution<float> speed(0.0f, 3.0f);
+  // In x order, as particles near one another mostly are in a group (their emitter's).
+  std::vector<Particle> ps(count);
+  for (std::size_t i = 0; i < ps.size(); ++i) {
+    Particle& p = ps[i];
+    p.position = Vec3(pos(rng), pos(rng), pos(rng));
+    p.velocity = Vec3(speed(rng), speed(rng), speed(rng)) * (i % 50 == 0 ? 20.0f : 1.0f);
+    if (i % 97 == 0) p.velocity.y = -0.0f;  // a -0 the falloff gravity must keep as it does
+  }
+  std::sort(ps.begin(), ps.end(),
+            [](const Particle& a, const Particle& b) { return a.position.x < b.position.x; });
+  for (const Particle& p : ps) g.add(p);
+  ctx.run(10);
+  CullRun r;
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const Particle p = g.particle(i);
+    auto put = [&](float x) { r.bits.push_back(std::bit_cast<std::uint32_t>(x)); };
+    for (int c = 0; c < 3; ++c) put(p.position[c]), put(p.velocity[c]);
+    put(p.age);
+    r.bits.push_back(p.visible ? 1u : 0u);
+    r.bits.push_back(p.id);
+  }
+  r.stats = g.stats();
+  return r;
+}
+
+// Each configuration is two programs (with and without culling) of a long list: a few
+// seconds each on PoCL.
+void expectCullingExact(std::size_t count, const Substeps* substeps) {
+  FLURRY_REQUIRE_OPENCL();
+  for (std::uint32_t seed : {1u, 2u}) {
+    const CullRun on = runCullingScene(seed, true, substeps, count);
+    const CullRun off = runCullingScene(seed, false, substeps, count);
+    EXPECT_EQ(on.bits.size(), off.bits.size()) << "seed " << seed;
+    EXPECT_TRUE(on.bits == off.bits) << "seed " << seed;
+    EXPECT_EQ(on.stats.killedByAction, off.stats.killedByAction);
+    EXPECT_GT(on.stats.blockActionsCulled, 0u);  // culling did skip work
+    EXPECT_EQ(off.stats.blockActionsCulled, 0u);
+  }
+}
+
+}  // namespace
+
+// fl_act: many work-groups.
+TEST(OpenCLCulling, RandomScenesAreBitwiseTheSameWithAndWithout) {
+  expectCullingExact(20000, nullptr);
+}
+
+// fl_small (up to 4096 particles): the group's whole step in one work-group, in passes of it;
+// sub-steps.
+TEST(OpenCLCulling, SmallGroupIsBitwiseTheSameWithAndWithout) {
+  const Substeps three{1.0 / 90.0, 0.0f, 8};  // its barriers in the sub-step loop
+  expectCullingExact(1500, &three);
+}
+
+// A fast particle among slow ones reaches a deflector far from its work-group's other
+// particles in one step: the swept bounds reach it, so it is bounced; a second, unreachable
+// deflector is skipped (by every work-group of fl_act).
+TEST(OpenCLCulling, AFarDeflectorReachedInOneStepStillBounces) {
+  FLURRY_REQUIRE_OPENCL();
+  ContextOptions o;
+  o.backend = Backend::OpenCL;
+  o.dt = 0.1;
+  Context ctx(o);
+  Group& g = ctx.createGroup("g", 8192);
+  g.setActions({Bounce{Domain::disc(Vec3(50.0f, 0.0f, 0.0f), Vec3(1.0f, 0.0f, 0.0f), 2.0f)},
+                Bounce{Domain::sphere(Vec3(0.0f, -500.0f, 0.0f), 1.0f)}, Move{}});
+  for (int i = 0; i < 8192; ++i) {
+    Particle p;
+    p.position = Vec3(float(i % 16) * 0.01f, float(i / 16) * 0.01f - 0.5f, 0.0f);
+    p.velocity = i == 1000 ? Vec3(600.0f, 0.0f, 0.0f) : Vec3(0.0f, 0.0f, 0.1f);
+    p.position.y = i == 1000 ? 0.0f : p.position.y;
+    g.add(p);
+  }
+  ctx.step();
+  bool found = false;
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const Particle p = g.particle(i);
+    if (p.id != 1000) continue;
+    found = true;
+    EXPECT_LT(p.velocity.x, 0.0f);   // reflected
+    EXPECT_LT(p.position.x, 50.0f);  // in front of the disc
+  }
+  EXPECT_TRUE(found);
+  // 32 work-groups of 256: each skips the far sphere; the disc only where it is out of reach.
+  EXPECT_GE(g.stats().blockActionsCulled, 32u);
+}
+
+// A deflector turns a work-group's paths towards a second one that their bounds, gathered
+// before the first, did not reach: the bounds follow the bounce (codegen.cpp followCode),
+// so the second still deflects them.
+TEST(OpenCLCulling, ABouncedPathIsFollowedToTheNextDeflector) {
+  FLURRY_REQUIRE_OPENCL();
+  ContextOptions o;
+  o.backend = Backend::OpenCL;
+  o.dt = 0.1;
+  Context ctx(o);
+  Group& g = ctx.createGroup("g", 256);
+  // A wall at 45° through x = 1 sends +x into +y; a ceiling at y = 0.3 above it.
+  g.setActions({Bounce{Domain::rectangle(Vec3(0.5f, -0.5f, -1.0f), Vec3(1.0f, 1.0f, 0.0f),
+                                         Vec3(0.0f, 0.0f, 2.0f))},
+                Bounce{Domain::rectangle(Vec3(0.0f, 0.3f, -1.0f), Vec3(2.0f, 0.0f, 0.0f),
+                                         Vec3(0.0f, 0.0f, 2.0f))},
+                Bounce{Domain::sphere(Vec3(0.0f, -500.0f, 0.0f), 1.0f)}, Move{}});
+  for (int i = 0; i < 256; ++i) {
+    Particle p;
+    p.position = Vec3(0.9f, 0.0f, float(i) / 256.0f * 0.2f - 0.1f);
+    p.velocity = Vec3(6.0f, 0.0f, 0.0f);
+    g.add(p);
+  }
+  ctx.step();
+  ASSERT_EQ(g.size(), 256u);
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const Particle p = g.particle(i);
+    EXPECT_LT(p.velocity.y, -5.9f) << p.id;  // turned up by the wall, down by the ceiling
+    EXPECT_LT(p.position.y, 0.3f) << p.id;   // under the ceiling
+  }
+  EXPECT_GE(g.stats().blockActionsCulled, 1u);  // the far sphere
 }

@@ -205,7 +205,7 @@ class ClGroup final : public DeviceMirror {
   cl_context context() const { return shared_->runtime->context(); }
 
   void allocate(GroupImpl& g);
-  void buildProgram(GroupImpl& g);
+  void buildProgram(GroupImpl& g, bool cull);
   void upload(GroupImpl& g);
   void retire(GroupImpl& g, bool wait);
   void drain(GroupImpl& g) {
@@ -237,9 +237,12 @@ class ClGroup final : public DeviceMirror {
   std::size_t runsRoom_ = 0;
   std::vector<std::uint64_t> staticUploaded_;
   bool hairProgram_ = false;  // the program has fl_hair
+  bool cullProgram_ = false;  // the program was generated for ContextOptions::cull
   Kernel hair_, small_;
   GrowBuffer strandP_, strandC_, strandR_, strandCount_;
   std::uint32_t lastHairAlive_ = 0;
+  std::uint32_t lastCulled_ = 0;
+  std::uint32_t reachOff_ = 0;  // where the actions' reach boxes start in extra_host_
   std::vector<LaneRef> actLanes_;
   bool neighbours_ = false, substepsByDistance_ = false;
   Kernel act_, count_, scan_, list_, scanList_, tailKernel_, maxSpeed_, birth_;
@@ -305,10 +308,11 @@ void ClGroup::allocate(GroupImpl& g) {
   programValid_ = false;
 }
 
-void ClGroup::buildProgram(GroupImpl& g) {
+void ClGroup::buildProgram(GroupImpl& g, bool cull) {
   // The emitter codes this step refreshed: the program and the planning agree on them.
-  const GeneratedProgram gen = generateProgram(
-      g.actions, g.stored, shared_->fp64(), emissionSource(emitterCodes_.variants), g.hair.enabled);
+  const GeneratedProgram gen =
+      generateProgram(g.actions, g.stored, shared_->fp64(), emissionSource(emitterCodes_.variants),
+                      g.hair.enabled, cull);
   emitterSignature_ = emitterSignature(emitterCodes_.variants);
   Program p(shared_->runtime->program(gen.source, gen.options));
   cl_int err = CL_SUCCESS;
@@ -334,6 +338,7 @@ void ClGroup::buildProgram(GroupImpl& g) {
   hair_ = std::move(hair);
   small_ = std::move(small);
   hairProgram_ = g.hair.enabled;
+  cullProgram_ = cull;
   actLanes_ = gen.actLanes;
   neighbours_ = gen.neighbours;
   substepsByDistance_ = gen.substepsByDistance;
@@ -402,6 +407,7 @@ void ClGroup::upload(GroupImpl& g) {
   nextId_ = g.nextId;
   lastDropped_ = 0;
   lastHairAlive_ = 0;
+  lastCulled_ = 0;
   lastKills_.assign(FL_KILL_CODES, 0u);
   (void)nActions;
   hostDirty_ = false;
@@ -416,6 +422,8 @@ void ClGroup::apply(GroupImpl& g, const std::vector<std::uint32_t>& s) {
   lastDropped_ = s[FL_STATE_DROPPED];
   g.stats.killedByAge += std::uint32_t(s[FL_STATE_HAIR_ALIVE] - lastHairAlive_);
   lastHairAlive_ = s[FL_STATE_HAIR_ALIVE];
+  g.stats.blockActionsCulled += std::uint32_t(s[FL_STATE_CULLED] - lastCulled_);
+  lastCulled_ = s[FL_STATE_CULLED];
   const auto& acts = programActions_.actions();
   {
     const std::size_t k = FL_NON_FINITE_CODE - 1;
@@ -567,8 +575,8 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   if (emitterCodes_.refresh(g) && programValid_ &&
       emitterSignature(emitterCodes_.variants) != emitterSignature_)
     programValid_ = false;
-  if (g.hair.enabled != hairProgram_) programValid_ = false;
-  if (!programValid_) buildProgram(g);
+  if (g.hair.enabled != hairProgram_ || sp.cull != cullProgram_) programValid_ = false;
+  if (!programValid_) buildProgram(g, sp.cull);
 
   // The actions' constants: packed again only for a new list or a new dt (they hold
   // products with dt), and uploaded only when their bytes changed.
@@ -577,6 +585,33 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   std::memcpy(&dtBitsF, &dtf, sizeof dtBitsF);
   if (packedVersion_ != g.actionsVersion || packedDt_ != dtBitsF) {
     packActions(g.actions, dtf, params_host_, extra_host_);
+    // The actions' reach boxes (the CPU's, cpu_backend.cpp actionReach: both backends cull
+    // alike) after the actions' own data, with what lets the bounds follow an action
+    // (codegen.cpp followCode).
+    const ActionPlan& plan = planActions(g);
+    reachOff_ = std::uint32_t(extra_host_.size());
+    const auto& acts = g.actions.actions();
+    for (std::size_t k = 0; k < acts.size(); ++k) {
+      const ActionPlan::Reach& r = plan.reach[k];
+      float follows = 0.0f, gain = 0.0f;
+      if (const auto* b = std::get_if<Bounce>(&acts[k])) {
+        // |v'| <= |v|: restitution and 1 - friction at most 1 in size.
+        follows = std::abs(b->restitution) <= 1.0f && b->friction >= 0.0f && b->friction <= 2.0f;
+      } else if (const auto* d = std::get_if<Damping>(&acts[k])) {
+        follows = d->rate.x >= 0.0f && d->rate.y >= 0.0f && d->rate.z >= 0.0f;
+      } else if (const auto* gr = std::get_if<Gravity>(&acts[k])) {
+        // The weight is 1, or (1 - d/radius)^power <= 1.
+        follows = !(gr->falloff.radius < kInfinity) ||
+                  (gr->falloff.radius > 0.0f && gr->falloff.power >= 0.0f);
+        const Vec3 a = gr->acceleration;
+        gain = std::abs(a.x) + std::abs(a.y) + std::abs(a.z);
+      }
+      static_assert(FL_REACH_FLOATS == 10);
+      const float box[FL_REACH_FLOATS] = {
+          r.lo[0],     r.lo[1], r.lo[2], r.hi[0], r.hi[1], r.hi[2], r.cullable ? r.scale : -1.0f,
+          r.quadratic, follows, gain};
+      extra_host_.insert(extra_host_.end(), box, box + FL_REACH_FLOATS);
+    }
     packedVersion_ = g.actionsVersion;
     packedDt_ = dtBitsF;
     const std::size_t paramBytes = params_host_.size() * sizeof(cl::FlActionParams);
@@ -753,6 +788,7 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     setArg(k, i++, cl_uint(births));
     setArg(k, i++, cap);
     setArg(k, i++, t1Bits);
+    setArg(k, i++, cl_uint(reachOff_));  // read only by a program that culls
     if (oneLaunch) {
       setArg(k, i++, tileDead_.get());
       setArg(k, i++, tileOff_.get());

@@ -307,7 +307,7 @@ std::string stepSource(const std::string& body, const Substeps& sub, bool byDist
     s << "  const uint nsub = 1u; (void)nsubStep;\n";
   if (byDistance) {
     char buf[64];
-    std::snprintf(buf, sizeof buf, "%.9g", double(sub.maxDistance));
+    std::snprintf(buf, sizeof buf, "%.9e", double(sub.maxDistance));  // "2f" is no literal
     s << "  {\n    const float vmax = sqrt(as_float(state[FL_STATE_MAX_SPEED2]));\n"
          "    if (isfinite(vmax)) {\n"
          "      const fl_real m = ceil((fl_real)vmax * fl_real_from_bits(dtBits) / (fl_real)"
@@ -320,7 +320,10 @@ std::string stepSource(const std::string& body, const Substeps& sub, bool byDist
     s << "  const float dt = (float)fl_len;\n";
   s << ""
        "  uint dead = 0u;\n"
-       "  for (uint sub = 0u; sub < nsub; ++sub) {\n"
+    // One sub-step: a block, not a loop (PoCL runs barriers in a loop less well).
+    << (sub.maxStep > 0 || byDistance ? "  for (uint sub = 0u; sub < nsub; ++sub) {\n"
+                                      : "  {\n    const uint sub = 0u;\n")
+    << ""
        "    const fl_real time = fl_t0 + (fl_real)sub * (fl_real)dt;\n"
        "    const uint streamSub = streamBase + (sub << 8);\n"
        "    (void)time; (void)streamSub;\n"
@@ -401,8 +404,125 @@ std::string hairKernel(const std::string& stepCode, const std::vector<LaneRef>& 
   return s.str();
 }
 
+namespace {
+
+// Whether action `a` may change positions or velocities: the work-group's bounds are taken
+// again after it (cpu_backend.cpp movesParticles; an action missing from this list only
+// costs a gather).
+bool mayMove(const Action& a) {
+  return !(std::holds_alternative<KillOld>(a) || std::holds_alternative<Sink>(a) ||
+           std::holds_alternative<SinkVelocity>(a) || std::holds_alternative<Block>(a) ||
+           std::holds_alternative<ColorOverLife>(a) || std::holds_alternative<SizeOverLife>(a) ||
+           std::holds_alternative<TargetColor>(a) || std::holds_alternative<TargetSize>(a) ||
+           std::holds_alternative<CopyVertexB>(a));
+}
+
+// What a culled action still does to stay bitwise exact (fused_pass.cpp applyCulled), or
+// false when it is never culled (no finite reach: cpu_backend.cpp actionReach, by the
+// action's kind; the host's reach in extra, scale >= 0, says whether it is this step).
+bool culledCode(const Action& a, std::size_t k, std::string& code) {
+  code.clear();
+  if (const auto* b = std::get_if<Bounce>(&a)) {
+    const auto& s = b->surface.shape();
+    return std::holds_alternative<RectangleDomain>(s) ||
+           std::holds_alternative<TriangleDomain>(s) || std::holds_alternative<DiscDomain>(s) ||
+           std::holds_alternative<SphereDomain>(s) ||
+           (std::holds_alternative<BoxDomain>(s) && !b->inside);
+  }
+  if (const auto* s = std::get_if<Sink>(&a)) {
+    using M = Sink::Mode;
+    return !((s->mode == M::Inside && !s->killInside) || (s->mode == M::Outside && s->killInside));
+  }
+  if (std::holds_alternative<Block>(a)) {
+    // The first blocker starts from "visible" (its apply, kept in the source, defined it).
+    code = "#if FL_FIRST_BLOCKER == " + std::to_string(k) + "\nvis = 1u;\n#endif\n";
+    return true;
+  }
+  if (const auto* g = std::get_if<Gravity>(&a)) {
+    if (!(g->falloff.radius < kInfinity)) return false;
+    // fl_gravity_falloff with its weight +0: v + a·(dt·0) turns -0 into +0.
+    const std::string ap = "(ap + " + std::to_string(k) + ")";
+    code = "vx = vx + " + ap + "->f[0] * (dt * 0.0f);\nvy = vy + " + ap +
+           "->f[1] * (dt * 0.0f);\nvz = vz + " + ap + "->f[2] * (dt * 0.0f);\n";
+    return true;
+  }
+  if (const auto* d = std::get_if<Damping>(&a)) return d->falloff.radius < kInfinity;
+  return false;
+}
+
+// How the work-group's bounds follow action k when it runs, without a gather (the host
+// says in extra, reach [8], whether this action qualifies): a Bounce that does not speed
+// particles up ends each path within the longest path (bounds [6]) of a point of the old
+// one, its new start within twice; a Gravity of weight <= 1 lengthens paths by at most
+// |a|·dt² (the sum of its axes in reach [9]); a slowing Damping keeps each path within its
+// old one. "" for an action the bounds cannot follow: they are gathered again.
+std::string followCode(const Action& a, const std::string& r) {
+  const std::string lost = "    else fl_grow = INFINITY;\n";
+  if (std::holds_alternative<Bounce>(a))
+    return "    if (" + r + "[8] > 0.0f) fl_grow += 2.0f * fl_rmax;\n" + lost;
+  if (std::holds_alternative<Gravity>(a))
+    return "    if (" + r + "[8] > 0.0f) {\n      const float fl_d = " + r +
+           "[9] * fl_dtmax * fl_dtmax;\n      fl_grow += fl_d;\n      fl_rmax += fl_d;\n"
+           "    }\n" +
+           lost;
+  if (std::holds_alternative<Damping>(a))
+    return "    if (!(" + r + "[8] > 0.0f)) fl_grow = INFINITY;\n";
+  return "";
+}
+
+// The list's body with spatial culling. The work-group's swept bounds are gathered
+// (fl_cull_gather: barriers) at points chosen here: before the first action that may be
+// culled, and again before the next one after an action that moves particles in a way the
+// bounds cannot follow (followCode; a Move). Each gather is unconditional, under no branch
+// but the sub-step loop (whose count is the same for the whole group), as PoCL needs
+// (barriers under run-time branches hung it), and a gather costs PoCL a parallel region per
+// barrier: hence few of them. An action whose reach (the host's, in extra) the bounds
+// cannot touch, widened by how far the paths may have left them since (fl_grow), is
+// skipped: the gather decides for every action once per work-group (PoCL would test each
+// work-item). fl_grow and fl_rmax have one value in the work-group (the reduced bounds, the
+// list's constants), so the skips are the group's; the skipped code holds no barrier. A
+// skip is counted once per work-group.
+std::string cullingBody(const std::vector<Action>& acts, const std::string& body,
+                        const std::vector<std::size_t>& marks, const std::vector<int>& placed) {
+  std::ostringstream s;
+  s << "    float fl_rmax = 0.0f; /* the longest path of the group */\n"
+       "    /* How far paths may have left the bounds since they were gathered (infinite: the\n"
+       "     * bounds are lost) */\n"
+       "    float fl_grow = INFINITY;\n"
+       "    const float fl_dtmax = (float)(fl_real_from_bits(dtBits) / (fl_real)nsub);\n"
+       "    (void)fl_rmax; (void)fl_grow; (void)fl_dtmax;\n";
+  bool stale = true;  // no bounds gathered since the sub-step's start or the last move
+  std::string culled;
+  for (std::size_t k = 0; k < acts.size(); ++k) {
+    const std::string piece = body.substr(marks[k], marks[k + 1] - marks[k]);
+    const std::string r = "(extra + reachOff + " + std::to_string(k * FL_REACH_FLOATS) + "u)";
+    const bool moves = placed[k] != 0 && mayMove(acts[k]);
+    const std::string follow = placed[k] == 1 && moves ? followCode(acts[k], r) : "";
+    if (placed[k] == 1 && culledCode(acts[k], k, culled)) {
+      if (stale)
+        s << "    fl_rmax = fl_cull_gather(fl_red, fl_live, dt, px, py, pz, vx, vy, vz, extra + "
+             "reachOff, "
+          << acts.size() << "u);\n    fl_grow = 0.0f;\n";
+      stale = false;
+      s << "    if (!(fl_grow <= fl_red[FL_CULL_GAP + " << k << "u])) {\n"
+        << piece << (moves ? follow : "") << "    } else {\n"
+        << "    if (get_local_id(0) == 0u) atomic_inc(&state[FL_STATE_CULLED]);\n";
+      std::istringstream lines(culled);
+      for (std::string line; std::getline(lines, line);) s << "    " << line << "\n";
+      s << "    }\n";
+    } else {
+      s << piece;
+      if (moves && !stale) s << follow;
+    }
+    if (moves && follow.empty()) stale = true;
+  }
+  return s.str();
+}
+
+}  // namespace
+
 GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored, bool fp64,
-                                 const std::string& emitSource, bool hair) {
+                                 const std::string& emitSource, bool hair, bool cull) {
   GeneratedProgram g;
   // What the act kernel loads (reads) and stores (writes).
   AttributeSet reads, writes;
@@ -444,9 +564,15 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
       }
     }
   }
+  // Where each action's code starts in `body`, and how it was placed there: 0 evaluated by
+  // the next Move (no code), 1 its own update (src.apply), 2 other code (a Move's integrator,
+  // a Bounce on the curved path).
+  std::vector<std::size_t> marks(acts.size() + 1, 0);
+  std::vector<int> placed(acts.size(), 2);
   for (std::size_t k = 0; k < acts.size(); ++k) {
     const Action& act = acts[k];
     ActionSource& src = sources[k];
+    marks[k] = std::size_t(body.tellp());
     reads.insert(src.reads);
     writes.insert(src.writes);
     g.neighbours |= src.neighbours;
@@ -458,6 +584,7 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
         pending.push_back(src.accel);
         pendingDamping.push_back(std::holds_alternative<Damping>(act) ? src.in.params : "");
         body << "    /* (evaluated by the next Move's integrator) */\n";
+        placed[k] = 0;
         continue;
       }
       if (std::holds_alternative<Bounce>(act)) {
@@ -498,9 +625,11 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
         continue;
       }
     }
+    placed[k] = 1;
     std::istringstream lines(src.apply);
     for (std::string line; std::getline(lines, line);) body << "    " << line << "\n";
   }
+  marks[acts.size()] = std::size_t(body.tellp());
   // The NaN guard reads what it checks.
   if (stored.has(Attribute::Velocity)) reads.insert(Attribute::Velocity);
   reads.insert(Attribute::Position);
@@ -534,35 +663,57 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
     if (touched.has(l.attribute)) g.actLanes.push_back(l);
   // The per-particle part, shared by fl_act and fl_small. A newborn (i >= n0) runs the list
   // for the part of the step it still has to live, from its birth time on.
+  // With culling (cull, and velocities for the swept bounds) fl_act and fl_small hold
+  // barriers: every work-item runs the list, those past the live particles (fl_live == 0)
+  // on zeros, storing nothing. Without (or with no action that may be culled) the program
+  // has no trace of it.
+  bool cullable = false;
+  for (std::size_t k = 0; k < acts.size(); ++k) {
+    std::string unused;
+    cullable |= placed[k] == 1 && culledCode(acts[k], k, unused);
+  }
+  g.culls = cull && cullable && stored.has(Attribute::Velocity);
+  const char* live = g.culls ? "fl_live && " : "";
   std::ostringstream one;
   one << "  fl_real fl_len = fl_real_from_bits(dtBits), fl_t0 = t0;\n"
-         "  if (i >= n0) {\n    const fl_real left = (fl_real)tau[i - n0];\n"
+         "  if ("
+      << live
+      << "i >= n0) {\n    const fl_real left = (fl_real)tau[i - n0];\n"
          "    fl_len = left;\n    fl_t0 = t1 - left;\n  }\n";
   for (const auto& l : g.actLanes) {
     const char* type = info(l.attribute).isUint ? "uint" : "float";
-    if (reads.has(l.attribute))
-      one << "  " << type << " " << l.name << " = l_" << l.name << "[i];\n";
-    else
+    if (!reads.has(l.attribute))
       one << "  " << type << " " << l.name << ";\n";
+    else if (g.culls)
+      one << "  " << type << " " << l.name << " = fl_live ? l_" << l.name << "[i] : 0;\n";
+    else
+      one << "  " << type << " " << l.name << " = l_" << l.name << "[i];\n";
   }
+  // Hair mode (one work-item per strand, each to its own death) runs the plain list.
   const std::string stepCode = stepSource(body.str(), sub, g.substepsByDistance, stored, guarded);
-  one << stepCode;
+  one << (g.culls ? stepSource(cullingBody(acts, body.str(), marks, placed), sub,
+                               g.substepsByDistance, stored, guarded)
+                  : stepCode);
+  const char* ind = g.culls ? "    " : "  ";
+  if (g.culls) one << "  if (fl_live) {\n";
   for (const auto& l : g.actLanes)
-    if (writes.has(l.attribute)) one << "  l_" << l.name << "[i] = " << l.name << ";\n";
-  one << "  codes[i] = (uchar)dead;\n";
+    if (writes.has(l.attribute)) one << ind << "l_" << l.name << "[i] = " << l.name << ";\n";
+  one << ind << "codes[i] = (uchar)dead;\n";
+  if (g.culls) one << "  }\n";
   const char* actArgs =
       "__global uchar* restrict codes, __global const FlActionParams* restrict ap,\n"
       "    __global uint* state, __global const float* restrict extra,\n"
       "    __global const float* restrict snap, ulong dtBits, ulong timeBits, uint seedLo,\n"
       "    uint seedHi, uint step, uint streamBase, uint nsubStep, uint snapStride,\n"
-      "    __global float* restrict tau, uint births, uint capacity, ulong t1Bits";
+      "    __global float* restrict tau, uint births, uint capacity, ulong t1Bits,\n"
+      "    uint reachOff";
   // [0, n0) lived before the step, [n0, n) are its newborns (fl_birth wrote them).
   const char* actPrologue =
       "  const uint n0 = state[FL_STATE_SIZE];\n"
       "  const uint n = fl_step_range(state, births, capacity);\n"
       "  const uint snapN = n;\n"
       "  (void)extra; (void)snap; (void)snapN; (void)snapStride; (void)seedLo; (void)seedHi;\n"
-      "  (void)step;\n"
+      "  (void)step; (void)reachOff;\n"
       "  const fl_real t0 = fl_real_from_bits(timeBits), t1 = fl_real_from_bits(t1Bits);\n";
   // The per-particle part once, as a function both kernels call: PoCL compiles the action
   // list's body once per program instead of once per kernel (cold start, issue #11).
@@ -573,7 +724,9 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
        "    __global const float* restrict snap, ulong dtBits, uint seedLo, uint seedHi,\n"
        "    uint step, uint streamBase, uint nsubStep, uint snapStride,\n"
        "    __global float* restrict tau, uint i, uint n0, uint n, uint snapN, fl_real t0,\n"
-       "    fl_real t1) {\n"
+       "    fl_real t1"
+    << (g.culls ? ", uint reachOff, uint fl_live, __local float* fl_red" : "")
+    << ") {\n"
        "  (void)state; (void)extra; (void)snap; (void)snapN; (void)snapStride; (void)seedLo;\n"
        "  (void)seedHi; (void)step; (void)n;\n"
     << one.str() << "}\n";
@@ -581,33 +734,44 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   for (const auto& l : g.actLanes) call += std::string("l_") + l.name + ", ";
   call +=
       "codes, ap, state, extra, snap, dtBits, seedLo, seedHi, step, streamBase, nsubStep,\n"
-      "      snapStride, tau, i, n0, n, snapN, t0, t1);\n";
-  s << "/* ---- generated: the fused act kernel */\n__kernel void fl_act(";
+      "      snapStride, tau, i, n0, n, snapN, t0, t1";
+  call += g.culls ? ", reachOff, i < n, fl_red);\n" : ");\n";
+  const std::string local = g.culls ? "  __local float fl_red[FL_CULL_LOCAL_FLOATS + " +
+                                          std::to_string(acts.size() + 1) +
+                                          "]; /* the culling's reduction and decisions */\n"
+                                    : "";
+  const char* size = g.culls ? "__attribute__((reqd_work_group_size(FL_ACT_LOCAL, 1, 1))) " : "";
+  s << "/* ---- generated: the fused act kernel */\n__kernel " << size << "void fl_act(";
   for (const auto& l : g.actLanes) s << laneDecl(l) << ", ";
   s << actArgs << ") {\n"
-    << actPrologue << "  const uint i = get_global_id(0);\n  if (i >= n) return;\n  " << call
-    << "}\n";
+    << local << actPrologue << "  const uint i = get_global_id(0);\n"
+    << (g.culls ? "" : "  if (i >= n) return;\n") << "  " << call << "}\n";
   // A small group's whole step in one launch of one work-group: births, act,
   // count-scan-list, tail. PoCL pays several microseconds per launch; this is one instead of
   // four.
   // Not for lists that read neighbours: their snapshot, copied before the act kernel, must
   // hold the newborns where they were born, so fl_birth runs before the copy.
   g.small = !g.substepsByDistance && !hair && !g.neighbours;
+  // With culling, in whole passes of the work-group (n is the same for all): the barriers.
+  const std::string loop = g.culls
+                               ? "  for (uint fl_first = 0u; fl_first < n; fl_first += lsize) {\n"
+                                 "    const uint i = fl_first + lid;\n    "
+                               : "  for (uint i = lid; i < n; i += lsize) {\n    ";
   if (g.small)
-    s << "/* ---- generated: a small group's step */\n"
-         "__kernel void fl_small(FL_LANE_PARAMS, "
-      << actArgs
+    s << "/* ---- generated: a small group's step */\n__kernel " << size
+      << "void fl_small(FL_LANE_PARAMS, " << actArgs
       << ",\n    __global uint* tileDead, __global uint* tileOff, __global uint* holes,\n"
          "    __global uint* tail, uint tiles,\n"
          "    __global const uchar* tables, uint offEmitters, uint offTypes, uint offKeys,\n"
          "    uint offShapes, uint runCount, uint salt) {\n"
          "  const uint lid = get_local_id(0), lsize = get_local_size(0);\n"
-         "  fl_birth_body(lid, lsize, FL_LANE_ARGS, tau, state, births, capacity, tables,\n"
+      << local
+      << "  fl_birth_body(lid, lsize, FL_LANE_ARGS, tau, state, births, capacity, tables,\n"
          "                offEmitters, offTypes, offKeys, offShapes, runCount, t1Bits, seedLo,\n"
          "                seedHi, salt);\n"
          "  barrier(CLK_GLOBAL_MEM_FENCE);\n"
          "  {\n"
-      << actPrologue << "  for (uint i = lid; i < n; i += lsize) {\n    " << call
+      << actPrologue << loop << call
       << "  }\n  }\n"
          "  barrier(CLK_GLOBAL_MEM_FENCE);\n"
          "  if (lid == 0u) fl_scan_list_body(codes, tileDead, tileOff, holes, tail, state, "

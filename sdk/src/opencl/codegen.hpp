@@ -31,15 +31,18 @@ struct GeneratedProgram {
   bool neighbours = false;          ///< fl_act reads the snapshot of p, v, rot
   bool substepsByDistance = false;  ///< fl_max_speed runs before fl_act
   bool small = false;               ///< has fl_small: a small group's whole step in one work-group
+  bool culls = false;               ///< fl_act and fl_small cull per work-group (reachOff)
 };
 
 /// The program for this list over these stored attributes: the embedded kernels plus one
 /// generated fused act kernel (fl_act) that runs exactly the list's actions, in order, and
 /// loads and stores exactly the lanes they use. `emitSource` is the generated emission code
 /// (emission.hpp emissionSource), placed before tail.cl. With `hair`, the program also has
-/// fl_hair, which runs each newborn's whole life as a strand (hair mode).
+/// fl_hair, which runs each newborn's whole life as a strand (hair mode). With `cull`,
+/// fl_act and fl_small skip actions out of a work-group's reach (ContextOptions::cull).
 GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored, bool fp64,
-                                 const std::string& emitSource, bool hair = false);
+                                 const std::string& emitSource, bool hair = false,
+                                 bool cull = false);
 
 /// What the generator of one action writes into the fused act kernel.
 ///
