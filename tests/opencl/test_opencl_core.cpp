@@ -67,7 +67,10 @@ TEST(OpenCLCore, CallbackWithAnOpenCLBody) {
         if (p.position.y > 2.0f) p.velocity.x += 0.5f;
       };
       if (device) cb.opencl = "user += dt;\nif (py > 2.0f) vx += 0.5f;";
-      g.setActions({Gravity{kDown}, cb, Move{}, KillOld{}});
+      // The far sink makes the device's program one that culls (its work-items past the
+      // live particles run the list on zeros): the callback runs for live particles only.
+      g.setActions({Gravity{kDown}, cb, Move{}, KillOld{},
+                    Sink{.region = Domain::sphere(Vec3(100.0f, 0.0f, 0.0f), 1.0f)}});
       return g;
     };
   };

@@ -330,10 +330,10 @@ ActionList cullingScene(std::uint32_t seed) {
         Domain::disc(stack + Vec3(0.7f * float(k), 0.0f, 0.0f), Vec3(1.0f, 0.0f, 0.0f), 10.0f),
         0.9f, 0.0f, 0.0f});
   list.add(Block{Domain::sphere(point(), size(rng))});
-  list.add(Sink{Domain::sphere(point(), size(rng)), true, 0.0f, Sink::Mode::Inside});
-  list.add(Sink{Domain::box(point(), point()), true, 0.3f, Sink::Mode::Enter});
-  list.add(Sink{Domain::cylinder(point(), point(), size(rng)), true, 0.0f, Sink::Mode::Leave});
-  list.add(Sink{Domain::disc(point(), dir(), size(rng)), true, 0.0f, Sink::Mode::Hit});
+  list.add(Sink{Domain::sphere(point(), size(rng)), 0.0f, Sink::Mode::Inside});
+  list.add(Sink{Domain::box(point(), point()), 0.3f, Sink::Mode::Enter});
+  list.add(Sink{Domain::cylinder(point(), point(), size(rng)), 0.0f, Sink::Mode::Leave});
+  list.add(Sink{Domain::disc(point(), dir(), size(rng)), 0.0f, Sink::Mode::Hit});
   list.add(Move{});
   return list;
 }

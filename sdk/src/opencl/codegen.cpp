@@ -430,8 +430,7 @@ bool culledCode(const Action& a, std::size_t k, std::string& code) {
            (std::holds_alternative<BoxDomain>(s) && !b->inside);
   }
   if (const auto* s = std::get_if<Sink>(&a)) {
-    using M = Sink::Mode;
-    return !((s->mode == M::Inside && !s->killInside) || (s->mode == M::Outside && s->killInside));
+    return s->mode != Sink::Mode::Outside;  // one that kills outside its region reaches everywhere
   }
   if (std::holds_alternative<Block>(a)) {
     // The first blocker starts from "visible" (its apply, kept in the source, defined it).
@@ -494,7 +493,10 @@ std::string cullingBody(const std::vector<Action>& acts, const std::string& body
   bool stale = true;  // no bounds gathered since the sub-step's start or the last move
   std::string culled;
   for (std::size_t k = 0; k < acts.size(); ++k) {
-    const std::string piece = body.substr(marks[k], marks[k + 1] - marks[k]);
+    std::string piece = body.substr(marks[k], marks[k + 1] - marks[k]);
+    // A user's callback may write global memory itself: only for live particles.
+    if (std::holds_alternative<Callback>(acts[k]))
+      piece = "    if (fl_live) {\n" + piece + "    }\n";
     const std::string r = "(extra + reachOff + " + std::to_string(k * FL_REACH_FLOATS) + "u)";
     const bool moves = placed[k] != 0 && mayMove(acts[k]);
     const std::string follow = placed[k] == 1 && moves ? followCode(acts[k], r) : "";
