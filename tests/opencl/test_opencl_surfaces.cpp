@@ -7,6 +7,7 @@
 #include <random>
 #include <vector>
 
+#include "../culling_scene.hpp"
 #include "parity.hpp"
 
 using namespace flurry;
@@ -293,49 +294,11 @@ TEST(OpenCLSurfaces, NeighboursWhileParticlesDie) {
 
 namespace {
 
-// Many finite deflectors, absorbers, blockers and falloff forces over [-50, 50]³ (as
-// tests/test_actions.cpp cullingScene), among particles 2 % of which cross several pieces in
-// one step; a stack of close discs; an emitter, so that newborns (each with its own step
-// length) share work-groups with the others.
+// The CPU culling tests' scene (tests/culling_scene.hpp) with three sets of deflectors;
+// the run adds an emitter, so that newborns (each with its own step length) share
+// work-groups with the others.
 ActionList cullingScene(std::uint32_t seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> pos(-50.0f, 50.0f), size(1.0f, 8.0f), unit(-1.0f, 1.0f);
-  auto point = [&] { return Vec3(pos(rng), pos(rng), pos(rng)); };
-  auto dir = [&] {
-    Vec3 d(unit(rng), unit(rng), unit(rng));
-    return glm::length(d) > 0.1f ? glm::normalize(d) : Vec3(0.0f, 1.0f, 0.0f);
-  };
-  ActionList list;
-  list.add(Gravity{Vec3(0.0f, -9.81f, 0.0f), {point(), size(rng) * 2.0f, 1.0f}});
-  list.add(Gravity{Vec3(3.0f, 0.0f, -2.0f), {point(), size(rng) * 2.0f, 2.0f}});
-  Damping d;
-  d.rate = Vec3(0.5f);
-  d.falloff = {point(), size(rng) * 2.0f, 1.0f};
-  list.add(d);
-  list.add(Block{Domain::box(point(), point())});
-  for (int k = 0; k < 3; ++k) {
-    const Vec3 c = point();
-    const float s = size(rng);
-    list.add(Bounce{Domain::rectangle(c, dir() * s, dir() * s), 0.8f, 0.1f, 0.0f});
-    list.add(Bounce{Domain::disc(point(), dir(), s, 0.2f * s), 0.5f, 0.0f, 0.0f});
-    list.add(
-        Bounce{Domain::triangle(point(), point() * 0.1f + c, c + dir() * s), 1.0f, 0.2f, 0.1f});
-    list.add(Bounce{Domain::sphere(point(), s), 0.9f, 0.1f, 0.0f, k % 2 == 0});
-    const Vec3 b = point();
-    list.add(Bounce{Domain::box(b, b + Vec3(s)), 0.7f, 0.0f, 0.0f});
-  }
-  const Vec3 stack = point();
-  for (int k = 0; k < 4; ++k)
-    list.add(Bounce{
-        Domain::disc(stack + Vec3(0.7f * float(k), 0.0f, 0.0f), Vec3(1.0f, 0.0f, 0.0f), 10.0f),
-        0.9f, 0.0f, 0.0f});
-  list.add(Block{Domain::sphere(point(), size(rng))});
-  list.add(Sink{Domain::sphere(point(), size(rng)), 0.0f, Sink::Mode::Inside});
-  list.add(Sink{Domain::box(point(), point()), 0.3f, Sink::Mode::Enter});
-  list.add(Sink{Domain::cylinder(point(), point(), size(rng)), 0.0f, Sink::Mode::Leave});
-  list.add(Sink{Domain::disc(point(), dir(), size(rng)), 0.0f, Sink::Mode::Hit});
-  list.add(Move{});
-  return list;
+  return flurry::test::cullingScene(seed, 3);
 }
 
 struct CullRun {
