@@ -61,4 +61,28 @@ inline ActionList cullingScene(std::uint32_t seed, int rounds = 6) {
   return list;
 }
 
+/// `count` slow particles in a small patch and one fast one (id 1000) that reaches, in one
+/// step of 0.1 s, a disc at x = 50 far from the others; a sphere no particle can reach.
+inline void farDeflectorScene(Group& g, int count) {
+  g.setActions({Bounce{Domain::disc(Vec3(50.0f, 0.0f, 0.0f), Vec3(1.0f, 0.0f, 0.0f), 2.0f)},
+                Bounce{Domain::sphere(Vec3(0.0f, -500.0f, 0.0f), 1.0f)}, Move{}});
+  for (int i = 0; i < count; ++i) {
+    Particle p;
+    p.position = Vec3(float(i % 16) * 0.01f, float(i / 16) * 0.01f - 0.5f, 0.0f);
+    p.velocity = i == 1000 ? Vec3(600.0f, 0.0f, 0.0f) : Vec3(0.0f, 0.0f, 0.1f);
+    p.position.y = i == 1000 ? 0.0f : p.position.y;
+    g.add(p);
+  }
+}
+
+/// After a step of farDeflectorScene: whether the fast particle was bounced by the far disc
+/// (reflected, in front of it).
+inline bool fastParticleBounced(const Group& g) {
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const Particle p = g.particle(i);
+    if (p.id == 1000) return p.velocity.x < 0.0f && p.position.x < 50.0f;
+  }
+  return false;
+}
+
 }  // namespace flurry::test
