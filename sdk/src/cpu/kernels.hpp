@@ -273,6 +273,20 @@ inline void bouncePlanarAll(float* __restrict px, float* __restrict py, float* _
   }
 }
 
+/// For each byte b, the positions j of its set bits in ascending order, packed one per byte
+/// of a little-endian word (bit j stands for flag j, as bouncePlanarLoop builds it).
+struct SetBitPositions {
+  std::uint64_t at[256];
+  constexpr SetBitPositions() : at{} {
+    for (unsigned b = 0; b < 256; ++b) {
+      unsigned k = 0;
+      for (unsigned j = 0; j < 8; ++j)
+        if (b & (1u << j)) at[b] |= std::uint64_t(j) << (8 * k++);
+    }
+  }
+};
+inline constexpr SetBitPositions kSetBitPositions{};
+
 /// A two-sided planar deflector (plane, rectangle, disc, triangle): `onPiece` says whether a
 /// point of the plane belongs to the piece. Most particles do not reach the plane in a step,
 /// and where some do (particles resting on a floor are spread through the group) they are
@@ -289,25 +303,29 @@ inline void bouncePlanarLoop(float* __restrict px, float* __restrict py, float* 
   const Reflect reflect{b.restitution, 1.0f - b.friction, b.cutoff * b.cutoff};
   alignas(32) std::uint8_t reaches[kChunk];
   alignas(32) float g[7][kChunk];  // the packed candidates: x, y, z, vx, vy, vz, dt
-  std::uint16_t idx[kChunk];
+  std::uint8_t idx[kChunk + 8];    // (eight are stored at once)
   for (std::size_t c0 = 0; c0 < n; c0 += kChunk) {
     const std::size_t m = std::min(kChunk, n - c0);
     float *x = px + c0, *y = py + c0, *z = pz + c0, *vx = vxs + c0, *vy = vys + c0, *vz = vzs + c0;
     for (std::size_t i = 0; i < m; ++i)
       reaches[i] = std::uint8_t(kernel::fl_planar_reaches(
           x[i], y[i], z[i], vx[i], vy[i], vz[i], dts[c0 + i], P.x, P.y, P.z, N.x, N.y, N.z));
-    // The candidates' indices, eight flags at a time (most words are zero).
+    // The candidates' indices, eight flags at a time and without branches: the eight flags
+    // make a byte, whose set bits' positions come from a table, stored eight at once (a
+    // branch per candidate mispredicted about once a word where a floor holds many).
     std::size_t k = 0, i = 0;
     for (; i + 8 <= m; i += 8) {
       std::uint64_t w;
       std::memcpy(&w, reaches + i, 8);
-      while (w) {
-        idx[k++] = std::uint16_t(i + std::size_t(std::countr_zero(w) / 8));
-        w &= w - 1;  // each flag is 0 or 1: one bit per byte
-      }
+      const unsigned bits = unsigned((w * 0x0102040810204080ull) >> 56);  // flag j -> bit j
+      const std::uint64_t at = kSetBitPositions.at[bits] + i * 0x0101010101010101ull;
+      std::memcpy(idx + k, &at, 8);
+      k += std::size_t(std::popcount(bits));
     }
-    for (; i < m; ++i)
-      if (reaches[i]) idx[k++] = std::uint16_t(i);
+    for (; i < m; ++i) {
+      idx[k] = std::uint8_t(i);
+      k += reaches[i];
+    }
     if (k == 0) continue;
     if (4 * k >= m) {  // many: packing would cost more than computing all of them
       bouncePlanarAll(x, y, z, vx, vy, vz, m, OffsetDt<Dt>{dts, c0}, P, N, onPiece, reflect);
