@@ -158,7 +158,8 @@ TEST(RenderSettingsJson, ReadsTheLookOptions) {
 
 TEST(RenderSettingsJson, ReadsStretchAndGroupLooks) {
   const RenderSettings s = parseRenderSettings(R"({"stretch": 0.05, "maxStretch": 6,
-    "groups": {"flames": {"sprite": "glow", "blend": "additive", "shading": false},
+    "$comment": "comments are allowed, as in the rest of the file",
+    "groups": {"$comment": "also here", "flames": {"sprite": "glow", "blend": "additive", "shading": false, "$comment": "x"},
                "rain": {"sprite": "drop.png", "stretch": 0.1, "maxStretch": 20, "sort": false}}})",
                                                "/fx");
   EXPECT_EQ(s.stretch, 0.05f);

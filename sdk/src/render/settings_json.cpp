@@ -21,6 +21,7 @@ struct Reader {
                        std::initializer_list<const char*> known) {
     if (!o.is_object()) fail(path, "must be an object");
     for (const auto& [k, v] : o.items()) {
+      if (k == "$comment") continue;  // as in the rest of an effect file
       bool ok = false;
       for (const char* n : known) ok = ok || k == n;
       if (!ok) {
@@ -246,6 +247,7 @@ RenderSettings parseRenderSettings(std::string_view text, const std::filesystem:
     if (!gs.is_object()) R::fail(gp, "must be an object: {\"GROUP\": {look}, ...}");
     s.groups.clear();
     for (const auto& [name, g] : gs.items()) {
+      if (name == "$comment") continue;
       const std::string lp = gp + "." + name;
       R::onlyKeys(g, lp, {"sprite", "blend", "sort", "shading", "stretch", "maxStretch"});
       GroupLook look;
