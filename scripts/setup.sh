@@ -1,7 +1,16 @@
 #!/usr/bin/env bash
 # Installs every Debian and PyPI dependency Flurry uses. Idempotent: when all is
 # present it only checks (a few seconds) and installs nothing.
+# `--gallery` also installs what only scripts/gallery.sh needs (ffmpeg, for the animated
+# previews), which CI and building do not.
 set -euo pipefail
+GALLERY=0
+for arg in "$@"; do
+  case "$arg" in
+    --gallery) GALLERY=1 ;;
+    *) echo "setup: unknown option $arg (known: --gallery)" >&2; exit 2 ;;
+  esac
+done
 
 DEB_PACKAGES=(
   build-essential cmake ninja-build pkg-config git clang-format
@@ -16,6 +25,7 @@ DEB_PACKAGES=(
   # Emulated CPUs without AVX / AVX-512 for the instruction-set tests
   qemu-user
 )
+if [ "$GALLERY" = 1 ]; then DEB_PACKAGES+=(ffmpeg); fi
 PY_PACKAGES=(numpy matplotlib pytest nanobind scikit-build-core)
 
 SUDO=""

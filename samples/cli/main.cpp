@@ -110,18 +110,38 @@ EffectLoadOptions effectLoadOptions() {
     std::error_code ec;
     if (s.sprite == Sprite::Image && !fs::is_regular_file(s.spriteImage, ec))
       throw InvalidArgument("render.sprite", "no such file: " + s.spriteImage);
+    for (const GroupLook& g : s.groups)
+      if (g.sprite == Sprite::Image && !fs::is_regular_file(g.spriteImage, ec))
+        throw InvalidArgument("render.groups." + g.group + ".sprite",
+                              "no such file: " + g.spriteImage);
   };
 #endif
   return o;
 }
 
+Effect loadEffectForCli(const std::string& nameOrPath) {
+  Effect fx = samples::loadEffectOrSample(nameOrPath, effectLoadOptions());
+#ifdef FLURRY_CLI_PNG
+  // The loader's render checker sees the render object alone, not the groups.
+  const RenderSettings s = parseRenderSettings(fx.render, fx.file.parent_path());
+  for (const GroupLook& g : s.groups) {
+    std::string names;
+    bool found = false;
+    for (const EffectGroup& eg : fx.groups) {
+      found = found || eg.name == g.group;
+      names += (names.empty() ? "" : ", ") + eg.name;
+    }
+    if (!found)
+      throw EffectError(fx.file.empty() ? nameOrPath : fx.file.string(), "render.groups." + g.group,
+                        "no group named \"" + g.group + "\" (groups: " + names + ")");
+  }
+#endif
+  return fx;
+}
+
 }  // namespace flurry::cli
 
 namespace {
-
-flurry::EffectLoadOptions loadOptions() {
-  return flurry::cli::effectLoadOptions();
-}
 
 std::string frameName(const std::string& base, int frame, const char* ext) {
   char buf[32];
@@ -207,7 +227,7 @@ void printStats(const flurry::Group& g, int frame, double time) {
 }
 
 int run(const RunOptions& o, std::vector<std::unique_ptr<flurry::cli::Plugin>>& plugins) {
-  const flurry::Effect fx = flurry::samples::loadEffectOrSample(o.effect, loadOptions());
+  const flurry::Effect fx = flurry::cli::loadEffectForCli(o.effect);
   printWarnings(fx, o.effect);
   const int frames = o.frames.value_or(fx.frames);
   if (!o.out.empty()) {
@@ -310,7 +330,7 @@ int validate(const std::vector<std::string>& files) {
   int bad = 0;
   for (const std::string& f : files) {
     try {
-      const flurry::Effect fx = flurry::samples::loadEffectOrSample(f, loadOptions());
+      const flurry::Effect fx = flurry::cli::loadEffectForCli(f);
       flurry::ContextOptions co = fx.contextOptions();
       co.threads = 1;
       flurry::Context ctx(co);

@@ -46,6 +46,9 @@ class Plugin {
 /// The options every command loads effects with: the VDB field reader and the render
 /// settings' checker where the tool has those parts (main.cpp).
 EffectLoadOptions effectLoadOptions();
+/// Loads an effect file or a built-in sample with effectLoadOptions(), then checks what the
+/// loader cannot: that the `render` object's per-group looks name the effect's groups.
+Effect loadEffectForCli(const std::string& nameOrPath);
 
 // Each factory is defined by its part's source file, compiled in when that part is built.
 std::unique_ptr<Plugin> makePngPlugin();     // png_output.cpp   (FLURRY_VIEWER)

@@ -90,6 +90,12 @@ RenderSettings settingsFrom(const std::string& render, const fs::path& effectFil
   if (!look.blend.empty())
     s.blend = look.blend == "additive" ? BlendMode::Additive : BlendMode::Alpha;
   if (look.unlit) s.shading = false;
+  // The command line's look is for every group: the effect's per-group looks give way.
+  for (GroupLook& g : s.groups) {
+    if (!look.sprite.empty()) g.sprite.reset();
+    if (!look.blend.empty()) g.blend.reset();
+    if (look.unlit) g.shading.reset();
+  }
   if (look.orbit.size() == 3) {
     s.camera.yaw = look.orbit[0];
     s.camera.pitch = look.orbit[1];
@@ -135,7 +141,7 @@ class PngPlugin : public Plugin {
 
   bool runCommand(CLI::App& /*app*/, int& exitCode) override {
     if (!view_->parsed()) return false;
-    const Effect fx = samples::loadEffectOrSample(viewEffect_, effectLoadOptions());
+    const Effect fx = loadEffectForCli(viewEffect_);
     for (const EffectWarning& w : fx.warnings)
       std::fprintf(stderr, "flurry: warning: %s: %s\n",
                    (fx.file.empty() ? viewEffect_ : fx.file.string()).c_str(), w.message().c_str());

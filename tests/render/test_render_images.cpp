@@ -415,6 +415,114 @@ TEST(RenderImage, BlendModes) {
   EXPECT_NEAR(p[2], 102, 2);
 }
 
+// Velocity-stretched sprites: a fast particle covers a streak along its screen-space velocity,
+// trailing behind it, as long as the path of the last `stretch` seconds (clamped to
+// maxStretch widths); a particle at rest, and any particle without `stretch`, stays round.
+TEST(RenderImage, StretchedSpritesStreakAlongTheVelocity) {
+  RenderSettings s;
+  s.camera = front(30.0f, 6.0f);
+  s.shading = false;
+  s.background = Vec3(0.0f);
+  s.sprite = Sprite::Glow;
+  s.blend = BlendMode::Additive;
+  Context ctx;
+  Group& g = particles(ctx);
+  auto moving = [&](Vec3 velocity) {
+    g.clear();
+    Particle q;
+    q.size = 0.15f;
+    q.color = Vec4(1.0f);
+    q.velocity = velocity;
+    g.add(q);
+  };
+  moving(Vec3(10.0f, 0.0f, 0.0f));  // +x: screen right
+  OffscreenRenderer r(small(), s);
+  const float ppu = pixelsPerUnit(s.camera);
+  // The lit footprint's extent and centre along x and y.
+  struct Footprint {
+    int minX = kSize, maxX = -1, minY = kSize, maxY = -1;
+    double cx = 0;
+  };
+  auto footprint = [&](const char* name) {
+    const Image img = r.render(g);
+    writePng(img, flurry::test::outDir() / (std::string("stretch_") + name + ".png"));
+    Footprint f;
+    int n = 0;
+    for (int y = 0; y < kSize; ++y)
+      for (int x = 0; x < kSize; ++x)
+        if (img.pixel(x, y)[0] > 24) {
+          f.minX = std::min(f.minX, x);
+          f.maxX = std::max(f.maxX, x);
+          f.minY = std::min(f.minY, y);
+          f.maxY = std::max(f.maxY, y);
+          f.cx += x;
+          ++n;
+        }
+    f.cx = n ? f.cx / n : -1.0;
+    return f;
+  };
+  const Footprint round = footprint("off");
+  const int w = round.maxX - round.minX, h = round.maxY - round.minY;
+  ASSERT_GT(w, 4);
+  EXPECT_NEAR(w, h, 2);         // no stretch: round
+  r.settings().stretch = 0.1f;  // 10 units/s x 0.1 s: a streak 1 unit long
+  const Footprint streak = footprint("on");
+  const int sw = streak.maxX - streak.minX, sh = streak.maxY - streak.minY;
+  EXPECT_NEAR(sw - w, ppu, 0.15 * ppu) << sw << " vs " << w;  // longer by the path
+  EXPECT_NEAR(sh, h, 2);                                      // no wider
+  EXPECT_LT(streak.cx, kSize / 2 - 0.35 * ppu);               // it trails the particle
+  EXPECT_GE(streak.maxX, round.maxX - 2);                     // the head stays at the particle
+  // Clamped: at most maxStretch widths long (the sprite swept over 2 of its widths more).
+  r.settings().maxStretch = 3.0f;
+  const Footprint clamped = footprint("clamped");
+  EXPECT_NEAR(clamped.maxX - clamped.minX - w, 2.0f * 2.0f * 0.15f * ppu, 3);
+  // A vertical velocity streaks vertically; a particle at rest stays round.
+  r.settings().maxStretch = 8.0f;
+  moving(Vec3(0.0f, -10.0f, 0.0f));
+  const Footprint down = footprint("down");
+  EXPECT_NEAR(down.maxX - down.minX, w, 2);
+  EXPECT_NEAR((down.maxY - down.minY) - h, ppu, 0.15 * ppu);
+  moving(Vec3(0.0f));
+  const Footprint rest = footprint("rest");
+  EXPECT_NEAR(rest.maxX - rest.minX, w, 2);
+}
+
+// Per-group looks: one group additive, another alpha-blended, in one frame; an instance
+// "NAME@I" takes NAME's look.
+TEST(RenderImage, GroupLooksOverrideTheSettings) {
+  RenderSettings s;
+  s.camera = front(30.0f, 6.0f);
+  s.shading = false;
+  s.background = Vec3(0.0f);
+  s.blend = BlendMode::Alpha;
+  GroupLook fire;
+  fire.group = "fire";
+  fire.blend = BlendMode::Additive;
+  s.groups = {fire};
+  Context ctx;
+  Group& a = ctx.createGroup("fire@2", 16);
+  Group& b = ctx.createGroup("smoke", 16);
+  for (Group* g : {&a, &b}) g->require(Renderer::attributes());
+  const float x = 0.6f;
+  add(a, Vec3(-x, 0.0f, 0.0f), 0.5f, Vec4(0.4f, 0.2f, 0.0f, 1.0f));
+  add(a, Vec3(-x, 0.0f, 0.1f), 0.5f, Vec4(0.0f, 0.2f, 0.4f, 1.0f));
+  add(b, Vec3(x, 0.0f, 0.0f), 0.5f, Vec4(0.4f, 0.2f, 0.0f, 1.0f));
+  add(b, Vec3(x, 0.0f, 0.1f), 0.5f, Vec4(0.0f, 0.2f, 0.4f, 1.0f));
+  OffscreenRenderer r(small(), s);
+  const Group* groups[] = {&a, &b};
+  const Image img = r.render(groups);
+  writePng(img, flurry::test::outDir() / "group_looks.png");
+  const int dx = int(x * pixelsPerUnit(s.camera));
+  const std::uint8_t* p = img.pixel(kSize / 2 - dx, kSize / 2);  // fire: added
+  EXPECT_NEAR(p[0], 102, 2);
+  EXPECT_NEAR(p[1], 102, 2);
+  EXPECT_NEAR(p[2], 102, 2);
+  p = img.pixel(kSize / 2 + dx, kSize / 2);  // smoke: the nearer one covers
+  EXPECT_NEAR(p[0], 0, 2);
+  EXPECT_NEAR(p[1], 51, 2);
+  EXPECT_NEAR(p[2], 102, 2);
+}
+
 // Glow and puff sprites are shaded flat: one normal towards the eye, so a lit puff of smoke is
 // not a ball with a bright and a dark side (the disc, shaded as a sphere, is).
 TEST(RenderImage, GlowAndPuffAreShadedFlat) {

@@ -156,6 +156,35 @@ TEST(RenderSettingsJson, ReadsTheLookOptions) {
   EXPECT_FALSE(parseRenderSettings(R"({"geometry": {"show": false}})").geometry.show);
 }
 
+TEST(RenderSettingsJson, ReadsStretchAndGroupLooks) {
+  const RenderSettings s = parseRenderSettings(R"({"stretch": 0.05, "maxStretch": 6,
+    "$comment": "comments are allowed, as in the rest of the file",
+    "groups": {"$comment": "also here", "flames": {"sprite": "glow", "blend": "additive", "shading": false, "$comment": "x"},
+               "rain": {"sprite": "drop.png", "stretch": 0.1, "maxStretch": 20, "sort": false}}})",
+                                               "/fx");
+  EXPECT_EQ(s.stretch, 0.05f);
+  EXPECT_EQ(s.maxStretch, 6.0f);
+  ASSERT_EQ(s.groups.size(), 2u);
+  const GroupLook& f = s.groups[0];
+  EXPECT_EQ(f.group, "flames");
+  EXPECT_EQ(f.sprite, Sprite::Glow);
+  EXPECT_EQ(f.blend, BlendMode::Additive);
+  EXPECT_EQ(f.shading, false);
+  EXPECT_FALSE(f.stretch.has_value());  // unset: the settings' value applies
+  EXPECT_FALSE(f.sortForAlpha.has_value());
+  const GroupLook& r = s.groups[1];
+  EXPECT_EQ(r.group, "rain");
+  EXPECT_EQ(r.sprite, Sprite::Image);
+  EXPECT_EQ(r.spriteImage, "/fx/drop.png");
+  EXPECT_EQ(r.stretch, 0.1f);
+  EXPECT_EQ(r.maxStretch, 20.0f);
+  EXPECT_EQ(r.sortForAlpha, false);
+  EXPECT_FALSE(r.blend.has_value());
+  const RenderSettings d = parseRenderSettings("{}");
+  EXPECT_EQ(d.stretch, 0.0f);
+  EXPECT_TRUE(d.groups.empty());
+}
+
 TEST(RenderSettingsJson, ErrorsNameTheField) {
   auto pathOf = [](const char* json) {
     try {
@@ -179,4 +208,12 @@ TEST(RenderSettingsJson, ErrorsNameTheField) {
   EXPECT_EQ(pathOf(R"({"geometry": {"opacity": 2}})"), "render.geometry.opacity");
   EXPECT_EQ(pathOf(R"({"geometry": {"colour": [1, 1, 1]}})"), "render.geometry.colour");
   EXPECT_EQ(pathOf(R"({"geometry": {"sink": "no"}})"), "render.geometry.sink");
+  EXPECT_EQ(pathOf(R"({"stretch": -1})"), "render.stretch");
+  EXPECT_EQ(pathOf(R"({"maxStretch": 0.5})"), "render.maxStretch");
+  EXPECT_EQ(pathOf(R"({"groups": []})"), "render.groups");
+  EXPECT_EQ(pathOf(R"({"groups": {"a": 1}})"), "render.groups.a");
+  EXPECT_EQ(pathOf(R"({"groups": {"a": {"toneMap": "aces"}}})"), "render.groups.a.toneMap");
+  EXPECT_EQ(pathOf(R"({"groups": {"a": {"blend": "max"}}})"), "render.groups.a.blend");
+  EXPECT_EQ(pathOf(R"({"groups": {"a": {"stretch": "long"}}})"), "render.groups.a.stretch");
+  EXPECT_EQ(pathOf(R"({"groups": {"a": {"sprite": 3}}})"), "render.groups.a.sprite");
 }

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -82,6 +83,19 @@ struct Camera {
   Vec3 eye() const;
 };
 
+/// One group's own look over RenderSettings' (a field left unset keeps the settings' value):
+/// e.g. additive glowing fire and alpha-blended smoke in one effect.
+struct GroupLook {
+  std::string group;  ///< the group's name; a built instance's "NAME@INSTANCE" matches too
+  std::optional<Sprite> sprite;
+  std::string spriteImage;  ///< the PNG for Sprite::Image
+  std::optional<BlendMode> blend;
+  std::optional<bool> sortForAlpha;
+  std::optional<bool> shading;
+  std::optional<float> stretch;
+  std::optional<float> maxStretch;
+};
+
 /// Everything that decides how a scene looks. A plain aggregate; effect files fill it.
 struct RenderSettings {
   Vec3 background{0.03f, 0.04f, 0.07f};  ///< clear color; blockers never change it
@@ -106,6 +120,14 @@ struct RenderSettings {
   /// premultiplied, in images): for compositing. `background` is then unused.
   bool transparent = false;
   SceneGeometry geometry;
+  /// Velocity-stretched sprites (billboards, not Sprite::Point): each is drawn along its
+  /// screen-space velocity, covering the path of the last `stretch` seconds (0: round), so
+  /// fast sparks and rain streak. Reads the Velocity attribute (a group without it: round).
+  float stretch = 0.0f;
+  /// The most a stretched sprite's length may be, in widths (>= 1).
+  float maxStretch = 8.0f;
+  /// Per-group looks; the first naming a group applies to it.
+  std::vector<GroupLook> groups;
 };
 
 /// Reads an effect file's `render` object (JSON text, docs/rendering.md) over `defaults`:
@@ -141,7 +163,8 @@ class Renderer {
 
   RenderSettings& settings();
   const RenderSettings& settings() const;
-  /// The attributes snow mode reads: call Group::require() with them before stepping.
+  /// The attributes snow mode reads (Velocity for stretched sprites): call Group::require()
+  /// with them before stepping.
   static AttributeSet attributes();
 
   /// Sets the viewport to width x height and clears it to the background.

@@ -68,6 +68,17 @@ GLuint link(const std::string& vs, const std::string& fs, const char* what) {
   return p;
 }
 
+// Instances of stretched billboards: PackLayout::instances() (position, radius, rgba), then
+// the velocity at byte 32.
+const PackLayout& stretchLayout() {
+  static const PackLayout layout =
+      PackLayout::interleaved({{Attribute::Position, PackFormat::Float32},
+                               {Attribute::Size, PackFormat::Float32},
+                               {Attribute::Color, PackFormat::Float32},
+                               {Attribute::Velocity, PackFormat::Float32}});
+  return layout;
+}
+
 GLint loc(GLuint program, const char* name) {
   return glGetUniformLocation(program, name);
 }
@@ -244,11 +255,14 @@ struct Renderer::Impl {
   GLint target = 0;  // the draw framebuffer bound at begin()
   bool hdrFrame = false;
   GLuint quadVbo = 0, instanceVbo = 0, strandVbo = 0;
-  GLuint billboardVao = 0, pointVao = 0, strandVao = 0;
-  GLuint sprite = 0;
-  Sprite spriteKind{};
-  std::string spritePath;
-  bool spriteLoaded = false;
+  GLuint billboardVao = 0, stretchVao = 0, pointVao = 0, strandVao = 0;
+  // Sprite textures made so far, one per (kind, PNG): groups may draw different sprites.
+  struct SpriteTexture {
+    Sprite kind;
+    std::string path;
+    GLuint texture;
+  };
+  std::vector<SpriteTexture> sprites;
   int width = 1, height = 1;
   std::size_t drawn = 0;
   std::vector<std::byte> packed;
@@ -258,11 +272,43 @@ struct Renderer::Impl {
 
   glm::mat4 view{1.0f}, proj{1.0f};
 
-  void ensureSprite() {
+  // What one group is drawn with: the settings, then its GroupLook.
+  struct Look {
+    Sprite sprite;
+    const std::string* spriteImage;
+    BlendMode blend;
+    bool sortForAlpha, shading;
+    float stretch, maxStretch;
+  };
+
+  Look lookFor(const Group& group) const {
     const RenderSettings& s = settings;
-    if (spriteLoaded && spriteKind == s.sprite && spritePath == s.spriteImage) return;
-    const Image img = detail::spriteBitmap(s.sprite, s.spriteImage);
-    if (!sprite) glGenTextures(1, &sprite);
+    Look k{s.sprite, &s.spriteImage, s.blend, s.sortForAlpha, s.shading, s.stretch, s.maxStretch};
+    const std::string& name = group.name();
+    const std::string_view base = std::string_view(name).substr(0, name.find('@'));
+    for (const GroupLook& g : s.groups) {
+      if (g.group != name && g.group != base) continue;
+      if (g.sprite) {
+        k.sprite = *g.sprite;
+        k.spriteImage = &g.spriteImage;
+      }
+      if (g.blend) k.blend = *g.blend;
+      if (g.sortForAlpha) k.sortForAlpha = *g.sortForAlpha;
+      if (g.shading) k.shading = *g.shading;
+      if (g.stretch) k.stretch = *g.stretch;
+      if (g.maxStretch) k.maxStretch = *g.maxStretch;
+      break;
+    }
+    return k;
+  }
+
+  GLuint spriteTexture(Sprite kind, const std::string& path) {
+    const std::string& key = kind == Sprite::Image ? path : std::string();
+    for (const SpriteTexture& t : sprites)
+      if (t.kind == kind && t.path == key) return t.texture;
+    const Image img = detail::spriteBitmap(kind, path);
+    GLuint sprite = 0;
+    glGenTextures(1, &sprite);
     glBindTexture(GL_TEXTURE_2D, sprite);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, img.width, img.height, 0, GL_RGBA, GL_UNSIGNED_BYTE,
@@ -272,18 +318,17 @@ struct Renderer::Impl {
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    spriteKind = s.sprite;
-    spritePath = s.spriteImage;
-    spriteLoaded = true;
+    sprites.push_back({kind, key, sprite});
+    return sprite;
   }
 
-  void setCommon(GLuint p) {
+  void setCommon(GLuint p, bool shading) {
     glUseProgram(p);
     glUniformMatrix4fv(loc(p, "uView"), 1, GL_FALSE, glm::value_ptr(view));
     glUniformMatrix4fv(loc(p, "uProj"), 1, GL_FALSE, glm::value_ptr(proj));
     glUniform2f(loc(p, "uViewport"), float(width), float(height));
     glUniform1f(loc(p, "uLitMinPixels"), settings.litMinPixels);
-    glUniform1i(loc(p, "uShading"), settings.shading ? 1 : 0);
+    glUniform1i(loc(p, "uShading"), shading ? 1 : 0);
     const Vec3 eye = settings.camera.eye();
     glUniform3fv(loc(p, "uEye"), 1, glm::value_ptr(eye));
   }
@@ -461,6 +506,21 @@ Renderer::Renderer(RenderSettings settings) : impl_(std::make_unique<Impl>()) {
   glGenVertexArrays(1, &d.pointVao);
   glBindVertexArray(d.pointVao);
   instanceAttribs(0);
+  // Stretched billboards: the same fields, then the velocity (stretchLayout()).
+  const GLsizei vstride = GLsizei(stretchLayout().stride);
+  glGenVertexArrays(1, &d.stretchVao);
+  glBindVertexArray(d.stretchVao);
+  glBindBuffer(GL_ARRAY_BUFFER, d.quadVbo);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
+  glBindBuffer(GL_ARRAY_BUFFER, d.instanceVbo);
+  for (GLuint a = 1; a <= 3; ++a) {
+    glEnableVertexAttribArray(a);
+    glVertexAttribDivisor(a, 1);
+  }
+  glVertexAttribPointer(1, 4, GL_FLOAT, GL_FALSE, vstride, nullptr);
+  glVertexAttribPointer(2, 4, GL_FLOAT, GL_FALSE, vstride, reinterpret_cast<void*>(16));
+  glVertexAttribPointer(3, 3, GL_FLOAT, GL_FALSE, vstride, reinterpret_cast<void*>(32));
 
   glGenVertexArrays(1, &d.strandVao);
   glBindVertexArray(d.strandVao);
@@ -498,10 +558,11 @@ Renderer::~Renderer() {
   glDeleteProgram(d.toneMap);
   const GLuint buffers[] = {d.quadVbo, d.instanceVbo, d.strandVbo, d.geometryVbo};
   glDeleteBuffers(4, buffers);
-  const GLuint vaos[] = {d.billboardVao, d.pointVao, d.strandVao, d.geometryVao, d.emptyVao};
-  glDeleteVertexArrays(5, vaos);
+  const GLuint vaos[] = {d.billboardVao, d.stretchVao,  d.pointVao,
+                         d.strandVao,    d.geometryVao, d.emptyVao};
+  glDeleteVertexArrays(6, vaos);
   d.releaseHdr();
-  if (d.sprite) glDeleteTextures(1, &d.sprite);
+  for (const Impl::SpriteTexture& t : d.sprites) glDeleteTextures(1, &t.texture);
 }
 
 RenderSettings& Renderer::settings() {
@@ -515,7 +576,7 @@ std::size_t Renderer::lastDrawn() const {
 }
 
 AttributeSet Renderer::attributes() {
-  return PackLayout::instances().attributes();
+  return stretchLayout().attributes();
 }
 
 void Renderer::begin(int width, int height) {
@@ -578,10 +639,12 @@ void Renderer::draw(const Group& group) {
   const RenderSettings& s = d.settings;
   if (s.geometry.show) d.drawGeometry(group);
   if (!group.strands().position.empty()) draw(group.strands());
+  const Impl::Look look = d.lookFor(group);
   PackOptions opts;
   opts.blockers = s.blockers;
-  if (s.blend == BlendMode::Alpha && s.sortForAlpha) opts.sortFromEye = s.camera.eye();
-  const PackLayout layout = PackLayout::instances();
+  if (look.blend == BlendMode::Alpha && look.sortForAlpha) opts.sortFromEye = s.camera.eye();
+  const bool stretched = look.stretch > 0.0f && look.sprite != Sprite::Point;
+  const PackLayout& layout = stretched ? stretchLayout() : PackLayout::instances();
   d.packed.resize(group.size() * layout.stride);
   const std::size_t n = packParticles(group, layout, d.packed, opts);
   d.drawn += n;
@@ -590,23 +653,26 @@ void Renderer::draw(const Group& group) {
   // Orphan the old storage so the driver need not wait for the last frame's draw.
   glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(n * layout.stride), nullptr, GL_STREAM_DRAW);
   glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(n * layout.stride), d.packed.data());
-  d.setBlend(false, s.blend == BlendMode::Additive);
-  if (s.sprite == Sprite::Point) {
-    d.setCommon(d.points);
+  d.setBlend(false, look.blend == BlendMode::Additive);
+  if (look.sprite == Sprite::Point) {
+    d.setCommon(d.points, look.shading);
     glEnable(GL_PROGRAM_POINT_SIZE);
     glBindVertexArray(d.pointVao);
     glDrawArrays(GL_POINTS, 0, GLsizei(n));
   } else {
-    d.ensureSprite();
-    d.setCommon(d.billboard);
+    const GLuint sprite = d.spriteTexture(look.sprite, *look.spriteImage);
+    d.setCommon(d.billboard, look.shading);
     d.setLighting(d.billboard);
     const glm::mat3 viewToWorld = glm::transpose(glm::mat3(d.view));
     glUniformMatrix3fv(loc(d.billboard, "uViewToWorld"), 1, GL_FALSE, glm::value_ptr(viewToWorld));
-    glUniform1i(loc(d.billboard, "uFlat"), s.sprite == Sprite::Glow || s.sprite == Sprite::Puff);
+    glUniform1i(loc(d.billboard, "uFlat"),
+                look.sprite == Sprite::Glow || look.sprite == Sprite::Puff);
+    glUniform1f(loc(d.billboard, "uStretch"), stretched ? look.stretch : 0.0f);
+    glUniform1f(loc(d.billboard, "uMaxStretch"), look.maxStretch);
     glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, d.sprite);
+    glBindTexture(GL_TEXTURE_2D, sprite);
     glUniform1i(loc(d.billboard, "uSprite"), 0);
-    glBindVertexArray(d.billboardVao);
+    glBindVertexArray(stretched ? d.stretchVao : d.billboardVao);
     glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(n));
   }
   glBindVertexArray(0);
@@ -668,7 +734,7 @@ void Renderer::draw(const Strands& strands) {
   glBufferSubData(GL_ARRAY_BUFFER, 0, bytes, d.strandVerts.data());
   // Opaque strands hide what is behind them, particles included; translucent ones blend.
   d.setBlend(true, s.blend == BlendMode::Additive);
-  d.setCommon(d.strands);
+  d.setCommon(d.strands, s.shading);
   d.setLighting(d.strands);
   glUniform1i(loc(d.strands, "uLines"), lines ? 1 : 0);
   glBindVertexArray(d.strandVao);

@@ -21,6 +21,7 @@ struct Reader {
                        std::initializer_list<const char*> known) {
     if (!o.is_object()) fail(path, "must be an object");
     for (const auto& [k, v] : o.items()) {
+      if (k == "$comment") continue;  // as in the rest of an effect file
       bool ok = false;
       for (const char* n : known) ok = ok || k == n;
       if (!ok) {
@@ -68,6 +69,47 @@ struct Reader {
   }
 };
 
+void readSprite(const json& v, const std::string& path, const std::filesystem::path& baseDir,
+                Sprite& sprite, std::string& image) {
+  if (!v.is_string())
+    Reader::fail(path, "must be point, disc, spark, snowflake, glow, puff or a PNG path");
+  const std::string name = v.get<std::string>();
+  if (name == "point")
+    sprite = Sprite::Point;
+  else if (name == "disc")
+    sprite = Sprite::Disc;
+  else if (name == "spark")
+    sprite = Sprite::Spark;
+  else if (name == "snowflake")
+    sprite = Sprite::Snowflake;
+  else if (name == "glow")
+    sprite = Sprite::Glow;
+  else if (name == "puff")
+    sprite = Sprite::Puff;
+  else {
+    sprite = Sprite::Image;
+    const std::filesystem::path file(name);
+    image = (file.is_relative() && !baseDir.empty() ? baseDir / file : file).string();
+  }
+}
+
+BlendMode readBlend(const json& v, const std::string& path) {
+  return Reader::choice(v, path, {"alpha", "additive"}) == "additive" ? BlendMode::Additive
+                                                                      : BlendMode::Alpha;
+}
+
+float readStretch(const json& v, const std::string& path) {
+  const float f = Reader::number(v, path);
+  if (!(f >= 0.0f && f <= 10.0f)) Reader::fail(path, "must be within [0, 10] seconds");
+  return f;
+}
+
+float readMaxStretch(const json& v, const std::string& path) {
+  const float f = Reader::number(v, path);
+  if (!(f >= 1.0f && f <= 1000.0f)) Reader::fail(path, "must be within [1, 1000]");
+  return f;
+}
+
 }  // namespace
 
 RenderSettings parseRenderSettings(std::string_view text, const std::filesystem::path& baseDir,
@@ -83,7 +125,7 @@ RenderSettings parseRenderSettings(std::string_view text, const std::filesystem:
   R::onlyKeys(root, p,
               {"background", "camera", "shading", "litMinPixels", "ambient", "lights", "material",
                "falloff", "blend", "sort", "sprite", "strands", "toneMap", "exposure",
-               "transparent", "geometry"});
+               "transparent", "geometry", "stretch", "maxStretch", "groups"});
   if (root.contains("background")) s.background = R::rgb(root["background"], p + ".background");
   if (root.contains("camera")) {
     const json& c = root["camera"];
@@ -154,34 +196,10 @@ RenderSettings parseRenderSettings(std::string_view text, const std::filesystem:
                          : f == "none" ? LightFalloff::None
                                        : LightFalloff::Light;
   }
-  if (root.contains("blend"))
-    s.blend = R::choice(root["blend"], p + ".blend", {"alpha", "additive"}) == "additive"
-                  ? BlendMode::Additive
-                  : BlendMode::Alpha;
+  if (root.contains("blend")) s.blend = readBlend(root["blend"], p + ".blend");
   if (root.contains("sort")) s.sortForAlpha = R::boolean(root["sort"], p + ".sort");
-  if (root.contains("sprite")) {
-    const json& v = root["sprite"];
-    if (!v.is_string())
-      R::fail(p + ".sprite", "must be point, disc, spark, snowflake, glow, puff or a PNG path");
-    const std::string name = v.get<std::string>();
-    if (name == "point")
-      s.sprite = Sprite::Point;
-    else if (name == "disc")
-      s.sprite = Sprite::Disc;
-    else if (name == "spark")
-      s.sprite = Sprite::Spark;
-    else if (name == "snowflake")
-      s.sprite = Sprite::Snowflake;
-    else if (name == "glow")
-      s.sprite = Sprite::Glow;
-    else if (name == "puff")
-      s.sprite = Sprite::Puff;
-    else {
-      s.sprite = Sprite::Image;
-      const std::filesystem::path file(name);
-      s.spriteImage = (file.is_relative() && !baseDir.empty() ? baseDir / file : file).string();
-    }
-  }
+  if (root.contains("sprite"))
+    readSprite(root["sprite"], p + ".sprite", baseDir, s.sprite, s.spriteImage);
   if (root.contains("strands"))
     s.strandStyle = R::choice(root["strands"], p + ".strands", {"ribbon", "line"}) == "line"
                         ? StrandStyle::Line
@@ -217,6 +235,35 @@ RenderSettings parseRenderSettings(std::string_view text, const std::filesystem:
       if (g.contains("bounce")) geo.bounce = R::boolean(g["bounce"], gp + ".bounce");
       if (g.contains("sink")) geo.sink = R::boolean(g["sink"], gp + ".sink");
       if (g.contains("block")) geo.block = R::boolean(g["block"], gp + ".block");
+    }
+  }
+  if (root.contains("stretch")) s.stretch = readStretch(root["stretch"], p + ".stretch");
+  if (root.contains("maxStretch"))
+    s.maxStretch = readMaxStretch(root["maxStretch"], p + ".maxStretch");
+  if (root.contains("groups")) {
+    // {"GROUP": {"sprite", "blend", "sort", "shading", "stretch", "maxStretch"}, ...}
+    const json& gs = root["groups"];
+    const std::string gp = p + ".groups";
+    if (!gs.is_object()) R::fail(gp, "must be an object: {\"GROUP\": {look}, ...}");
+    s.groups.clear();
+    for (const auto& [name, g] : gs.items()) {
+      if (name == "$comment") continue;
+      const std::string lp = gp + "." + name;
+      R::onlyKeys(g, lp, {"sprite", "blend", "sort", "shading", "stretch", "maxStretch"});
+      GroupLook look;
+      look.group = name;
+      if (g.contains("sprite")) {
+        Sprite sprite{};
+        readSprite(g["sprite"], lp + ".sprite", baseDir, sprite, look.spriteImage);
+        look.sprite = sprite;
+      }
+      if (g.contains("blend")) look.blend = readBlend(g["blend"], lp + ".blend");
+      if (g.contains("sort")) look.sortForAlpha = R::boolean(g["sort"], lp + ".sort");
+      if (g.contains("shading")) look.shading = R::boolean(g["shading"], lp + ".shading");
+      if (g.contains("stretch")) look.stretch = readStretch(g["stretch"], lp + ".stretch");
+      if (g.contains("maxStretch"))
+        look.maxStretch = readMaxStretch(g["maxStretch"], lp + ".maxStretch");
+      s.groups.push_back(std::move(look));
     }
   }
   return s;

@@ -76,34 +76,59 @@ inline constexpr const char* kBillboardVs = R"(
 layout(location = 0) in vec2 aCorner;
 layout(location = 1) in vec4 aCenterRadius;
 layout(location = 2) in vec4 aColor;
-out vec2 vUV;
+layout(location = 3) in vec3 aVelocity;  // (0, 0, 0) unless the sprites are stretched
+uniform float uStretch;     // seconds of path a sprite covers; 0: round
+uniform float uMaxStretch;  // the most a sprite's length may be, in widths
+out vec2 vUV;         // x along the streak, in half sizes from its middle; y across
+flat out float vHalfStreak;  // half the streak's length, in half sizes
+flat out vec2 vDir;   // the streak's screen direction (x when round)
 flat out vec4 vColor;
 flat out vec3 vCenter;
 flat out float vRadius;
 flat out int vMode;  // 0: sub-pixel, 1: unshaded sprite, 2: shaded sprite
 void main() {
   vec4 c = uView * vec4(aCenterRadius.xyz, 1.0);
-  float ppu = pixelsPerUnit(-c.z);
+  float depth = max(-c.z, 1e-6);
+  float ppu = pixelsPerUnit(depth);
   float rpx = aCenterRadius.w * ppu;
   float halfSize = aCenterRadius.w;
+  // The streak: the projection's derivative along the view-space velocity, over uStretch
+  // seconds, in view units at this depth (screen x = x / depth, so d/dt = (vx + x vz / depth)
+  // / depth).
+  vec3 v = mat3(uView) * aVelocity;
+  vec2 streak = uStretch * (v.xy + c.xy * v.z / depth);
+  float len = length(streak);
+  vec2 dir = len > 1e-9 ? streak / len : vec2(1.0, 0.0);
   vColor = aColor;
   if (rpx < 0.5) {
-    // One pixel wide, its alpha the disc's coverage of that pixel.
+    // One pixel wide, its alpha the disc's coverage of that pixel; a streak's pixels are
+    // covered across its width instead.
     halfSize = 0.5 / ppu;
-    vColor.a *= 3.14159265 * rpx * rpx;
+    float streakPx = min(len * ppu, 1.0);
+    vColor.a *= mix(3.14159265 * rpx * rpx, min(1.0, 2.0 * rpx), streakPx);
     vMode = 0;
   } else {
     vMode = (uShading && rpx >= uLitMinPixels) ? 2 : 1;
   }
-  vUV = aCorner;
+  len = min(len, (uMaxStretch - 1.0) * 2.0 * halfSize);
+  vec2 side = vec2(-dir.y, dir.x);
+  // Along dir the quad covers the sprite swept along the streak, which trails the particle:
+  // its caps are the sprite's two halves, its middle the sprite's centre line across.
+  // Unstretched it is the plain billboard.
+  vec2 offset = dir * (aCorner.x * (halfSize + 0.5 * len) - 0.5 * len) + side * aCorner.y * halfSize;
+  vHalfStreak = 0.5 * len / halfSize;
+  vUV = vec2(aCorner.x * (1.0 + vHalfStreak), aCorner.y);
+  vDir = dir;
   vCenter = aCenterRadius.xyz;
   vRadius = aCenterRadius.w;
-  gl_Position = uProj * vec4(c.xy + aCorner * halfSize, c.z, 1.0);
+  gl_Position = uProj * vec4(c.xy + offset, c.z, 1.0);
 }
 )";
 
 inline constexpr const char* kBillboardFs = R"(
 in vec2 vUV;
+flat in float vHalfStreak;
+flat in vec2 vDir;
 flat in vec4 vColor;
 flat in vec3 vCenter;
 flat in float vRadius;
@@ -117,7 +142,9 @@ void main() {
     oColor = vColor;
     return;
   }
-  vec4 t = texture(uSprite, vUV * 0.5 + 0.5);
+  // The sprite swept along the streak: its coordinate across the middle is its centre line.
+  vec2 uv = vec2(sign(vUV.x) * max(abs(vUV.x) - vHalfStreak, 0.0), vUV.y);
+  vec4 t = texture(uSprite, uv * 0.5 + 0.5);
   float a = vColor.a * t.a;
   if (a <= 0.0) discard;
   vec3 base = vColor.rgb * t.rgb;
@@ -125,9 +152,11 @@ void main() {
     vec3 n = normalize(uEye - vCenter);
     base = shade(base, vCenter, n);
   } else if (vMode == 2) {
-    // A sphere's normal under the billboard; outside the disc, the rim's.
-    float r2 = dot(vUV, vUV);
-    vec3 nv = r2 < 1.0 ? vec3(vUV, sqrt(1.0 - r2)) : vec3(vUV * inversesqrt(r2), 0.0);
+    // A sphere's normal under the billboard (a capsule's when stretched); outside the
+    // disc, the rim's. uv turned back to screen axes.
+    vec2 q = uv.x * vDir + uv.y * vec2(-vDir.y, vDir.x);
+    float r2 = dot(q, q);
+    vec3 nv = r2 < 1.0 ? vec3(q, sqrt(1.0 - r2)) : vec3(q * inversesqrt(r2), 0.0);
     vec3 n = normalize(uViewToWorld * nv);
     base = shade(base, vCenter + vRadius * n, n);
   }
