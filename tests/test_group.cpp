@@ -377,3 +377,211 @@ TEST(Group, InternalsAreNotPublic) {
   EXPECT_FALSE(kHasPublicImpl<Group>);
   EXPECT_FALSE(kHasPublicImpl<const Group>);
 }
+
+// ---- instance transforms and prewarm ----------------------------------------------------------
+
+namespace {
+std::vector<float> allLanes(const Group& g) {
+  std::vector<float> out;
+  for (Attribute a : {Attribute::Position, Attribute::Velocity, Attribute::Age})
+    for (int c = 0; c < (a == Attribute::Age ? 1 : 3); ++c) {
+      const auto lane = g.lane(a, c);
+      out.insert(out.end(), lane.begin(), lane.end());
+    }
+  const auto ids = g.ids();
+  for (std::uint32_t id : ids) out.push_back(float(id));
+  return out;
+}
+
+// A drop effect: particles born at the local origin falling onto a local floor y = 0.
+Effect dropEffect(const char* space) {
+  return parseEffect(std::string(R"({"name": "drop", "dt": 0.02, "space": ")") + space + R"(",
+    "groups": [{"name": "drop", "capacity": 2000,
+      "emitters": [{"position": [0, 1, 0], "rate": 200, "types": [{"lifetime": 4,
+                    "velocity": {"type": "sphere", "center": [0, -3, 0], "outerRadius": 1}}]}],
+      "actions": [{"type": "Gravity", "acceleration": [0, -9.81, 0]},
+                  {"type": "Bounce", "surface": {"type": "plane", "point": [0, 0, 0],
+                   "normal": [0, 1, 0]}, "restitution": 0.5},
+                  {"type": "Move"}, {"type": "KillOld"}]}]})");
+}
+
+// The height of each particle above the instance's floor (in the world).
+float lowestAboveFloor(const Group& g, const Transform& t) {
+  const Vec3 up = t.direction(Vec3(0, 1, 0));
+  float lowest = 1e30f;
+  for (std::size_t i = 0; i < g.size(); ++i)
+    lowest = std::min(lowest, glm::dot(g.particle(i).position - t.position, up));
+  return lowest;
+}
+}  // namespace
+
+TEST(Instance, AnEmitterAtTheLocalOriginEmitsAtTheInstancesPlace) {
+  Context ctx({.seed = 3, .dt = 0.1, .threads = 1});
+  Group& g = ctx.createGroup("g", 10);
+  Emitter e;
+  e.bursts = {Burst{0.0, 1}};
+  e.types[0].velocity = Domain::point(Vec3(0, 0, 1));  // local +z
+  g.addEmitter(e);
+  g.setActions({Move{}});
+  const Transform t{Vec3(5, 2, -3), glm::angleAxis(glm::radians(90.0f), Vec3(0, 1, 0)), 2.0f};
+  g.setTransform(t);
+  ctx.step();
+  ASSERT_EQ(g.size(), 1u);
+  const Particle p = g.particle(0);
+  // Born at the instance's origin at t = 0, moving along local +z turned to world +x
+  // (velocities are rotated, not scaled), for the whole step.
+  EXPECT_NEAR(p.velocity.x, 1.0f, 1e-6f);
+  EXPECT_NEAR(p.velocity.z, 0.0f, 1e-6f);
+  EXPECT_NEAR(p.position.x, 5.1f, 1e-5f);
+  EXPECT_NEAR(p.position.y, 2.0f, 1e-5f);
+  EXPECT_NEAR(p.position.z, -3.0f, 1e-5f);
+  // The group's own emitters and actions still read as given.
+  EXPECT_EQ(g.emitters()[0].position, Vec3(0.0f));
+  EXPECT_EQ(g.transform().position, t.position);
+}
+
+TEST(Instance, ATurnedAndMovedFloorStillCatchesParticlesInBothSpaces) {
+  for (const char* space : {"world", "local"}) {
+    SCOPED_TRACE(space);
+    const Effect fx = dropEffect(space);
+    ContextOptions o = fx.contextOptions();
+    o.threads = 2;
+    Context ctx(o);
+    EffectInstance inst = fx.instantiate(ctx, "a");
+    Group& g = *inst.groups().at(0);
+    // The floor stands up as a wall x = 7 (local up is world -x: particles fall along -x
+    // in the instance's frame, but gravity is the world's, along the wall).
+    Transform t{Vec3(7, 0, 2), glm::angleAxis(glm::radians(90.0f), Vec3(0, 0, 1)), 1.5f};
+    inst.setTransform(t);
+    // Gravity along the wall: the particles reach it only by their launch velocity.
+    for (int s = 0; s < 100; ++s) {
+      ctx.step();
+      ASSERT_GE(lowestAboveFloor(g, t), -1e-4f) << "step " << s;
+    }
+    // A second place, turned the other way: a floor tilted by 30 degrees.
+    const Transform t2{Vec3(-4, 3, 1), glm::angleAxis(glm::radians(30.0f), Vec3(1, 0, 0)), 1.0f};
+    const std::size_t before = g.size();
+    ASSERT_GT(before, 100u);
+    std::vector<Vec3> was;
+    for (std::size_t i = 0; i < g.size(); ++i) was.push_back(g.particle(i).position);
+    inst.setTransform(t2);
+    if (std::string(space) == "local") {
+      // The live particles went with the instance: the same place relative to it.
+      for (std::size_t i = 0; i < g.size(); ++i) {
+        const Vec3 local = glm::conjugate(t.rotation) * (was[i] - t.position) / t.scale;
+        const Vec3 expect = t2.point(local);
+        ASSERT_NEAR(glm::distance(g.particle(i).position, expect), 0.0f, 1e-4f) << i;
+      }
+    } else {
+      for (std::size_t i = 0; i < g.size(); ++i) ASSERT_EQ(g.particle(i).position, was[i]);
+    }
+    if (std::string(space) == "local") {
+      for (int s = 0; s < 100; ++s) {
+        ctx.step();
+        ASSERT_GE(lowestAboveFloor(g, t2), -1e-4f) << "step " << s;
+      }
+      // Gravity is the world's, the floor tilted: particles rest on it, none fell through.
+      EXPECT_GT(g.size(), 500u);
+    }
+    // New particles are born at the new place: 1 unit above the floor, along its normal.
+    Context fresh(o);
+    EffectInstance b = fx.instantiate(fresh, "b");
+    b.setTransform(t2);
+    fresh.step();
+    const Group& gb = *b.groups()[0];
+    ASSERT_GT(gb.size(), 0u);
+    EXPECT_NEAR(lowestAboveFloor(gb, t2), 1.0f, 0.2f);
+  }
+}
+
+TEST(Instance, TheIdentityIsBitwiseNoTransform) {
+  for (const char* space : {"world", "local"}) {
+    const Effect fx = dropEffect(space);
+    ContextOptions o = fx.contextOptions();
+    o.threads = 2;
+    Context plain(o), placed(o);
+    Group& a = *fx.build(plain, 0, "x").at(0);
+    EffectInstance b = fx.instantiate(placed, "x");
+    b.setTransform(Transform{});
+    plain.run(60);
+    placed.run(60);
+    b.setTransform(Transform{});  // again, between steps
+    plain.run(20);
+    placed.run(20);
+    ASSERT_GT(a.size(), 0u);
+    EXPECT_EQ(allLanes(a), allLanes(*b.groups()[0])) << space;
+  }
+}
+
+TEST(Instance, InvalidTransformsNameTheFieldAndChangeNothing) {
+  const Effect fx = dropEffect("world");
+  Context ctx(fx.contextOptions());
+  EffectInstance inst = fx.instantiate(ctx, "a");
+  Group& g = *inst.groups()[0];
+  auto field = [&](const Transform& t) {
+    try {
+      inst.setTransform(t);
+    } catch (const InvalidArgument& e) {
+      return e.parameter();
+    }
+    return std::string("(accepted)");
+  };
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(field({Vec3(nan, 0, 0)}), "transform.position");
+  EXPECT_EQ(field({Vec3(0), glm::quat(0, 0, 0, 0)}), "transform.rotation");
+  EXPECT_EQ(field({Vec3(0), glm::quat(nan, 0, 0, 0)}), "transform.rotation");
+  EXPECT_EQ(field({Vec3(0), glm::quat(1, 0, 0, 0), 0.0f}), "transform.scale");
+  EXPECT_EQ(field({Vec3(0), glm::quat(1, 0, 0, 0), -1.0f}), "transform.scale");
+  EXPECT_EQ(field({Vec3(0), glm::quat(1, 0, 0, 0), kInfinity}), "transform.scale");
+  EXPECT_THROW(Transform::fromMatrix(glm::scale(glm::mat4(1.0f), Vec3(1, 2, 1))), InvalidArgument);
+  // A box turns only by quarter turns.
+  g.setActions({Sink{Domain::box(Vec3(-1), Vec3(1))}, Move{}});
+  EXPECT_EQ(field({Vec3(1, 2, 3), glm::angleAxis(glm::radians(45.0f), Vec3(0, 1, 0))}),
+            "transform.rotation");
+  EXPECT_TRUE(g.transform().isIdentity());  // left as it was
+  EXPECT_EQ(field({Vec3(1, 2, 3), glm::angleAxis(glm::radians(90.0f), Vec3(0, 1, 0))}),
+            "(accepted)");
+  const auto& box = std::get<BoxDomain>(std::get<Sink>(g.actions().actions()[0]).region.shape());
+  EXPECT_EQ(box.min, Vec3(-1));  // the group's own list is as given
+  // A matrix round trip.
+  const Transform t{Vec3(1, 2, 3), glm::angleAxis(0.7f, glm::normalize(Vec3(1, 2, 3))), 2.5f};
+  const Transform m = Transform::fromMatrix(t.matrix());
+  EXPECT_NEAR(glm::distance(m.point(Vec3(0.3f, -1, 2)), t.point(Vec3(0.3f, -1, 2))), 0.0f, 1e-5f);
+  EXPECT_NEAR(m.scale, 2.5f, 1e-5f);
+}
+
+TEST(Instance, PrewarmIsBitwiseSteppingByHand) {
+  const Effect fx = dropEffect("world");
+  ContextOptions o = fx.contextOptions();
+  o.threads = 2;
+  Context byHand(o), warm(o);
+  fx.instantiate(byHand, "other");  // the same group indices (random streams) in both
+  EffectInstance a = fx.instantiate(byHand, "a");
+  fx.instantiate(warm, "other");  // another instance, not prewarmed: its clock does not move
+  EffectInstance b = fx.instantiate(warm, "a");
+  const Transform t{Vec3(1, 0, 0), glm::angleAxis(0.3f, Vec3(0, 0, 1)), 1.0f};
+  a.setTransform(t);
+  b.setTransform(t);
+  byHand.run(50);
+  EXPECT_EQ(b.prewarm(50 * fx.dt), 50u);
+  EXPECT_EQ(warm.stepIndex(), 0u);
+  EXPECT_EQ(warm.group("drop@other").size(), 0u);
+  ASSERT_GT(a.groups()[0]->size(), 0u);
+  EXPECT_EQ(allLanes(*a.groups()[0]), allLanes(*b.groups()[0]));
+  // And it goes on as it would have.
+  byHand.run(30);
+  warm.run(30);
+  EXPECT_EQ(allLanes(*a.groups()[0]), allLanes(*b.groups()[0]));
+  EXPECT_GT(warm.group("drop@other").size(), 0u);
+  EXPECT_THROW(b.prewarm(-1.0), InvalidArgument);
+  EXPECT_EQ(b.prewarm(0.0), 0u);
+}
+
+TEST(Instance, TheEffectFileSaysItsSpace) {
+  EXPECT_EQ(dropEffect("local").space, Space::Local);
+  EXPECT_EQ(dropEffect("world").space, Space::World);
+  EXPECT_EQ(parseEffect(saveEffect(dropEffect("local"))).space, Space::Local);
+  EXPECT_THROW(dropEffect("galaxy"), EffectError);
+  Context ctx;
+  EXPECT_EQ(dropEffect("local").instantiate(ctx, "a").groups()[0]->space(), Space::Local);
+}

@@ -27,6 +27,8 @@ struct Context::Impl {
   std::uint64_t step = 0;
   double timeAtDtChange = 0.0;  // time = timeAtDtChange + stepsSinceDtChange·dt: no drift
   std::uint64_t stepsSinceDtChange = 0;
+
+  detail::StepParams params() const;
 };
 
 namespace {
@@ -119,26 +121,81 @@ std::vector<Group*> Context::groups() {
   return r;
 }
 
-void Context::step() {
+namespace {
+
+// The step a group takes now, `extra` steps past its own clock: the context's, or with
+// Context::prewarm's steps ahead of it. Kept in the context's form (base + steps·dt) so that
+// a prewarmed group reads the very times a group stepped by hand would.
+detail::StepParams groupStep(const detail::StepParams& sp, const detail::GroupImpl& gi,
+                             double timeAtDtChange, std::uint64_t stepsSinceDtChange,
+                             std::uint64_t extra) {
+  const std::uint64_t ahead = gi.stepsAhead + extra;
+  if (ahead == 0) return sp;
+  detail::StepParams r = sp;
+  r.step = sp.step + ahead;
+  r.time = std::isnan(gi.aheadSeconds) ? timeAtDtChange + double(stepsSinceDtChange + ahead) * sp.dt
+                                       : sp.time + gi.aheadSeconds + double(extra) * sp.dt;
+  return r;
+}
+
+void stepGroup(detail::BackendImpl& backend, detail::GroupImpl& gi, const detail::StepParams& sp) {
+  gi.placeEmitters();
+  gi.ensureStorage();
+  if (gi.stats.killedByAction.size() != gi.actions.size())
+    gi.stats.killedByAction.assign(gi.actions.size(), 0);
+  backend.step(gi, sp);
+}
+
+}  // namespace
+
+detail::StepParams Context::Impl::params() const {
   detail::StepParams sp;
-  sp.time = impl_->time;
-  sp.dt = impl_->options.dt;
-  sp.seed = impl_->options.seed;
-  sp.step = impl_->step;
-  sp.blockSize = impl_->options.blockSize;
-  sp.fused = impl_->options.fused;
-  sp.cull = impl_->options.cull;
-  sp.pool = impl_->pool.get();
+  sp.time = time;
+  sp.dt = options.dt;
+  sp.seed = options.seed;
+  sp.step = step;
+  sp.blockSize = options.blockSize;
+  sp.fused = options.fused;
+  sp.cull = options.cull;
+  sp.pool = pool.get();
+  return sp;
+}
+
+void Context::step() {
+  const detail::StepParams sp = impl_->params();
   for (auto& g : impl_->groups) {
     auto& gi = *g->impl_;
-    gi.ensureStorage();
-    if (gi.stats.killedByAction.size() != gi.actions.size())
-      gi.stats.killedByAction.assign(gi.actions.size(), 0);
-    impl_->backend->step(gi, sp);
+    stepGroup(*impl_->backend, gi,
+              groupStep(sp, gi, impl_->timeAtDtChange, impl_->stepsSinceDtChange, 0));
   }
   ++impl_->step;
   ++impl_->stepsSinceDtChange;
   impl_->time = impl_->timeAtDtChange + double(impl_->stepsSinceDtChange) * impl_->options.dt;
+}
+
+std::uint64_t Context::prewarm(std::span<Group* const> groups, double seconds) {
+  if (!(seconds >= 0.0) || !std::isfinite(seconds))
+    throw InvalidArgument("seconds", "must be finite and >= 0");
+  for (Group* g : groups) {
+    const auto& all = impl_->groups;
+    if (!g || std::none_of(all.begin(), all.end(), [&](const auto& o) { return o.get() == g; }))
+      throw InvalidArgument("groups", "not a group of this context");
+  }
+  const double dt = impl_->options.dt;
+  // The fewest whole steps that cover `seconds` (a hair's rounding of seconds/dt forgiven).
+  const double q = seconds / dt;
+  std::uint64_t n = std::uint64_t(std::ceil(q));
+  if (n > 0 && double(n - 1) >= q * (1.0 - 1e-9)) --n;
+  const detail::StepParams sp = impl_->params();
+  for (std::uint64_t i = 0; i < n; ++i)
+    for (Group* g : groups) {
+      auto& gi = *g->impl_;
+      stepGroup(*impl_->backend, gi,
+                groupStep(sp, gi, impl_->timeAtDtChange, impl_->stepsSinceDtChange, 0));
+      ++gi.stepsAhead;
+      if (!std::isnan(gi.aheadSeconds)) gi.aheadSeconds += dt;
+    }
+  return n;
 }
 
 double Context::time() const {
@@ -152,6 +209,14 @@ double Context::timeStep() const {
 }
 void Context::setTimeStep(double dt) {
   checkDt(dt);
+  // Groups ahead of the clock keep their lead in seconds: their steps so far were of the old dt.
+  for (auto& g : impl_->groups) {
+    auto& gi = *g->impl_;
+    if (gi.stepsAhead > 0 && std::isnan(gi.aheadSeconds))
+      gi.aheadSeconds = (impl_->timeAtDtChange +
+                         double(impl_->stepsSinceDtChange + gi.stepsAhead) * impl_->options.dt) -
+                        impl_->time;
+  }
   impl_->timeAtDtChange = impl_->time;
   impl_->stepsSinceDtChange = 0;
   impl_->options.dt = dt;

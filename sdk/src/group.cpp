@@ -8,6 +8,7 @@
 
 #include "flurry/error.hpp"
 #include "group_impl.hpp"
+#include "transform.hpp"
 
 namespace flurry {
 
@@ -235,6 +236,12 @@ void Group::require(AttributeSet attributes) {
 
 Group& Group::setActions(ActionList actions) {
   impl_->syncHost();
+  if (auto* f = impl_->frame.get()) {
+    ActionList world =
+        f->transform.isIdentity() ? actions : detail::transformActions(actions, f->transform);
+    f->actions = std::move(actions);
+    actions = std::move(world);
+  }
   impl_->actions = std::move(actions);
   ++impl_->actionsVersion;  // the fused pass's plan is rebuilt
   impl_->stats.killedByAction.assign(impl_->actions.size(), 0);
@@ -244,19 +251,148 @@ Group& Group::setActions(ActionList actions) {
 }
 
 const ActionList& Group::actions() const {
-  return impl_->actions;
+  return impl_->frame ? impl_->frame->actions : impl_->actions;
+}
+
+namespace {
+
+// Carries the live particles from transform `from` to `to` (Space::Local): points through
+// to ∘ from⁻¹, vectors by the change of rotation alone (see Transform).
+void carryParticles(detail::GroupImpl& g, const Transform& from, const Transform& to) {
+  g.syncHost();
+  if (g.size == 0 && g.live.empty()) return;
+  const glm::quat dq = to.rotation * glm::conjugate(from.rotation);
+  const float ds = to.scale / from.scale;
+  const detail::Lanes L = g.lanePointers();
+  auto points = [&](float* const* lane) {
+    if (!lane[0]) return;
+    for (std::size_t i = 0; i < g.size; ++i) {
+      const Vec3 p(lane[0][i], lane[1][i], lane[2][i]);
+      const Vec3 q = to.position + dq * (ds * (p - from.position));
+      lane[0][i] = q.x, lane[1][i] = q.y, lane[2][i] = q.z;
+    }
+  };
+  auto vectors = [&](float* const* lane) {
+    if (!lane[0]) return;
+    for (std::size_t i = 0; i < g.size; ++i) {
+      const Vec3 v = dq * Vec3(lane[0][i], lane[1][i], lane[2][i]);
+      lane[0][i] = v.x, lane[1][i] = v.y, lane[2][i] = v.z;
+    }
+  };
+  points(L.p);
+  points(L.prev);
+  points(L.posB);
+  vectors(L.v);
+  vectors(L.velB);
+  vectors(L.up);
+  vectors(L.rot);
+  // Emitters spawned by prime emitters are part of the effect's state too.
+  for (detail::LiveEmitter& e : g.live) {
+    e.position = to.position + dq * (ds * (e.position - from.position));
+    e.velocity = dq * e.velocity;
+  }
+  g.hostChanged();
+}
+
+}  // namespace
+
+Group& Group::setTransform(const Transform& transform) {
+  transform.validate("transform");
+  Transform t = transform;
+  t.rotation = glm::normalize(t.rotation);
+  if (t.rotation == glm::quat(-1.0f, 0.0f, 0.0f, 0.0f)) t.rotation = glm::quat(1.0f, 0, 0, 0);
+  auto& g = *impl_;
+  const bool first = !g.frame;
+  const detail::Frame* f = g.frame.get();
+  const ActionList& local = f ? f->actions : g.actions;
+  const std::vector<Emitter>& localEmitters = f ? f->emitters : g.emitters;
+  const std::vector<PrimeEmitter>& localPrimes = f ? f->primes : g.primes;
+  // Everything derived first, so that a refused transform leaves the group as it was.
+  const bool identity = t.isIdentity();
+  ActionList world = identity ? local : detail::transformActions(local, t);
+  std::vector<Emitter> emitters;
+  std::vector<PrimeEmitter> primes;
+  emitters.reserve(localEmitters.size());
+  primes.reserve(localPrimes.size());
+  for (const Emitter& e : localEmitters)
+    emitters.push_back(identity ? e : detail::transformEmitter(e, t));
+  for (const PrimeEmitter& p : localPrimes)
+    primes.push_back(identity ? p : detail::transformPrime(p, t));
+  if (first) {
+    g.frame = std::make_unique<detail::Frame>();
+    g.frame->actions = g.actions;
+    g.frame->emitters = g.emitters;
+    g.frame->primes = g.primes;
+  }
+  detail::Frame& fr = *g.frame;
+  if (fr.space == Space::Local) carryParticles(g, fr.transform, t);
+  fr.transform = t;
+  // Only the actions' constants change: a device backend uploads them, and its program (which
+  // depends on the kinds of actions and domains alone) is kept.
+  g.actions = std::move(world);
+  ++g.actionsVersion;
+  g.emitters = std::move(emitters);
+  g.primes = std::move(primes);
+  g.primeSpecs.clear();
+  for (const PrimeEmitter& p : g.primes)
+    g.primeSpecs.push_back(std::make_shared<EmitterSpec>(p.child));
+  ++g.emittersVersion;
+  fr.emittersDerived = g.emittersVersion;
+  return *this;
+}
+
+const Transform& Group::transform() const {
+  static const Transform identity;
+  return impl_->frame ? impl_->frame->transform : identity;
+}
+
+Group& Group::setSpace(Space space) {
+  if (!impl_->frame) setTransform(Transform{});
+  impl_->frame->space = space;
+  return *this;
+}
+
+Space Group::space() const {
+  return impl_->frame ? impl_->frame->space : Space::World;
+}
+
+void detail::GroupImpl::placeEmitters() {
+  if (!frame || frame->emittersDerived == emittersVersion) return;
+  const Transform& t = frame->transform;
+  const bool identity = t.isIdentity();
+  emitters.clear();
+  for (const Emitter& e : frame->emitters)
+    emitters.push_back(identity ? e : transformEmitter(e, t));
+  primes.clear();
+  for (const PrimeEmitter& p : frame->primes) primes.push_back(identity ? p : transformPrime(p, t));
+  primeSpecs.clear();
+  for (const PrimeEmitter& p : primes) primeSpecs.push_back(std::make_shared<EmitterSpec>(p.child));
+  ++emittersVersion;
+  frame->emittersDerived = emittersVersion;
 }
 
 Emitter& Group::addEmitter(Emitter emitter) {
   emitter.validate("emitters[" + std::to_string(impl_->emitters.size()) + "]");
-  impl_->emitters.push_back(std::move(emitter));
-  impl_->emitterState.emplace_back();
-  ++impl_->emittersVersion;
-  return impl_->emitters.back();
+  auto& g = *impl_;
+  if (g.frame) {
+    const Transform& t = g.frame->transform;
+    g.emitters.push_back(t.isIdentity() ? emitter : detail::transformEmitter(emitter, t));
+    g.frame->emitters.push_back(std::move(emitter));
+  } else {
+    g.emitters.push_back(std::move(emitter));
+  }
+  g.emitterState.emplace_back();
+  ++g.emittersVersion;
+  if (g.frame) {
+    g.frame->emittersDerived = g.emittersVersion;
+    return g.frame->emitters.back();
+  }
+  return g.emitters.back();
 }
 
 std::span<Emitter> Group::emitters() {
   ++impl_->emittersVersion;  // the caller may edit through the span
+  if (impl_->frame) return impl_->frame->emitters;
   return impl_->emitters;
 }
 
@@ -266,17 +402,29 @@ void Group::removeEmitter(std::size_t i) {
     throw InvalidArgument("index", std::to_string(i) + " is past the " +
                                        std::to_string(g.emitters.size()) + " emitters");
   g.emitters.erase(g.emitters.begin() + std::ptrdiff_t(i));
+  if (g.frame) g.frame->emitters.erase(g.frame->emitters.begin() + std::ptrdiff_t(i));
   g.emitterState.erase(g.emitterState.begin() + std::ptrdiff_t(i));
   ++g.emittersVersion;
 }
 
 PrimeEmitter& Group::addPrimeEmitter(PrimeEmitter prime) {
   prime.validate("primeEmitters[" + std::to_string(impl_->primes.size()) + "]");
-  impl_->primes.push_back(std::move(prime));
-  impl_->primeState.emplace_back();
-  impl_->primeLive.push_back(0);
-  ++impl_->emittersVersion;
-  return impl_->primes.back();
+  auto& g = *impl_;
+  if (g.frame) {
+    const Transform& t = g.frame->transform;
+    g.primes.push_back(t.isIdentity() ? prime : detail::transformPrime(prime, t));
+    g.frame->primes.push_back(std::move(prime));
+  } else {
+    g.primes.push_back(std::move(prime));
+  }
+  g.primeState.emplace_back();
+  g.primeLive.push_back(0);
+  ++g.emittersVersion;
+  if (g.frame) {
+    g.frame->emittersDerived = g.emittersVersion;
+    return g.frame->primes.back();
+  }
+  return g.primes.back();
 }
 
 std::size_t Group::liveEmitterCount() const {

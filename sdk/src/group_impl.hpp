@@ -3,12 +3,14 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "flurry/group.hpp"
 #include "flurry/strands.hpp"
+#include "flurry/transform.hpp"
 
 namespace flurry::detail {
 
@@ -135,6 +137,20 @@ struct ActionPlan {
   bool cullable = false;  ///< some action has a finite reach
 };
 
+/// A group placed in the world (Group::setTransform): its emitters and action list as the
+/// user gave them, in the group's own frame. GroupImpl::emitters, primes and actions are their
+/// images in the world, which the backends run. Absent until a transform is set, so a group
+/// never placed runs exactly as before.
+struct Frame {
+  Transform transform;
+  Space space = Space::World;
+  std::vector<Emitter> emitters;
+  std::vector<PrimeEmitter> primes;
+  ActionList actions;
+  /// GroupImpl::emittersVersion when the world emitters were last derived from these.
+  std::uint64_t emittersDerived = ~std::uint64_t(0);
+};
+
 struct GroupImpl;
 /// Brings group.plan up to date with its action list (when actionsVersion changed) and
 /// returns it (cpu/cpu_backend.cpp).
@@ -183,6 +199,13 @@ struct GroupImpl {
   ActionPlan plan;                       ///< the fused pass's, for actionsVersion
 
   std::unique_ptr<DeviceMirror> mirror;  ///< null on the CPU backend
+  std::unique_ptr<Frame> frame;          ///< null until Group::setTransform
+  /// Steps this group runs ahead of its context's clock (Context::prewarm): its step index
+  /// and time are the context's plus these steps.
+  std::uint64_t stepsAhead = 0;
+  /// NaN while the context's dt is the one the steps ahead were taken with; after a change of
+  /// dt, the lead in seconds.
+  double aheadSeconds = std::numeric_limits<double>::quiet_NaN();
 
   /// Brings the live count and `attributes` (default: all; before the host writes, all) up
   /// to date on the host.
@@ -199,6 +222,10 @@ struct GroupImpl {
   void syncStats() {
     if (mirror) mirror->syncStats(*this);
   }
+
+  /// Derives the world emitters from the frame's when they may have changed (a step calls it
+  /// first; no-op without a frame).
+  void placeEmitters();
 
   /// The attributes the group must store now.
   AttributeSet wanted() const { return required | actions.attributes(); }

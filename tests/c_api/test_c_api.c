@@ -659,6 +659,68 @@ static void test_visible(void) {
   OK(flurry_context_destroy(ctx));
 }
 
+/* An instance's transform: a particle born at the local origin appears at its place; the
+ * local space carries it along; bad transforms name their field; prewarm steps alone. */
+static void test_transform(void) {
+  const char* json =
+      "{\"name\": \"t\", \"dt\": 0.1, \"groups\": [{\"name\": \"g\", \"capacity\": 4,"
+      " \"emitters\": [{\"bursts\": [{\"time\": 0, \"count\": 1}]}],"
+      " \"actions\": [{\"type\": \"Move\"}]}]}";
+  flurry_effect* fx = NULL;
+  flurry_context* ctx = NULL;
+  flurry_context_options o;
+  flurry_group* g = NULL;
+  const float* x = NULL;
+  size_t n = 0, stride = 0;
+  float pos[3] = {5, 2, -3}, rot[4] = {0, 0, 0, 1}, back[4] = {0}, scale = 0;
+  uint64_t steps = 0;
+  flurry_space space = FLURRY_SPACE_WORLD;
+  const float nanpos[3] = {NAN, 0, 0}, zero[4] = {0, 0, 0, 0};
+  OK(flurry_effect_parse(json, "t", &fx));
+  OK(flurry_effect_context_options(fx, &o));
+  OK(flurry_context_create(&o, &ctx));
+  OK(flurry_effect_build(fx, ctx, 0));
+  OK(flurry_context_group(ctx, "g", &g));
+  OK(flurry_group_set_transform(g, pos, rot, 2.0f));
+  OK(flurry_group_transform(g, NULL, back, &scale));
+  CHECK(back[3] == 1 && scale == 2.0f);
+  OK(flurry_context_step(ctx));
+  OK(flurry_group_lane(g, FLURRY_ATTR_POSITION, 0, &x, &n, &stride));
+  CHECK(n == 1 && x[0] == 5.0f);
+  /* Local space: the particle moves with the group. */
+  OK(flurry_group_set_space(g, FLURRY_SPACE_LOCAL));
+  OK(flurry_group_space(g, &space));
+  CHECK(space == FLURRY_SPACE_LOCAL);
+  pos[0] = 7;
+  OK(flurry_group_set_transform(g, pos, rot, 2.0f));
+  OK(flurry_group_lane(g, FLURRY_ATTR_POSITION, 0, &x, &n, &stride));
+  CHECK(n == 1 && x[0] == 7.0f);
+  FAILS(flurry_group_set_transform(g, nanpos, rot, 1), FLURRY_ERROR_INVALID_ARGUMENT,
+        "transform.position");
+  FAILS(flurry_group_set_transform(g, pos, zero, 1), FLURRY_ERROR_INVALID_ARGUMENT,
+        "transform.rotation");
+  FAILS(flurry_group_set_transform(g, pos, rot, 0), FLURRY_ERROR_INVALID_ARGUMENT,
+        "transform.scale");
+  FAILS(flurry_group_set_transform(NULL, pos, rot, 1), FLURRY_ERROR_NULL_ARGUMENT, "group");
+  FAILS(flurry_group_set_transform(g, NULL, rot, 1), FLURRY_ERROR_NULL_ARGUMENT, "position");
+  FAILS(flurry_group_set_transform(g, pos, NULL, 1), FLURRY_ERROR_NULL_ARGUMENT, "rotation");
+  FAILS(flurry_group_transform(NULL, pos, rot, &scale), FLURRY_ERROR_NULL_ARGUMENT, "group");
+  FAILS(flurry_group_set_space(NULL, FLURRY_SPACE_LOCAL), FLURRY_ERROR_NULL_ARGUMENT, "group");
+  FAILS(flurry_group_set_space(g, (flurry_space)7), FLURRY_ERROR_INVALID_ARGUMENT, "space");
+  FAILS(flurry_group_space(NULL, &space), FLURRY_ERROR_NULL_ARGUMENT, "group");
+  FAILS(flurry_group_space(g, NULL), FLURRY_ERROR_NULL_ARGUMENT, "space");
+  /* Prewarm: the group alone runs ahead, the context's clock stays. */
+  OK(flurry_context_prewarm(ctx, &g, 1, 0.5, &steps));
+  CHECK(steps == 5);
+  OK(flurry_context_step_index(ctx, &steps));
+  CHECK(steps == 1);
+  FAILS(flurry_context_prewarm(ctx, &g, 1, -1, NULL), FLURRY_ERROR_INVALID_ARGUMENT, "seconds");
+  FAILS(flurry_context_prewarm(NULL, &g, 1, 1, NULL), FLURRY_ERROR_NULL_ARGUMENT, "ctx");
+  FAILS(flurry_context_prewarm(ctx, NULL, 1, 1, NULL), FLURRY_ERROR_NULL_ARGUMENT, "groups");
+  OK(flurry_context_destroy(ctx));
+  OK(flurry_effect_destroy(fx));
+}
+
 int main(int argc, char** argv) {
   if (argc != 3) {
     fprintf(stderr, "usage: test_c_api FOUNTAIN_JSON OUT_DIR\n");
@@ -672,6 +734,7 @@ int main(int argc, char** argv) {
   test_building();
   test_group(argv[2]);
   test_visible();
+  test_transform();
   if (failures) {
     fprintf(stderr, "%d checks failed\n", failures);
     return 1;

@@ -10,6 +10,7 @@
 #include "opencl/backend.hpp"
 #include "opencl/runtime.hpp"
 #include "opencl_test.hpp"
+#include "parity.hpp"
 
 using namespace flurry;
 
@@ -454,4 +455,52 @@ TEST(OpenCLBackend, PoclCacheLivesInFlurrysCache) {
   const char* pocl = std::getenv("POCL_CACHE_DIR");
   ASSERT_NE(pocl, nullptr);
   EXPECT_EQ(std::filesystem::path(pocl), dir / "pocl");
+}
+
+// An instance moved between steps: its emitter and floor follow it on the device as on the
+// CPU, and the move reaches the device as constants, with no program rebuilt.
+TEST(OpenCLBackend, InstanceTransformsMatchTheCpuWithoutARebuild) {
+  FLURRY_REQUIRE_OPENCL();
+  const Effect fx = parseEffect(R"({"name": "drop", "dt": 0.02,
+    "groups": [{"name": "drop", "capacity": 4000,
+      "emitters": [{"position": [0, 1, 0], "rate": 300, "types": [{"lifetime": 5,
+                    "velocity": {"type": "sphere", "center": [0, -3, 0], "outerRadius": 1}}]}],
+      "actions": [{"type": "Gravity"}, {"type": "Bounce", "surface": {"type": "disc",
+                   "center": [0, 0, 0], "normal": [0, 1, 0], "outerRadius": 40},
+                   "restitution": 0.5}, {"type": "Move"}, {"type": "KillOld"}]}]})");
+  const Transform t1{Vec3(3, -2, 1), glm::angleAxis(0.4f, Vec3(0, 0, 1)), 1.5f};
+  const Transform t2{Vec3(-1, 4, 2), glm::angleAxis(-0.3f, Vec3(1, 0, 0)), 0.8f};
+  detail::ocl::CacheStats before{}, after{};
+  auto run = [&](Backend backend) {
+    ContextOptions o = fx.contextOptions();
+    o.backend = backend;
+    o.threads = 2;
+    Context ctx(o);
+    EffectInstance inst = fx.instantiate(ctx, "a");
+    Group& g = *inst.groups()[0];
+    inst.setTransform(t1);
+    ctx.run(30);
+    if (backend == Backend::OpenCL) before = detail::ocl::Runtime::cacheStats();
+    inst.setTransform(t2);  // world space: the floor moves, the particles stay
+    ctx.run(20);
+    g.setSpace(Space::Local);
+    inst.setTransform(t1);  // local space: the particles come along
+    ctx.run(20);
+    if (backend == Backend::OpenCL) after = detail::ocl::Runtime::cacheStats();
+    test::RunResult r;
+    r.size = g.size();
+    r.stats = g.stats();
+    r.stored = g.attributes();
+    for (std::size_t i = 0; i < r.size; ++i) {
+      const Particle p = g.particle(i);
+      r.byId[p.id] = p;
+    }
+    return r;
+  };
+  const test::RunResult cpu = run(Backend::Cpu), cl = run(Backend::OpenCL);
+  ASSERT_GT(cpu.size, 300u);
+  test::expectSame(cpu, cl);
+  EXPECT_EQ(after.builds, before.builds);
+  EXPECT_EQ(after.diskHits, before.diskHits);
+  EXPECT_EQ(after.memoryHits, before.memoryHits);
 }

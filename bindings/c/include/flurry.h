@@ -243,6 +243,32 @@ FLURRY_C_EXPORT flurry_status flurry_emitter_validate(const flurry_emitter* emit
 /* ---- groups ------------------------------------------------------------------------------ */
 
 FLURRY_C_EXPORT flurry_status flurry_group_name(const flurry_group* group, const char** name);
+/** Where a group's particles live when it moves (flurry::Space). */
+typedef enum flurry_space {
+  FLURRY_SPACE_WORLD = 0, /**< born particles stay put; emitters and colliders follow */
+  FLURRY_SPACE_LOCAL = 1  /**< the live particles move with the group */
+} flurry_space;
+/** Places the group in the world (flurry::Group::setTransform), at any time between steps:
+ * world = position + rotation * (scale * local), rotation a unit quaternion x, y, z, w. From
+ * then on its emitters and action lists are in its own frame and follow it. Refused
+ * (FLURRY_ERROR_INVALID_ARGUMENT naming "transform.position", "transform.rotation" or
+ * "transform.scale") unless finite with scale > 0 and a unit rotation; the group is then
+ * unchanged. */
+FLURRY_C_EXPORT flurry_status flurry_group_set_transform(flurry_group* group,
+                                                         const float position[3],
+                                                         const float rotation[4], float scale);
+/** The group's transform (the identity if none was set); any output may be NULL. */
+FLURRY_C_EXPORT flurry_status flurry_group_transform(const flurry_group* group, float position[3],
+                                                     float rotation[4], float* scale);
+FLURRY_C_EXPORT flurry_status flurry_group_set_space(flurry_group* group, flurry_space space);
+FLURRY_C_EXPORT flurry_status flurry_group_space(const flurry_group* group, flurry_space* space);
+/** Starts `count` groups of `ctx` as if they had run `seconds` already (flurry::Context::prewarm):
+ * they alone are stepped, the context's clock does not move; *steps (may be NULL) gets the
+ * steps taken. */
+FLURRY_C_EXPORT flurry_status flurry_context_prewarm(flurry_context* ctx,
+                                                     flurry_group* const* groups, size_t count,
+                                                     double seconds, uint64_t* steps);
+
 /** Live particles: indices [0, size). */
 FLURRY_C_EXPORT flurry_status flurry_group_size(const flurry_group* group, size_t* size);
 FLURRY_C_EXPORT flurry_status flurry_group_capacity(const flurry_group* group, size_t* capacity);

@@ -762,6 +762,61 @@ flurry_status flurry_group_name(const flurry_group* g, const char** name) {
     *name = group(g).name().c_str();
   });
 }
+flurry_status flurry_group_set_transform(flurry_group* g, const float position[3],
+                                         const float rotation[4], float scale) {
+  return guard([&] {
+    need(g, "group");
+    need(position, "position");
+    need(rotation, "rotation");
+    flurry::Transform t;
+    t.position = flurry::Vec3(position[0], position[1], position[2]);
+    t.rotation = glm::quat(rotation[3], rotation[0], rotation[1], rotation[2]);  // w, x, y, z
+    t.scale = scale;
+    group(g).setTransform(t);
+  });
+}
+flurry_status flurry_group_transform(const flurry_group* g, float position[3], float rotation[4],
+                                     float* scale) {
+  return guard([&] {
+    need(g, "group");
+    const flurry::Transform& t = group(g).transform();
+    if (position)
+      position[0] = t.position.x, position[1] = t.position.y, position[2] = t.position.z;
+    if (rotation)
+      rotation[0] = t.rotation.x, rotation[1] = t.rotation.y, rotation[2] = t.rotation.z,
+      rotation[3] = t.rotation.w;
+    if (scale) *scale = t.scale;
+  });
+}
+flurry_status flurry_group_set_space(flurry_group* g, flurry_space space) {
+  return guard([&] {
+    need(g, "group");
+    if (space != FLURRY_SPACE_WORLD && space != FLURRY_SPACE_LOCAL)
+      throw flurry::InvalidArgument("space", "not a flurry_space");
+    group(g).setSpace(space == FLURRY_SPACE_LOCAL ? flurry::Space::Local : flurry::Space::World);
+  });
+}
+flurry_status flurry_group_space(const flurry_group* g, flurry_space* space) {
+  return guard([&] {
+    need(g, "group");
+    need(space, "space");
+    *space = group(g).space() == flurry::Space::Local ? FLURRY_SPACE_LOCAL : FLURRY_SPACE_WORLD;
+  });
+}
+flurry_status flurry_context_prewarm(flurry_context* ctx, flurry_group* const* groups, size_t count,
+                                     double seconds, uint64_t* steps) {
+  return guard([&] {
+    need(ctx, "ctx");
+    if (count > 0) need(groups, "groups");
+    std::vector<flurry::Group*> gs;
+    for (size_t i = 0; i < count; ++i) {
+      need(groups[i], "groups[i]");
+      gs.push_back(&group(groups[i]));
+    }
+    const std::uint64_t n = ctx->ctx.prewarm(gs, seconds);
+    if (steps) *steps = n;
+  });
+}
 flurry_status flurry_group_size(const flurry_group* g, size_t* size) {
   return guard([&] {
     need(g, "group");

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -60,6 +61,15 @@ class Context {
   void run(std::size_t steps) {
     for (std::size_t i = 0; i < steps; ++i) step();
   }
+
+  /// Starts `groups` (an effect instance's: EffectInstance::prewarm) as if they had been
+  /// created `seconds` earlier and stepped with the context since: they alone take the fewest
+  /// whole steps of timeStep() that cover `seconds`, nothing is drawn or read back, and the
+  /// context's clock does not move. They then stay those steps ahead of it (their step index
+  /// and time are the context's plus these), so they go on as they would have: the particles
+  /// are bitwise those of stepping them by hand from the start. Returns the steps taken.
+  /// Throws InvalidArgument "seconds" (negative, not finite) or "groups" (not this context's).
+  std::uint64_t prewarm(std::span<Group* const> groups, double seconds);
 
   double time() const;
   std::uint64_t stepIndex() const;

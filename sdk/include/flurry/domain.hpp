@@ -17,6 +17,7 @@
 
 #include "flurry/math.hpp"
 #include "flurry/random.hpp"
+#include "flurry/transform.hpp"
 
 namespace flurry {
 
@@ -137,6 +138,10 @@ class Domain {
   double measure() const;
   /// True for the shapes with a two-sided planar surface: plane, rectangle, disc, triangle.
   bool isPlanar() const;
+  /// The domain carried by `t`: its points through t.point, its normals and axes rotated,
+  /// its lengths (radii, edges) scaled. A box stays axis-aligned: it turns only by quarter
+  /// turns (throws InvalidArgument "transform.rotation" for another rotation).
+  Domain transformed(const Transform& t) const;
   /// "sphere", "box", ...: used in error messages and effect files.
   const char* name() const;
 

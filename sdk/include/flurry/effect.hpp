@@ -59,6 +59,8 @@ struct EffectGroup {
   AttributeSet require;
 };
 
+class EffectInstance;
+
 /// A loaded effect file.
 struct Effect {
   std::string name;
@@ -66,6 +68,8 @@ struct Effect {
   double dt = 1.0 / 30.0;   ///< seconds per step
   std::uint64_t seed = 1;
   int frames = 300;  ///< steps `flurry run` takes by default
+  /// Where its particles live when an instance moves (`"space": "world"` or `"local"`).
+  Space space = Space::World;
   std::vector<EffectGroup> groups;
   /// The `render` object as JSON text ("{}" when absent); the core does not read it, a
   /// renderer parses it (docs/rendering.md).
@@ -86,6 +90,34 @@ struct Effect {
   /// naming the group.
   std::vector<Group*> build(Context& ctx, std::size_t maxCapacity = 0,
                             std::string_view instance = {}) const;
+  /// build() as an instance a game places, moves and prewarms: see EffectInstance.
+  EffectInstance instantiate(Context& ctx, std::string_view instance,
+                             std::size_t maxCapacity = 0) const;
+};
+
+/// One effect built into a Context (Effect::instantiate): its groups, placed together. A
+/// handle: copies refer to the same groups, which belong to the context.
+class EffectInstance {
+ public:
+  EffectInstance() = default;
+  const std::vector<Group*>& groups() const { return groups_; }
+  /// Places every group of the instance, at any time between steps (Group::setTransform: the
+  /// emitters and the action lists' geometry follow; in Space::Local the live particles too).
+  /// All or nothing: throws InvalidArgument naming the field and leaves the instance where it
+  /// was.
+  EffectInstance& setTransform(const Transform& transform);
+  const Transform& transform() const { return transform_; }
+  /// Starts the instance as if it had run `seconds` already (Context::prewarm of its groups):
+  /// call it before the instance's first step. Returns the steps taken.
+  std::uint64_t prewarm(double seconds);
+  /// Destroys its groups (Context::destroyGroup); the handle is empty after.
+  void destroy();
+
+ private:
+  friend struct Effect;
+  Context* context_ = nullptr;
+  std::vector<Group*> groups_;
+  Transform transform_;
 };
 
 /// Reads a sampled vector field kept outside the effect file (`{"vdb": "file.vdb", "grid":

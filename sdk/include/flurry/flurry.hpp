@@ -16,4 +16,5 @@
 #include "flurry/math.hpp"
 #include "flurry/random.hpp"
 #include "flurry/strands.hpp"
+#include "flurry/transform.hpp"
 #include "flurry/version.hpp"

@@ -12,6 +12,7 @@
 #include "flurry/attribute.hpp"
 #include "flurry/emitter.hpp"
 #include "flurry/strands.hpp"
+#include "flurry/transform.hpp"
 
 namespace flurry {
 
@@ -114,10 +115,29 @@ class Group {
   void require(AttributeSet attributes);
 
   Group& setActions(ActionList actions);
+  /// The action list as given (in the group's frame once it has a transform).
   const ActionList& actions() const;
+
+  /// Places the group in the world, at any time between steps (an effect instance's groups
+  /// together: EffectInstance::setTransform). From the first call on, the emitters and the
+  /// action list are in the group's own frame: what they say is carried by the transform
+  /// (see Transform for what follows it) into the world, where the particles are simulated.
+  /// In Space::Local the live particles are carried from the old transform to the new one
+  /// (on a device backend that reads them back and uploads them once). The identity runs
+  /// bitwise as a group never placed. Throws InvalidArgument naming the field
+  /// ("transform.scale", ...) for a transform that is not finite, a scale <= 0, or a rotation
+  /// that is not a unit quaternion, and "transform.rotation" for a box domain in the effect
+  /// under a rotation other than quarter turns; the group is then left as it was.
+  Group& setTransform(const Transform& transform);
+  const Transform& transform() const;
+  /// World (the default) or Local: see Space. Set it before the particles move.
+  Group& setSpace(Space space);
+  Space space() const;
 
   /// Adds an emitter (validated: throws InvalidArgument naming the bad field).
   Emitter& addEmitter(Emitter emitter);
+  /// The emitters as given (in the group's frame once it has a transform); edits through the
+  /// span take effect at the next step.
   std::span<Emitter> emitters();
   /// Removes emitter i (0 <= i < emitters().size(); throws InvalidArgument "index"): it emits
   /// no more, and the emitters after it move down by one.

@@ -913,6 +913,11 @@ Effect readEffect(const json& j, const Loader& L, const std::string& defaultName
   o.opt("seed", fx.seed);
   if (const json* v = o.get("frames"))
     fx.frames = int(readInteger(*v, o.at("frames"), L, 1, 100'000'000));
+  if (const json* v = o.get("space")) {
+    if (!v->is_string() || (*v != "world" && *v != "local"))
+      L.fail(o.at("space"), "expected \"world\" or \"local\"");
+    fx.space = *v == "local" ? Space::Local : Space::World;
+  }
   const json& gs = o.require("groups", "an array of groups");
   arrayOf(gs, "groups", L, 0, "an array of groups");
   if (gs.empty()) L.fail("groups", "an effect needs at least one group");
@@ -960,6 +965,7 @@ std::vector<Group*> Effect::build(Context& ctx, std::size_t maxCapacity,
       g.setActions(eg.actions);
       if (eg.hair.enabled) g.setHair(eg.hair);
       g.require(eg.require);
+      if (space == Space::Local) g.setSpace(Space::Local);
       for (std::size_t k = 0; k < eg.emitters.size(); ++k) g.addEmitter(eg.emitters[k]);
       for (std::size_t k = 0; k < eg.primeEmitters.size(); ++k)
         g.addPrimeEmitter(eg.primeEmitters[k]);
@@ -971,6 +977,39 @@ std::vector<Group*> Effect::build(Context& ctx, std::size_t maxCapacity,
     }
   }
   return made;
+}
+
+EffectInstance Effect::instantiate(Context& ctx, std::string_view instance,
+                                   std::size_t maxCapacity) const {
+  EffectInstance fx;
+  fx.groups_ = build(ctx, maxCapacity, instance);
+  fx.context_ = &ctx;
+  return fx;
+}
+
+EffectInstance& EffectInstance::setTransform(const Transform& transform) {
+  // All or nothing: a group that refuses it (a box turned by other than quarter turns) puts
+  // back the ones already moved.
+  const Transform before = this->transform();
+  std::size_t moved = 0;
+  try {
+    for (; moved < groups_.size(); ++moved) groups_[moved]->setTransform(transform);
+  } catch (...) {
+    for (std::size_t k = 0; k < moved; ++k) groups_[k]->setTransform(before);
+    throw;
+  }
+  transform_ = groups_.empty() ? transform : groups_.front()->transform();
+  return *this;
+}
+
+std::uint64_t EffectInstance::prewarm(double seconds) {
+  if (!context_) throw Error("prewarm: an empty EffectInstance (use Effect::instantiate)");
+  return context_->prewarm(groups_, seconds);
+}
+
+void EffectInstance::destroy() {
+  for (Group* g : groups_) context_->destroyGroup(*g);
+  groups_.clear();
 }
 
 namespace {
@@ -1196,6 +1235,7 @@ std::string saveEffect(const Effect& fx) {
   o["dt"] = write(w, fx.dt);
   o["seed"] = fx.seed;
   o["frames"] = fx.frames;
+  if (fx.space == Space::Local) o["space"] = "local";
   ojson groups = ojson::array();
   for (std::size_t i = 0; i < fx.groups.size(); ++i)
     groups.push_back(writeGroup(w, fx.groups[i], index("groups", i)));

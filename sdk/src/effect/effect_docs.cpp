@@ -276,6 +276,7 @@ std::string effectSchema() {
         {"dt", {{"type", "number"}, {"exclusiveMinimum", 0}, {"maximum", 10}}},
         {"seed", {{"type", "integer"}, {"minimum", 0}}},
         {"frames", {{"type", "integer"}, {"minimum", 1}}},
+        {"space", {{"enum", {"world", "local"}}}},
         {"groups", {{"type", "array"}, {"minItems", 1}, {"items", defRef("group")}}},
         {"render", {{"type", "object"}, {"description", "docs/rendering.md"}}},
         {"$comment", comment}}},
@@ -421,13 +422,15 @@ std::string effectReference() {
 std::string fuzzDictionary() {
   std::set<std::string> keys = {
       // the effect, groups, fuzzy values, sampled fields: no descriptors yet
-      "version", "name",       "description", "dt",           "seed",          "frames",
-      "groups",  "render",     "capacity",    "emitters",     "primeEmitters", "actions",
-      "mode2d",  "integrator", "substeps",    "maxStep",      "maxDistance",   "maxSubsteps",
-      "hair",    "enabled",    "every",       "maxVertices",  "require",       "type",
-      "center",  "spread",     "percent",     "distribution", "origin",        "voxelSize",
-      "dims",    "data",       "vdb",         "grid",         "normal",        "point"};
-  std::set<std::string> values = {"uniform", "normal", "inf", "-inf", "true", "false", "null"};
+      "version",     "name",   "description", "dt",       "seed",         "frames",
+      "space",       "groups", "render",      "capacity", "emitters",     "primeEmitters",
+      "actions",     "mode2d", "integrator",  "substeps", "maxStep",      "maxDistance",
+      "maxSubsteps", "hair",   "enabled",     "every",    "maxVertices",  "require",
+      "type",        "center", "spread",      "percent",  "distribution", "origin",
+      "voxelSize",   "dims",   "data",        "vdb",      "grid",         "normal",
+      "point"};
+  std::set<std::string> values = {"world", "local", "uniform", "normal", "inf",
+                                  "-inf",  "true",  "false",   "null"};
   for (const DomainKind& k : domainKinds()) {
     values.insert(k.name);
     for (const auto& [key, def] : k.fields) keys.insert(key);
