@@ -7,8 +7,7 @@
  * generator and packer (sdk/src/opencl/actions_*.cpp). */
 
 FL_INLINE void fl_kill_old(float age, float life, uint code, uint* dead) {
-  const uint k = age > life ? code : 0u;
-  *dead = *dead != 0u ? *dead : k;
+  *dead = fl_dead_old(age, life, code, *dead); /* absorb.h */
 }
 
 FL_INLINE void fl_move(float dt, float* px, float* py, float* pz, float vx, float vy, float vz) {

@@ -12,14 +12,11 @@
  * power. */
 #define FL_FALLOFF 27
 
-/* actions_more.hpp falloffWeight: (1 - r/radius)^power inside the radius, 0 outside, 1 for
- * an infinite radius. */
+/* The falloff's weight (forces.h). */
 FL_INLINE float fl_force_falloff(__global const FlActionParams* a, float px, float py, float pz) {
   __global const float* f = a->f + FL_FALLOFF;
-  if (!(f[3] < INFINITY)) return 1.0f;
-  const float dx = px - f[0], dy = py - f[1], dz = pz - f[2];
-  const float t = fl_maxf(0.0f, 1.0f - sqrt(dx * dx + dy * dy + dz * dz) / f[3]);
-  return f[4] == 1.0f ? t : pow(t, f[4]);
+  const FlFalloff w = {f[0], f[1], f[2], f[3], f[4]};
+  return fl_falloff_weight(w, px, py, pz);
 }
 
 /* exp(-rate * dt): the host's value (std::exp, as the CPU's) for the step length it packed,
@@ -28,32 +25,9 @@ FL_INLINE float fl_force_decay(float rate, float dt, float packedDt, float packe
   return dt == packedDt ? packed : exp(-rate * dt);
 }
 
-/* actions_more.hpp approach(): the fraction of the way an exponential approach covers. */
+/* fl_approach (forces.h), with the host's exp for the packed step length. */
 FL_INLINE float fl_force_approach(float rate, float dt, float packedDt, float packed) {
-  return 1.0f - fl_force_decay(rate, dt, packedDt, packed);
-}
-
-/* actions_more.hpp softPull: magnitude * d / (|d|^2 + eps)^(3/2), zero beyond maxR and at
- * the centre (where s sqrt(s) underflows to 0 for a tiny eps: 0 inf would be NaN). */
-FL_INLINE void fl_force_soft_pull(float dx, float dy, float dz, float magnitude, float eps,
-                                  float maxR, float* ox, float* oy, float* oz) {
-  const float r2 = dx * dx + dy * dy + dz * dz;
-  if (!(r2 <= maxR * maxR) || !(r2 > 0.0f)) {
-    *ox = 0.0f;
-    *oy = 0.0f;
-    *oz = 0.0f;
-    return;
-  }
-  const float s = r2 + eps;
-  const float k = magnitude / (s * sqrt(s));
-  *ox = dx * k;
-  *oy = dy * k;
-  *oz = dz * k;
-}
-
-/* actions_more.hpp chargePerMass: a particle of zero (or negative) mass feels no field. */
-FL_INLINE float fl_force_charge_per_mass(float charge, float mass) {
-  return mass > 0.0f ? charge / mass : 0.0f;
+  return dt == packedDt ? 1.0f - packed : fl_approach(rate, dt);
 }
 
 /* ---- Gravity: f[0..2] acceleration --------------------------------------------------- */
@@ -67,10 +41,7 @@ FL_INLINE void fl_gravity(__global const FlActionParams* a, float dt, float* vx,
 
 FL_INLINE void fl_gravity_falloff(__global const FlActionParams* a, float dt, float px, float py,
                                   float pz, float* vx, float* vy, float* vz) {
-  const float s = dt * fl_force_falloff(a, px, py, pz);
-  *vx = *vx + a->f[0] * s;
-  *vy = *vy + a->f[1] * s;
-  *vz = *vz + a->f[2] * s;
+  fl_add_scaled(a->f[0], a->f[1], a->f[2], dt * fl_force_falloff(a, px, py, pz), vx, vy, vz);
 }
 
 FL_INLINE void fl_gravity_acc(__global const FlActionParams* a, float px, float py, float pz,
@@ -92,113 +63,78 @@ FL_INLINE void fl_damping(__global const FlActionParams* a, float dt, float* vx,
 
 FL_INLINE void fl_damping_falloff(__global const FlActionParams* a, float dt, float px, float py,
                                   float pz, float* vx, float* vy, float* vz) {
-  const float w = fl_force_falloff(a, px, py, pz);
-  *vx = *vx * exp(-a->f[3] * dt * w);
-  *vy = *vy * exp(-a->f[4] * dt * w);
-  *vz = *vz * exp(-a->f[5] * dt * w);
+  fl_damping_step(a->f[3], a->f[4], a->f[5], dt, fl_force_falloff(a, px, py, pz), vx, vy, vz);
 }
 
 FL_INLINE void fl_damping_acc(__global const FlActionParams* a, float px, float py, float pz,
                               float vx, float vy, float vz, float* ax, float* ay, float* az) {
-  const float w = fl_force_falloff(a, px, py, pz);
-  *ax += -a->f[3] * vx * w;
-  *ay += -a->f[4] * vy * w;
-  *az += -a->f[5] * vz * w;
+  fl_damping_accel(a->f[3], a->f[4], a->f[5], fl_force_falloff(a, px, py, pz), vx, vy, vz, ax,
+                   ay, az);
 }
 
 /* ---- OrbitPoint: f[0..2] center, [3] magnitude, [4] epsilon, [5] maxRadius ------------- */
 
+FL_INLINE void fl_orbit_point_pull(__global const FlActionParams* a, float px, float py,
+                                   float pz, float* x, float* y, float* z) {
+  fl_soft_pull(a->f[0] - px, a->f[1] - py, a->f[2] - pz, a->f[3], a->f[4], a->f[5] * a->f[5], x,
+               y, z);
+}
+
 FL_INLINE void fl_orbit_point_acc(__global const FlActionParams* a, float px, float py, float pz,
                                   float* ax, float* ay, float* az) {
   float x, y, z;
-  fl_force_soft_pull(a->f[0] - px, a->f[1] - py, a->f[2] - pz, a->f[3], a->f[4], a->f[5], &x, &y,
-                     &z);
-  *ax += x;
-  *ay += y;
-  *az += z;
+  fl_orbit_point_pull(a, px, py, pz, &x, &y, &z);
+  fl_add_scaled(x, y, z, 1.0f, ax, ay, az);
 }
 
 FL_INLINE void fl_orbit_point(__global const FlActionParams* a, float dt, float px, float py,
                               float pz, float* vx, float* vy, float* vz) {
   float x, y, z;
-  fl_force_soft_pull(a->f[0] - px, a->f[1] - py, a->f[2] - pz, a->f[3], a->f[4], a->f[5], &x, &y,
-                     &z);
-  *vx = *vx + x * dt;
-  *vy = *vy + y * dt;
-  *vz = *vz + z * dt;
+  fl_orbit_point_pull(a, px, py, pz, &x, &y, &z);
+  fl_add_scaled(x, y, z, dt, vx, vy, vz);
 }
 
 /* ---- OrbitLine: f[0..2] point, [3..5] unit axis, [6] magnitude, [7] eps, [8] maxRadius -- */
 
-FL_INLINE void fl_orbit_line_pull(__global const FlActionParams* a, float px, float py, float pz,
-                                  float* x, float* y, float* z) {
-  const float ux = a->f[3], uy = a->f[4], uz = a->f[5];
-  const float wx = px - a->f[0], wy = py - a->f[1], wz = pz - a->f[2];
-  const float d = wx * ux + wy * uy + wz * uz;
-  /* towards the nearest point of the line */
-  fl_force_soft_pull(-(wx - ux * d), -(wy - uy * d), -(wz - uz * d), a->f[6], a->f[7], a->f[8], x,
-                     y, z);
+FL_INLINE void fl_orbit_line_of(__global const FlActionParams* a, float px, float py, float pz,
+                                float* x, float* y, float* z) {
+  fl_orbit_line_pull(a->f[0], a->f[1], a->f[2], a->f[3], a->f[4], a->f[5], a->f[6], a->f[7],
+                     a->f[8] * a->f[8], px, py, pz, x, y, z);
 }
 
 FL_INLINE void fl_orbit_line(__global const FlActionParams* a, float dt, float px, float py,
                              float pz, float* vx, float* vy, float* vz) {
   float x, y, z;
-  fl_orbit_line_pull(a, px, py, pz, &x, &y, &z);
-  *vx = *vx + x * dt;
-  *vy = *vy + y * dt;
-  *vz = *vz + z * dt;
+  fl_orbit_line_of(a, px, py, pz, &x, &y, &z);
+  fl_add_scaled(x, y, z, dt, vx, vy, vz);
 }
 
 FL_INLINE void fl_orbit_line_acc(__global const FlActionParams* a, float px, float py, float pz,
                                  float* ax, float* ay, float* az) {
   float x, y, z;
-  fl_orbit_line_pull(a, px, py, pz, &x, &y, &z);
-  *ax += x;
-  *ay += y;
-  *az += z;
+  fl_orbit_line_of(a, px, py, pz, &x, &y, &z);
+  fl_add_scaled(x, y, z, 1.0f, ax, ay, az);
 }
 
 /* ---- Vortex: f[0..2] center, [3..5] unit axis, [6] aroundSpeed, [7] coreRadius,
  * [8] tightness, [9] inSpeed, [10] upSpeed, [11] responsiveness, [12] maxRadius,
  * [13] packed dt, [14] exp(-responsiveness * dt) ------------------------------------------ */
 
-/* The vortex's velocity field at p into u; 0 beyond maxRadius (the particle is left alone). */
-FL_INLINE int fl_vortex_u(__global const FlActionParams* a, float px, float py, float pz, float* ux,
-                          float* uy, float* uz) {
-  const float kx = a->f[3], ky = a->f[4], kz = a->f[5];
-  const float wx = px - a->f[0], wy = py - a->f[1], wz = pz - a->f[2];
-  const float d = wx * kx + wy * ky + wz * kz;
-  const float rx = wx - kx * d, ry = wy - ky * d, rz = wz - kz * d;
-  const float r = sqrt(rx * rx + ry * ry + rz * rz);
-  if (!(r <= a->f[12])) return 0;
-  /* On the axis there is no radial direction: no swirl, no inflow. */
-  const float hx = r > 0.0f ? rx / r : 0.0f, hy = r > 0.0f ? ry / r : 0.0f,
-              hz = r > 0.0f ? rz / r : 0.0f;
-  const float around = r < a->f[7] ? a->f[6] * r / a->f[7] : a->f[6] * pow(a->f[7] / r, a->f[8]);
-  const float in = a->f[9], up = a->f[10];
-  *ux = (ky * hz - hy * kz) * around - hx * in + kx * up;
-  *uy = (kz * hx - hz * kx) * around - hy * in + ky * up;
-  *uz = (kx * hy - hx * ky) * around - hz * in + kz * up;
-  return 1;
+FL_INLINE FlVortex fl_vortex_of(__global const FlActionParams* a) {
+  const FlVortex v = {a->f[0], a->f[1], a->f[2], a->f[3], a->f[4],  a->f[5],
+                      a->f[6], a->f[7], a->f[8], a->f[9], a->f[10], a->f[12]};
+  return v;
 }
 
 FL_INLINE void fl_vortex(__global const FlActionParams* a, float dt, float px, float py, float pz,
                          float* vx, float* vy, float* vz) {
-  const float k = fl_force_approach(a->f[11], dt, a->f[13], a->f[14]);
-  float ux, uy, uz;
-  if (!fl_vortex_u(a, px, py, pz, &ux, &uy, &uz)) return;
-  *vx = *vx + (ux - *vx) * k;
-  *vy = *vy + (uy - *vy) * k;
-  *vz = *vz + (uz - *vz) * k;
+  fl_vortex_step(fl_vortex_of(a), fl_force_approach(a->f[11], dt, a->f[13], a->f[14]), px, py, pz,
+                 vx, vy, vz);
 }
 
 FL_INLINE void fl_vortex_acc(__global const FlActionParams* a, float px, float py, float pz,
                              float vx, float vy, float vz, float* ax, float* ay, float* az) {
-  float ux, uy, uz;
-  if (!fl_vortex_u(a, px, py, pz, &ux, &uy, &uz)) return;
-  *ax += (ux - vx) * a->f[11];
-  *ay += (uy - vy) * a->f[11];
-  *az += (uz - vz) * a->f[11];
+  fl_vortex_accel(fl_vortex_of(a), a->f[11], px, py, pz, vx, vy, vz, ax, ay, az);
 }
 
 /* ---- Jet: f[0..2] center, [3] radius; domain: the acceleration (kind a literal; a mesh's
@@ -207,8 +143,7 @@ FL_INLINE void fl_vortex_acc(__global const FlActionParams* a, float px, float p
 FL_INLINE int fl_jet_accel(__global const FlActionParams* a, uint kind, float px, float py,
                            float pz, uint id, uint seedLo, uint seedHi, uint step, uint stream,
                            float3* acc, __global const float* shapes) {
-  const float dx = px - a->f[0], dy = py - a->f[1], dz = pz - a->f[2];
-  if (!(dx * dx + dy * dy + dz * dz <= a->f[3] * a->f[3])) return 0;
+  if (!fl_in_ball(a->f[0], a->f[1], a->f[2], a->f[3], px, py, pz)) return 0;
   FlRandom rng = fl_random(seedLo, seedHi, id, step, stream);
   /* a point domain: its point, no draw */
   *acc = fl_sample_any(&a->domain, kind, &rng, shapes);
@@ -243,28 +178,16 @@ FL_INLINE void fl_explosion(__global const FlActionParams* a, float dt, fl_real 
   const fl_real t = time + (fl_real)0.5 * (fl_real)dt; /* the front's radius at mid-step */
   if (t < (fl_real)a->f[7]) return;
   const float front = a->f[3] * (float)(t - (fl_real)a->f[7]);
-  const float dx = px - a->f[0], dy = py - a->f[1], dz = pz - a->f[2];
-  const float r = sqrt(dx * dx + dy * dy + dz * dz);
-  if (!(r > 0.0f)) return;
-  const float delta = r - front;
-  const float mag = a->f[4] * exp(-delta * delta * a->f[5]) / (r * r + a->f[6]);
-  const float s = mag / r * dt;
-  *vx = *vx + dx * s;
-  *vy = *vy + dy * s;
-  *vz = *vz + dz * s;
+  fl_explosion_step(a->f[0], a->f[1], a->f[2], a->f[4], a->f[5], a->f[6], front, dt, px, py, pz,
+                    vx, vy, vz);
 }
 
 FL_INLINE void fl_explosion_acc(__global const FlActionParams* a, fl_real t, float px, float py,
                                 float pz, float* ax, float* ay, float* az) {
   if (!(t >= (fl_real)a->f[7])) return;
-  const float dx = px - a->f[0], dy = py - a->f[1], dz = pz - a->f[2];
-  const float r = sqrt(dx * dx + dy * dy + dz * dz);
-  if (!(r > 0.0f)) return;
-  const float delta = r - a->f[3] * (float)(t - (fl_real)a->f[7]);
-  const float s = a->f[4] * exp(-delta * delta / a->f[8]) / (r * r + a->f[6]) / r;
-  *ax += dx * s;
-  *ay += dy * s;
-  *az += dz * s;
+  const float front = a->f[3] * (float)(t - (fl_real)a->f[7]);
+  fl_explosion_accel(a->f[0], a->f[1], a->f[2], a->f[4], a->f[8], a->f[6], front, px, py, pz, ax,
+                     ay, az);
 }
 
 /* ---- Random actions: domain, the draw (kind a literal; a mesh's or union's data in
@@ -352,15 +275,12 @@ FL_INLINE void fl_turbulence_acc(__global const FlActionParams* a, fl_real t, fl
 FL_INLINE void fl_electric(__global const FlActionParams* a, float dt, float px, float py, float pz,
                            float* vx, float* vy, float* vz, float charge, float mass) {
   const float w = fl_force_falloff(a, px, py, pz);
-  const float s = fl_force_charge_per_mass(charge, mass) * dt * w;
-  *vx = *vx + a->f[0] * s;
-  *vy = *vy + a->f[1] * s;
-  *vz = *vz + a->f[2] * s;
+  fl_add_scaled(a->f[0], a->f[1], a->f[2], fl_charge_per_mass(charge, mass) * dt * w, vx, vy, vz);
 }
 
 FL_INLINE void fl_electric_acc(__global const FlActionParams* a, float px, float py, float pz,
                                float charge, float mass, float* ax, float* ay, float* az) {
-  const float q = fl_force_charge_per_mass(charge, mass);
+  const float q = fl_charge_per_mass(charge, mass);
   const float w = fl_force_falloff(a, px, py, pz);
   *ax += a->f[0] * q * w;
   *ay += a->f[1] * q * w;
@@ -375,26 +295,16 @@ FL_INLINE void fl_magnetic(__global const FlActionParams* a, float dt, float px,
                            float* vx, float* vy, float* vz, float charge, float mass) {
   const float B = a->f[3];
   if (!(B > 0.0f)) return;
-  const fl_real theta = -(fl_real)fl_force_charge_per_mass(charge, mass) * (fl_real)B *
+  const fl_real theta = -(fl_real)fl_charge_per_mass(charge, mass) * (fl_real)B *
                         (fl_real)dt * (fl_real)fl_force_falloff(a, px, py, pz);
-  const fl_real ct = cos(theta), st = sin(theta);
-  const fl_real x = *vx, y = *vy, z = *vz;
-  const fl_real kx = a->f[0], ky = a->f[1], kz = a->f[2];
-  const fl_real d = (kx * x + ky * y + kz * z) * ((fl_real)1.0 - ct);
-  *vx = (float)(x * ct + (ky * z - y * kz) * st + kx * d);
-  *vy = (float)(y * ct + (kz * x - z * kx) * st + ky * d);
-  *vz = (float)(z * ct + (kx * y - x * ky) * st + kz * d);
+  fl_magnetic_turn(a->f[0], a->f[1], a->f[2], theta, vx, vy, vz);
 }
 
 FL_INLINE void fl_magnetic_acc(__global const FlActionParams* a, float px, float py, float pz,
                                float vx, float vy, float vz, float charge, float mass, float* ax,
                                float* ay, float* az) {
-  const float Bx = a->f[4], By = a->f[5], Bz = a->f[6];
-  const float q = fl_force_charge_per_mass(charge, mass);
-  const float w = fl_force_falloff(a, px, py, pz);
-  *ax += (vy * Bz - By * vz) * q * w;
-  *ay += (vz * Bx - Bz * vx) * q * w;
-  *az += (vx * By - Bx * vy) * q * w;
+  fl_magnetic_accel(a->f[4], a->f[5], a->f[6], fl_charge_per_mass(charge, mass),
+                    fl_force_falloff(a, px, py, pz), vx, vy, vz, ax, ay, az);
 }
 
 /* ---- SampledField: f[0..2] grid origin, [3] voxel size, [4] strength,
@@ -402,18 +312,14 @@ FL_INLINE void fl_magnetic_acc(__global const FlActionParams* a, float px, float
  * float in extra (xyz per sample, x fastest), u[1..3] dims, u[4] 1 for Mode::Velocity;
  * falloff ---------------------------------------------------------------------------------- */
 
-FL_INLINE float fl_force_clamp(float v, float lo, float hi) { /* std::clamp's rule */
-  return v < lo ? lo : hi < v ? hi : v;
-}
-
 /* field.hpp VectorField::sample: trilinear, positions outside take the border's value. */
 FL_INLINE float3 fl_field_sample(__global const FlActionParams* a, __global const float* extra,
                                  float px, float py, float pz) {
   const int nx = (int)a->u[1], ny = (int)a->u[2], nz = (int)a->u[3];
   const float vs = a->f[3];
-  const float fx = fl_force_clamp((px - a->f[0]) / vs, 0.0f, (float)(nx - 1));
-  const float fy = fl_force_clamp((py - a->f[1]) / vs, 0.0f, (float)(ny - 1));
-  const float fz = fl_force_clamp((pz - a->f[2]) / vs, 0.0f, (float)(nz - 1));
+  const float fx = fl_clampf((px - a->f[0]) / vs, 0.0f, (float)(nx - 1));
+  const float fy = fl_clampf((py - a->f[1]) / vs, 0.0f, (float)(ny - 1));
+  const float fz = fl_clampf((pz - a->f[2]) / vs, 0.0f, (float)(nz - 1));
   const int x0 = min((int)fx, nx - 1), y0 = min((int)fy, ny - 1), z0 = min((int)fz, nz - 1);
   const int x1 = min(x0 + 1, nx - 1), y1 = min(y0 + 1, ny - 1), z1 = min(z0 + 1, nz - 1);
   const float tx = fx - (float)x0, ty = fy - (float)y0, tz = fz - (float)z0;
@@ -468,48 +374,32 @@ FL_INLINE float fl_target_k(__global const FlActionParams* a, float dt) {
 FL_INLINE void fl_target3(__global const FlActionParams* a, float dt, float* x, float* y,
                           float* z) {
   const float k = fl_target_k(a, dt);
-  *x += (a->f[0] - *x) * k;
-  *y += (a->f[1] - *y) * k;
-  *z += (a->f[2] - *z) * k;
+  *x = fl_toward(*x, a->f[0], k);
+  *y = fl_toward(*y, a->f[1], k);
+  *z = fl_toward(*z, a->f[2], k);
 }
 
 FL_INLINE void fl_target_color(__global const FlActionParams* a, float dt, float* r, float* g,
                                float* b, float* al) {
   const float k = fl_target_k(a, dt);
-  *r += (a->f[0] - *r) * k;
-  *g += (a->f[1] - *g) * k;
-  *b += (a->f[2] - *b) * k;
-  *al += (a->f[3] - *al) * k;
+  *r = fl_toward(*r, a->f[0], k);
+  *g = fl_toward(*g, a->f[1], k);
+  *b = fl_toward(*b, a->f[2], k);
+  *al = fl_toward(*al, a->f[3], k);
 }
 
 FL_INLINE void fl_target_size(__global const FlActionParams* a, float dt, float* size) {
-  *size += (a->f[0] - *size) * fl_target_k(a, dt);
+  *size = fl_toward(*size, a->f[0], fl_target_k(a, dt));
 }
 
 /* ---- SpeedClamp: f[0] minSpeed, [1] maxSpeed ------------------------------------------- */
 
 FL_INLINE void fl_speed_clamp(__global const FlActionParams* a, float* vx, float* vy, float* vz) {
-  const float x = *vx, y = *vy, z = *vz;
-  const float s = sqrt(x * x + y * y + z * z);
-  float k;
-  if (s > a->f[1])
-    k = a->f[1] / s;
-  else if (s < a->f[0] && s > 0.0f)
-    k = a->f[0] / s;
-  else
-    return;
-  *vx = x * k;
-  *vy = y * k;
-  *vz = z * k;
+  fl_clamp_speed(a->f[0], a->f[1], vx, vy, vz);
 }
 
 /* ---- Curves over life: u[0] the first key's float in extra, u[1] keys; a key is t then
  * its value (ColorOverLife: r g b a, SizeOverLife: size) ---------------------------------- */
-
-/* actions_more.hpp lifeFraction. */
-FL_INLINE float fl_force_life_fraction(float age, float life) {
-  return life > 0.0f ? fl_force_clamp(age / life, 0.0f, 1.0f) : 1.0f;
-}
 
 /* actions_more.hpp lookup(): keys of `stride` floats (t, then stride - 1 values) into out. */
 FL_INLINE void fl_force_lookup(__global const float* keys, uint count, uint stride, float t,
@@ -522,9 +412,7 @@ FL_INLINE void fl_force_lookup(__global const float* keys, uint count, uint stri
     hi = count; /* past the last key: its value */
     for (uint k = 1; k < count; ++k) {
       if (t <= keys[k * stride]) {
-        const float t0 = keys[(k - 1) * stride];
-        const float span = keys[k * stride] - t0;
-        w = span > 0.0f ? (t - t0) / span : 1.0f;
+        w = fl_key_weight(keys[(k - 1) * stride], keys[k * stride], t);
         hi = k;
         break;
       }
@@ -543,7 +431,7 @@ FL_INLINE void fl_force_lookup(__global const float* keys, uint count, uint stri
 FL_INLINE void fl_color_over_life(__global const FlActionParams* a, __global const float* extra,
                                   float age, float life, float* r, float* g, float* b, float* al) {
   float c[4];
-  fl_force_lookup(extra + a->u[0], a->u[1], 5u, fl_force_life_fraction(age, life), c);
+  fl_force_lookup(extra + a->u[0], a->u[1], 5u, fl_life_fraction(age, life), c);
   *r = c[0];
   *g = c[1];
   *b = c[2];
@@ -553,7 +441,7 @@ FL_INLINE void fl_color_over_life(__global const FlActionParams* a, __global con
 FL_INLINE void fl_size_over_life(__global const FlActionParams* a, __global const float* extra,
                                  float age, float life, float* size) {
   float s[1];
-  fl_force_lookup(extra + a->u[0], a->u[1], 2u, fl_force_life_fraction(age, life), s);
+  fl_force_lookup(extra + a->u[0], a->u[1], 2u, fl_life_fraction(age, life), s);
   *size = s[0];
 }
 
@@ -563,7 +451,7 @@ FL_INLINE void fl_color_over_life_scaled(__global const FlActionParams* a,
                                          float r0, float g0, float b0, float a0, float* r, float* g,
                                          float* b, float* al) {
   float c[4];
-  fl_force_lookup(extra + a->u[0], a->u[1], 5u, fl_force_life_fraction(age, life), c);
+  fl_force_lookup(extra + a->u[0], a->u[1], 5u, fl_life_fraction(age, life), c);
   *r = r0 * c[0];
   *g = g0 * c[1];
   *b = b0 * c[2];
@@ -574,6 +462,6 @@ FL_INLINE void fl_size_over_life_scaled(__global const FlActionParams* a,
                                         __global const float* extra, float age, float life,
                                         float size0, float* size) {
   float s[1];
-  fl_force_lookup(extra + a->u[0], a->u[1], 2u, fl_force_life_fraction(age, life), s);
+  fl_force_lookup(extra + a->u[0], a->u[1], 2u, fl_life_fraction(age, life), s);
   *size = size0 * s[0];
 }

@@ -204,24 +204,20 @@ FL_INLINE void fl_kill(uint code, uint* dead) {
   *dead = *dead != 0u ? *dead : code;
 }
 
-/* Inside or Outside (kernels.hpp sinkLoop). */
+/* Inside or Outside (absorb.h). */
 FL_INLINE void fl_sink(__global const FlActionParams* a, uint kind, int killInside, float x,
                        float y, float z, uint code, uint* dead, __global const float* shapes) {
-  const uint in = fl_inside_any(a->domain.v, kind, x, y, z, shapes) ? 1u : 0u;
-  const uint k = in == (killInside ? 1u : 0u) ? code : 0u;
-  *dead = *dead != 0u ? *dead : k;
+  *dead = fl_dead_sink(fl_inside_any(a->domain.v, kind, x, y, z, shapes), killInside, code, *dead);
 }
 
-/* Enter or Leave in the coming Move (actions_more.hpp sinkMotionLoop). */
+/* Enter or Leave in the coming Move (absorb.h). */
 FL_INLINE void fl_sink_motion(__global const FlActionParams* a, uint kind, int enter, float dt,
                               float x, float y, float z, float vx, float vy, float vz, uint code,
                               uint* dead, __global const float* shapes) {
   const int now = fl_inside_any(a->domain.v, kind, x, y, z, shapes);
   const int next =
       fl_inside_any(a->domain.v, kind, x + vx * dt, y + vy * dt, z + vz * dt, shapes);
-  const int k = enter ? ((!now) & next) : (now & (!next));
-  const uint kk = k ? code : 0u;
-  *dead = *dead != 0u ? *dead : kk;
+  *dead = fl_dead_sink_motion(now, next, enter, code, *dead);
 }
 
 /* Hit: the coming Move crosses the plane piece (actions_more.hpp apply(Sink)). */
@@ -246,7 +242,7 @@ FL_INLINE void fl_sink_pass(__global const FlActionParams* a, uint id, uint code
                             uint seedLo, uint seedHi, uint key) {
   if (*dead != code) return;
   const uint4 w = fl_philox((uint4)(id, key, 0xFFFF0002u, 0u), seedLo, seedHi);
-  if ((float)(w.x >> 8) * (1.0f / 16777216.0f) < a->f[0]) *dead = 0u;
+  if (fl_passes(w.x, a->f[0])) *dead = 0u;
 }
 
 /* Hides the particles inside the region (actions_more.hpp apply(Block)); the list's first
@@ -305,14 +301,11 @@ FL_INLINE void fl_constrain2d(__global const FlActionParams* a, float* px, float
 
 /* ---- Neighbours: the particles as they were at the start of the step (FL_SNAP) ----------- */
 
-/* actions_more.hpp softPull: magnitude d / (|d|^2 + eps)^(3/2), zero beyond maxR and at the
- * centre. f[0]
- * magnitude, f[1] epsilon, f[2] maxR^2. Adds to acc (adding zero changes nothing). */
-FL_INLINE void fl_soft_pull(__global const FlActionParams* a, float3 d, float3* acc) {
-  const float r2 = fl_dotv(d, d);
-  if (!(r2 <= a->f[2]) || !(r2 > 0.0f)) return;
-  const float s = r2 + a->f[1];
-  *acc += d * (a->f[0] / (s * sqrt(s)));
+/* forces.h fl_soft_pull towards d, added to acc. f[0] magnitude, f[1] epsilon, f[2] maxR^2. */
+FL_INLINE void fl_add_soft_pull(__global const FlActionParams* a, float3 d, float3* acc) {
+  float x, y, z;
+  fl_soft_pull(d.x, d.y, d.z, a->f[0], a->f[1], a->f[2], &x, &y, &z);
+  *acc += (float3)(x, y, z);
 }
 
 /* Gravitate's acceleration at p: towards every other particle (integrate.hpp accumulate). */
@@ -322,7 +315,7 @@ FL_INLINE float3 fl_gravitate_acc(__global const FlActionParams* a, __global con
   for (uint j = 0; j < snapN; ++j) {
     if (j == self) continue;
     const float3 q = (float3)(FL_SNAP(0, 0, j), FL_SNAP(0, 1, j), FL_SNAP(0, 2, j));
-    fl_soft_pull(a, q - p, &acc);
+    fl_add_soft_pull(a, q - p, &acc);
   }
   return acc;
 }
@@ -334,7 +327,7 @@ FL_INLINE float3 fl_follow_acc(__global const FlActionParams* a, __global const 
   const uint next = self + 1u;
   if (next >= snapN) return acc;
   const float3 q = (float3)(FL_SNAP(0, 0, next), FL_SNAP(0, 1, next), FL_SNAP(0, 2, next));
-  fl_soft_pull(a, q - p, &acc);
+  fl_add_soft_pull(a, q - p, &acc);
   return acc;
 }
 

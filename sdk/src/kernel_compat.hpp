@@ -21,12 +21,17 @@ inline namespace FLURRY_ISA_NAMESPACE {
 namespace kernel {
 
 using uint = std::uint32_t;
+using fl_real = double;  // the device's too where it has doubles (domain.cl)
 using float3 = Vec3;
 inline float3 make_float3(float x, float y, float z) {
   return Vec3(x, y, z);
 }
+using std::cos;
+using std::exp;
 using std::fabs;
 using std::floor;
+using std::pow;
+using std::sin;
 using std::sqrt;
 
 #include "../../kernels/math.h"

@@ -24,24 +24,36 @@ inline void put(float* const* a, std::size_t i, Vec3 v) {
   a[1][i] = v.y;
   a[2][i] = v.z;
 }
-// (1 - r/radius)^power inside the radius, 0 outside; 1 everywhere for an infinite radius.
+// The per-particle math of the forces and absorbers is kernels/forces.h and absorb.h, shared
+// with the device (kernels.hpp includes them in namespace kernel); these adapt its arguments.
+inline kernel::FlFalloff flFalloff(const Falloff& f) {
+  return {f.center.x, f.center.y, f.center.z, f.radius, f.power};
+}
 inline float falloffWeight(const Falloff& f, Vec3 p) {
-  if (!(f.radius < kInfinity)) return 1.0f;
-  const float t = std::max(0.0f, 1.0f - glm::length(p - f.center) / f.radius);
-  return f.power == 1.0f ? t : std::pow(t, f.power);
+  return kernel::fl_falloff_weight(flFalloff(f), p.x, p.y, p.z);
 }
-// The fraction of the way an exponential approach covers in dt: never more than 1.
 inline float approach(float rate, float dt) {
-  return 1.0f - std::exp(-rate * dt);
+  return kernel::fl_approach(rate, dt);
 }
-// Softened inverse-square pull towards d: magnitude·d / (|d|² + eps)^(3/2), zero beyond maxR
-// and at the centre: there s·√s underflows to 0 for eps below ~1e-26, and 0·inf would be NaN.
-// Elsewhere a pull that overflows stays infinite, and the NaN guard kills the particle.
 inline Vec3 softPull(Vec3 d, float magnitude, float eps, float maxR) {
-  const float r2 = glm::dot(d, d);
-  if (!(r2 <= maxR * maxR) || !(r2 > 0.0f)) return Vec3(0.0f);
-  const float s = r2 + eps;
-  return d * (magnitude / (s * std::sqrt(s)));
+  Vec3 o;
+  kernel::fl_soft_pull(d.x, d.y, d.z, magnitude, eps, maxR * maxR, &o.x, &o.y, &o.z);
+  return o;
+}
+inline kernel::FlVortex flVortex(const Vortex& a) {
+  const Vec3 k = glm::normalize(a.axis);
+  return {a.center.x,    a.center.y,   a.center.z,  k.x,       k.y,       k.z,
+          a.aroundSpeed, a.coreRadius, a.tightness, a.inSpeed, a.upSpeed, a.maxRadius};
+}
+// Calls f(&x, &y, &z) on locals holding lane particle i's vector and stores them back: the
+// shared kernels' pointers into the arrays would hide their __restrict from the vectoriser.
+template <class F>
+inline void onLocals(float* const* lane, std::size_t i, F f) {
+  float x = lane[0][i], y = lane[1][i], z = lane[2][i];
+  f(&x, &y, &z);
+  lane[0][i] = x;
+  lane[1][i] = y;
+  lane[2][i] = z;
 }
 inline void kill(const BlockContext& c, std::size_t i) {
   if (c.dead[i] == 0u) c.dead[i] = c.action + 1;
@@ -115,7 +127,7 @@ inline void addVaryingLoop(float* __restrict vx, float* __restrict vy, float* __
 // x += (target - x)·(1 - exp(-rate·dt[i])): an exponential approach over each particle's step.
 inline void approachOwnLoop(float* __restrict x, std::size_t n, float target, float rate,
                             const float* __restrict h) {
-  for (std::size_t i = 0; i < n; ++i) x[i] += (target - x[i]) * approach(rate, h[i]);
+  for (std::size_t i = 0; i < n; ++i) x[i] = kernel::fl_toward(x[i], target, approach(rate, h[i]));
 }
 }  // namespace
 
@@ -128,12 +140,10 @@ inline void sinkMotionLoop(const Shape& shape, const float* __restrict px,
                            const float* __restrict vz, std::uint32_t* __restrict dead,
                            std::size_t n, Dt dt, std::uint32_t code, bool enter) {
   for (std::size_t i = 0; i < n; ++i) {
-    const bool now = detail::inside(shape, Vec3(px[i], py[i], pz[i]));
-    const bool next = detail::inside(
+    const int now = detail::inside(shape, Vec3(px[i], py[i], pz[i]));
+    const int next = detail::inside(
         shape, Vec3(px[i] + vx[i] * dt[i], py[i] + vy[i] * dt[i], pz[i] + vz[i] * dt[i]));
-    const bool k = enter ? (!now & next) : (now & !next);
-    const std::uint32_t kk = k ? code : 0u;
-    dead[i] = dead[i] != 0u ? dead[i] : kk;
+    dead[i] = kernel::fl_dead_sink_motion(now, next, enter, code, dead[i]);
   }
 }
 
@@ -199,41 +209,38 @@ inline void apply(const Block& a, const Lanes& L, std::size_t n, const BlockCont
 
 // Gravity and Damping with a falloff radius (without one they are the vectorised loops).
 inline void applyWeighted(const Gravity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const Vec3 g = a.acceleration;
   for (std::size_t i = 0; i < n; ++i)
-    put(L.v, i, at(L.v, i) + a.acceleration * (c.dtAt(i) * falloffWeight(a.falloff, at(L.p, i))));
+    onLocals(L.v, i, [&](float* x, float* y, float* z) {
+      kernel::fl_add_scaled(g.x, g.y, g.z, c.dtAt(i) * falloffWeight(a.falloff, at(L.p, i)), x, y,
+                            z);
+    });
 }
 
 inline void applyWeighted(const Damping& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  for (std::size_t i = 0; i < n; ++i) {
-    const float w = falloffWeight(a.falloff, at(L.p, i)), dt = c.dtAt(i);
-    const Vec3 v = at(L.v, i);
-    put(L.v, i,
-        Vec3(v.x * std::exp(-a.rate.x * dt * w), v.y * std::exp(-a.rate.y * dt * w),
-             v.z * std::exp(-a.rate.z * dt * w)));
-  }
+  for (std::size_t i = 0; i < n; ++i)
+    onLocals(L.v, i, [&](float* x, float* y, float* z) {
+      kernel::fl_damping_step(a.rate.x, a.rate.y, a.rate.z, c.dtAt(i),
+                              falloffWeight(a.falloff, at(L.p, i)), x, y, z);
+    });
 }
 
 inline void apply(const RotDamping& a, const Lanes& L, std::size_t n, const BlockContext& c) {
   withDt(c, [&](auto dt) { dampLoop(L.rot[0], L.rot[1], L.rot[2], n, a.rate, dt); });
 }
 
-// softPull's arithmetic, branch-free over __restrict lanes so that it vectorises: the pull
-// is computed everywhere and selected where it applies (0 beyond maxRadius and at the centre,
-// where softPull returns 0 untouched: the select keeps out what is computed there).
+// fl_soft_pull (branch-free) over __restrict lanes, through locals so that it vectorises.
 template <class Dt>
 inline void orbitPointLoop(const float* __restrict px, const float* __restrict py,
                            const float* __restrict pz, float* __restrict vx, float* __restrict vy,
                            float* __restrict vz, std::size_t n, Vec3 center, float magnitude,
                            float eps, float maxR2, Dt dt) {
   for (std::size_t i = 0; i < n; ++i) {
-    const float dx = center.x - px[i], dy = center.y - py[i], dz = center.z - pz[i];
-    const float r2 = dx * dx + dy * dy + dz * dz;  // glm::dot's order
-    const bool pulls = (r2 <= maxR2) & (r2 > 0.0f);
-    const float s = r2 + eps;
-    const float k = magnitude / (s * std::sqrt(s));
-    vx[i] = vx[i] + (pulls ? dx * k : 0.0f) * dt[i];
-    vy[i] = vy[i] + (pulls ? dy * k : 0.0f) * dt[i];
-    vz[i] = vz[i] + (pulls ? dz * k : 0.0f) * dt[i];
+    float x, y, z, ux = vx[i], uy = vy[i], uz = vz[i];
+    kernel::fl_soft_pull(center.x - px[i], center.y - py[i], center.z - pz[i], magnitude, eps,
+                         maxR2, &x, &y, &z);
+    kernel::fl_add_scaled(x, y, z, dt[i], &ux, &uy, &uz);
+    vx[i] = ux, vy[i] = uy, vz[i] = uz;
   }
 }
 
@@ -245,11 +252,15 @@ inline void apply(const OrbitPoint& a, const Lanes& L, std::size_t n, const Bloc
 }
 
 inline void apply(const OrbitLine& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const Vec3 axis = glm::normalize(a.axis);
+  const Vec3 u = glm::normalize(a.axis), o = a.point;
+  const float maxR2 = a.maxRadius * a.maxRadius;
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 w = at(L.p, i) - a.point;
-    const Vec3 d = -(w - axis * glm::dot(w, axis));  // towards the nearest point of the line
-    put(L.v, i, at(L.v, i) + softPull(d, a.magnitude, a.epsilon, a.maxRadius) * c.dtAt(i));
+    float gx, gy, gz;
+    kernel::fl_orbit_line_pull(o.x, o.y, o.z, u.x, u.y, u.z, a.magnitude, a.epsilon, maxR2,
+                               L.p[0][i], L.p[1][i], L.p[2][i], &gx, &gy, &gz);
+    onLocals(L.v, i, [&](float* x, float* y, float* z) {
+      kernel::fl_add_scaled(gx, gy, gz, c.dtAt(i), x, y, z);
+    });
   }
 }
 
@@ -269,21 +280,13 @@ inline void apply(const Gravitate& a, const Lanes& L, std::size_t n, const Block
 }
 
 inline void apply(const Vortex& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const Vec3 axis = glm::normalize(a.axis);
+  const kernel::FlVortex vortex = flVortex(a);
   const float kStep = approach(a.responsiveness, c.dt);
   for (std::size_t i = 0; i < n; ++i) {
     const float k = c.ownDt ? approach(a.responsiveness, c.ownDt[i]) : kStep;
-    const Vec3 w = at(L.p, i) - a.center;
-    const Vec3 radial = w - axis * glm::dot(w, axis);
-    const float r = glm::length(radial);
-    if (!(r <= a.maxRadius)) continue;
-    // On the axis there is no radial direction: no swirl, no inflow (finite, not NaN).
-    const Vec3 rhat = r > 0.0f ? radial / r : Vec3(0.0f);
-    const float around = r < a.coreRadius ? a.aroundSpeed * r / a.coreRadius
-                                          : a.aroundSpeed * std::pow(a.coreRadius / r, a.tightness);
-    const Vec3 u = glm::cross(axis, rhat) * around - rhat * a.inSpeed + axis * a.upSpeed;
-    const Vec3 v = at(L.v, i);
-    put(L.v, i, v + (u - v) * k);
+    onLocals(L.v, i, [&](float* x, float* y, float* z) {
+      kernel::fl_vortex_step(vortex, k, L.p[0][i], L.p[1][i], L.p[2][i], x, y, z);
+    });
   }
 }
 
@@ -291,8 +294,8 @@ inline void apply(const Jet& a, const Lanes& L, std::size_t n, const BlockContex
   const bool constant = std::holds_alternative<PointDomain>(a.acceleration.shape());
   const Vec3 fixed = constant ? std::get<PointDomain>(a.acceleration.shape()).p : Vec3(0.0f);
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 d = at(L.p, i) - a.center;
-    if (!(glm::dot(d, d) <= a.radius * a.radius)) continue;
+    const Vec3 C = a.center;
+    if (!kernel::fl_in_ball(C.x, C.y, C.z, a.radius, L.p[0][i], L.p[1][i], L.p[2][i])) continue;
     Vec3 acc = fixed;
     if (!constant) {
       Random rng = actionRandom(c, L, i);
@@ -307,14 +310,12 @@ inline void apply(const Explosion& a, const Lanes& L, std::size_t n, const Block
   if (t < a.time) return;
   const float front = a.speed * float(t - a.time);
   const float inv2s2 = 1.0f / (2.0f * a.stddev * a.stddev);
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 d = at(L.p, i) - a.center;
-    const float r = glm::length(d);
-    if (!(r > 0.0f)) continue;
-    const float delta = r - front;
-    const float mag = a.magnitude * std::exp(-delta * delta * inv2s2) / (r * r + a.epsilon);
-    put(L.v, i, at(L.v, i) + d * (mag / r * c.dt));
-  }
+  const Vec3 C = a.center;
+  for (std::size_t i = 0; i < n; ++i)
+    onLocals(L.v, i, [&](float* x, float* y, float* z) {
+      kernel::fl_explosion_step(C.x, C.y, C.z, a.magnitude, inv2s2, a.epsilon, front, c.dt,
+                                L.p[0][i], L.p[1][i], L.p[2][i], x, y, z);
+    });
 }
 
 // The accelerations are drawn for a batch of particles at once (Philox vectorised, the
@@ -377,14 +378,16 @@ inline void apply(const Turbulence& a, const Lanes& L, std::size_t n, const Bloc
 
 // Charge over mass; a particle of zero (or negative) mass does not respond to fields.
 inline float chargePerMass(const Lanes& L, std::size_t i) {
-  const float m = L.mass[i];
-  return m > 0.0f ? L.charge[i] / m : 0.0f;
+  return kernel::fl_charge_per_mass(L.charge[i], L.mass[i]);
 }
 
 inline void apply(const ElectricField& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const Vec3 E = a.field;
   for (std::size_t i = 0; i < n; ++i) {
     const float w = falloffWeight(a.falloff, at(L.p, i));
-    put(L.v, i, at(L.v, i) + a.field * (chargePerMass(L, i) * c.dtAt(i) * w));
+    onLocals(L.v, i, [&](float* x, float* y, float* z) {
+      kernel::fl_add_scaled(E.x, E.y, E.z, chargePerMass(L, i) * c.dtAt(i) * w, x, y, z);
+    });
   }
 }
 
@@ -397,10 +400,9 @@ inline void apply(const MagneticField& a, const Lanes& L, std::size_t n, const B
     // double so that the speed does not drift by float rounding over many steps.
     const double theta =
         -double(chargePerMass(L, i)) * B * c.dtAt(i) * falloffWeight(a.falloff, at(L.p, i));
-    const double ct = std::cos(theta), st = std::sin(theta);
-    const glm::dvec3 v(at(L.v, i)), kd(k);
-    const glm::dvec3 r = v * ct + glm::cross(kd, v) * st + kd * (glm::dot(kd, v) * (1.0 - ct));
-    put(L.v, i, Vec3(r));
+    onLocals(L.v, i, [&](float* x, float* y, float* z) {
+      kernel::fl_magnetic_turn(k.x, k.y, k.z, theta, x, y, z);
+    });
   }
 }
 
@@ -485,7 +487,7 @@ inline void apply(const MatchRotVelocity& a, const Lanes& L, std::size_t n, cons
 // ---- Targets, clamps, curves -------------------------------------------------------------
 
 inline void approachLoop(float* __restrict x, std::size_t n, float target, float k) {
-  for (std::size_t i = 0; i < n; ++i) x[i] += (target - x[i]) * k;
+  for (std::size_t i = 0; i < n; ++i) x[i] = kernel::fl_toward(x[i], target, k);
 }
 // Each lane towards its target at `rate`: one factor for the block's step, or one per
 // newborn for its own.
@@ -516,13 +518,13 @@ inline void apply(const TargetSize& a, const Lanes& L, std::size_t n, const Bloc
 }
 
 inline void apply(const SpeedClamp& a, const Lanes& L, std::size_t n, const BlockContext&) {
+  float* __restrict vx = L.v[0];
+  float* __restrict vy = L.v[1];
+  float* __restrict vz = L.v[2];
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 v = at(L.v, i);
-    const float s = glm::length(v);
-    if (s > a.maxSpeed)
-      put(L.v, i, v * (a.maxSpeed / s));
-    else if (s < a.minSpeed && s > 0.0f)
-      put(L.v, i, v * (a.minSpeed / s));
+    float x = vx[i], y = vy[i], z = vz[i];
+    kernel::fl_clamp_speed(a.minSpeed, a.maxSpeed, &x, &y, &z);
+    vx[i] = x, vy[i] = y, vz[i] = z;
   }
 }
 
@@ -531,16 +533,14 @@ inline Value lookup(const Keys& keys, float t, Value (*value)(const typename Key
   if (t <= keys.front().t) return value(keys.front());
   for (std::size_t k = 1; k < keys.size(); ++k) {
     if (t <= keys[k].t) {
-      const float span = keys[k].t - keys[k - 1].t;
-      const float w = span > 0.0f ? (t - keys[k - 1].t) / span : 1.0f;
+      const float w = kernel::fl_key_weight(keys[k - 1].t, keys[k].t, t);
       return value(keys[k - 1]) + (value(keys[k]) - value(keys[k - 1])) * w;
     }
   }
   return value(keys.back());
 }
 inline float lifeFraction(const Lanes& L, std::size_t i) {
-  const float life = L.lifetime[i];
-  return life > 0.0f ? std::clamp(L.age[i] / life, 0.0f, 1.0f) : 1.0f;
+  return kernel::fl_life_fraction(L.age[i], L.lifetime[i]);
 }
 // Multiply scales the birth value (stored by emission), Replace sets the curve's value.
 inline void apply(const ColorOverLife& a, const Lanes& L, std::size_t n, const BlockContext&) {

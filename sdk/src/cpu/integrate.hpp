@@ -43,12 +43,15 @@ inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std
           if constexpr (std::is_same_v<A, Gravity>) {
             acc = a.acceleration * falloffWeight(a.falloff, p);
           } else if constexpr (std::is_same_v<A, Damping>) {
-            acc = -a.rate * v * falloffWeight(a.falloff, p);
+            kernel::fl_damping_accel(a.rate.x, a.rate.y, a.rate.z, falloffWeight(a.falloff, p), v.x,
+                                     v.y, v.z, &acc.x, &acc.y, &acc.z);
           } else if constexpr (std::is_same_v<A, OrbitPoint>) {
             acc = softPull(a.center - p, a.magnitude, a.epsilon, a.maxRadius);
           } else if constexpr (std::is_same_v<A, OrbitLine>) {
-            const Vec3 axis = glm::normalize(a.axis), w = p - a.point;
-            acc = softPull(-(w - axis * glm::dot(w, axis)), a.magnitude, a.epsilon, a.maxRadius);
+            const Vec3 u = glm::normalize(a.axis);
+            kernel::fl_orbit_line_pull(a.point.x, a.point.y, a.point.z, u.x, u.y, u.z, a.magnitude,
+                                       a.epsilon, a.maxRadius * a.maxRadius, p.x, p.y, p.z, &acc.x,
+                                       &acc.y, &acc.z);
           } else if constexpr (std::is_same_v<A, Gravitate>) {
             const Snapshot& sn = *c.snapshot;
             for (std::size_t j = 0; j < sn.size; ++j)
@@ -62,33 +65,18 @@ inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std
               acc = softPull(Vec3(sn.p[0][next], sn.p[1][next], sn.p[2][next]) - p, a.magnitude,
                              a.epsilon, a.maxRadius);
           } else if constexpr (std::is_same_v<A, Vortex>) {
-            const Vec3 axis = glm::normalize(a.axis), w = p - a.center;
-            const Vec3 radial = w - axis * glm::dot(w, axis);
-            const float r = glm::length(radial);
-            if (r <= a.maxRadius) {
-              const Vec3 rhat = r > 0.0f ? radial / r : Vec3(0.0f);
-              const float around = r < a.coreRadius
-                                       ? a.aroundSpeed * r / a.coreRadius
-                                       : a.aroundSpeed * std::pow(a.coreRadius / r, a.tightness);
-              const Vec3 u = glm::cross(axis, rhat) * around - rhat * a.inSpeed + axis * a.upSpeed;
-              acc = (u - v) * a.responsiveness;
-            }
+            kernel::fl_vortex_accel(flVortex(a), a.responsiveness, p.x, p.y, p.z, v.x, v.y, v.z,
+                                    &acc.x, &acc.y, &acc.z);
           } else if constexpr (std::is_same_v<A, Jet>) {
-            const Vec3 d = p - a.center;
-            if (glm::dot(d, d) <= a.radius * a.radius) {
+            if (kernel::fl_in_ball(a.center.x, a.center.y, a.center.z, a.radius, p.x, p.y, p.z)) {
               Random rng = actionRandom(c, L, i);
               acc = a.acceleration.sample(rng);
             }
           } else if constexpr (std::is_same_v<A, Explosion>) {
-            if (t >= a.time) {
-              const Vec3 d = p - a.center;
-              const float r = glm::length(d);
-              if (r > 0.0f) {
-                const float delta = r - a.speed * float(t - a.time);
-                acc = d * (a.magnitude * std::exp(-delta * delta / (2 * a.stddev * a.stddev)) /
-                           (r * r + a.epsilon) / r);
-              }
-            }
+            if (t >= a.time)
+              kernel::fl_explosion_accel(
+                  a.center.x, a.center.y, a.center.z, a.magnitude, 2 * a.stddev * a.stddev,
+                  a.epsilon, a.speed * float(t - a.time), p.x, p.y, p.z, &acc.x, &acc.y, &acc.z);
           } else if constexpr (std::is_same_v<A, RandomAccel>) {
             Random rng = actionRandom(c, L, i);
             acc = a.acceleration.sample(rng) * falloffWeight(a.falloff, p);
@@ -98,7 +86,9 @@ inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std
           } else if constexpr (std::is_same_v<A, ElectricField>) {
             acc = a.field * chargePerMass(L, i) * falloffWeight(a.falloff, p);
           } else if constexpr (std::is_same_v<A, MagneticField>) {
-            acc = glm::cross(v, a.field) * chargePerMass(L, i) * falloffWeight(a.falloff, p);
+            kernel::fl_magnetic_accel(a.field.x, a.field.y, a.field.z, chargePerMass(L, i),
+                                      falloffWeight(a.falloff, p), v.x, v.y, v.z, &acc.x, &acc.y,
+                                      &acc.z);
           } else if constexpr (std::is_same_v<A, SampledField>) {
             const Vec3 u = sampleTrilinear(*a.field, p) * a.strength;
             acc = (a.mode == SampledField::Mode::Acceleration ? u : (u - v) * a.responsiveness) *

@@ -22,7 +22,9 @@
 namespace flurry::detail {
 inline namespace FLURRY_ISA_NAMESPACE {
 namespace kernel {
+#include "../../kernels/absorb.h"
 #include "../../kernels/deflect.h"
+#include "../../kernels/forces.h"
 }  // namespace kernel
 }  // namespace FLURRY_ISA_NAMESPACE
 }  // namespace flurry::detail
@@ -165,21 +167,16 @@ inline void ageLoop(float* __restrict age, std::size_t n, Dt dt) {
 
 inline void killOldLoop(const float* __restrict age, const float* __restrict life,
                         std::uint32_t* __restrict dead, std::size_t n, std::uint32_t code) {
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::uint32_t k = age[i] > life[i] ? code : 0u;
-    dead[i] = dead[i] != 0u ? dead[i] : k;
-  }
+  for (std::size_t i = 0; i < n; ++i) dead[i] = kernel::fl_dead_old(age[i], life[i], code, dead[i]);
 }
 
 template <class Shape>
 inline void sinkLoop(const Shape& shape, const float* __restrict px, const float* __restrict py,
                      const float* __restrict pz, std::uint32_t* __restrict dead, std::size_t n,
                      std::uint32_t code, bool killInside) {
-  const std::uint32_t want = killInside ? 1u : 0u;
   for (std::size_t i = 0; i < n; ++i) {
-    const std::uint32_t in = detail::inside(shape, Vec3(px[i], py[i], pz[i])) ? 1u : 0u;
-    const std::uint32_t k = in == want ? code : 0u;
-    dead[i] = dead[i] != 0u ? dead[i] : k;
+    const int in = detail::inside(shape, Vec3(px[i], py[i], pz[i]));
+    dead[i] = kernel::fl_dead_sink(in, killInside, code, dead[i]);
   }
 }
 
@@ -190,7 +187,7 @@ inline void sinkLoop(const Shape& shape, const float* __restrict px, const float
 inline bool sinkPasses(std::uint64_t seed, std::uint32_t id, std::uint32_t key, float fraction) {
   const auto b = Philox4x32::generate(id, key, stream::kPassThrough, 0u, std::uint32_t(seed),
                                       std::uint32_t(seed >> 32));
-  return uniformFloat(b.v[0]) < fraction;
+  return kernel::fl_passes(b.v[0], fraction);
 }
 
 inline void applyWeighted(const Gravity& a, const Lanes& L, std::size_t n, const BlockContext& c);

@@ -653,7 +653,7 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   s << "\n";
   for (const char* f :
        {"compat_opencl.h", "math.h", "params.h", "philox.h", "noise.h", "deflect.h", "domain.cl",
-        "actions.cl", "forces.cl", "surfaces.cl", "compact.cl", "emit.cl"})
+        "forces.h", "absorb.h", "actions.cl", "forces.cl", "surfaces.cl", "compact.cl", "emit.cl"})
     s << "/* ---- " << f << " */\n" << embeddedKernel(f) << "\n";
 
   s << "/* ---- generated: emission */\n" << emitSource;

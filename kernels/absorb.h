@@ -1,0 +1,39 @@
+/* Absorbers' kill tests (KillOld, Sink, SinkVelocity), written once for both backends in the
+ * kernels' shared C subset (compat_opencl.h, sdk/src/kernel_compat.hpp). A particle's `dead`
+ * is 0 while it lives, else the code (1 + index in the list) of the first action that killed
+ * it: a later kill does not overwrite it. Branch-free, so the CPU's loops vectorise. Whether a
+ * point is inside a domain is each side's domain code. */
+#ifndef FLURRY_KERNELS_ABSORB_H
+#define FLURRY_KERNELS_ABSORB_H
+
+/* The new dead after an action with `code` that kills where `kill` is nonzero. */
+FL_INLINE uint fl_dead_if(int kill, uint code, uint dead) {
+  const uint k = kill ? code : 0u;
+  return dead != 0u ? dead : k;
+}
+
+/* KillOld: past its lifetime. */
+FL_INLINE uint fl_dead_old(float age, float life, uint code, uint dead) {
+  return fl_dead_if(age > life, code, dead);
+}
+
+/* Sink (Inside, Outside) and SinkVelocity: `inside` the region, killing those inside when
+ * killInside, else those outside. */
+FL_INLINE uint fl_dead_sink(int inside, int killInside, uint code, uint dead) {
+  return fl_dead_if((inside != 0) == (killInside != 0), code, dead);
+}
+
+/* Sink (Enter, Leave): inside now and at the end of the coming Move's straight step. */
+FL_INLINE uint fl_dead_sink_motion(int now, int next, int enter, uint code, uint dead) {
+  const int k = enter ? ((!now) & next) : (now & (!next));
+  return fl_dead_if(k, code, dead);
+}
+
+/* The particles an absorber with a pass-through fraction kills survive if this holds: u is
+ * the first word of their pass-through Philox block (kernels.hpp sinkPasses), as a uniform in
+ * [0, 1). */
+FL_INLINE int fl_passes(uint u, float fraction) {
+  return (float)(u >> 8) * (1.0f / 16777216.0f) < fraction;
+}
+
+#endif /* FLURRY_KERNELS_ABSORB_H */

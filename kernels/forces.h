@@ -1,0 +1,227 @@
+/* Forces, targets and speed limits, per particle: written once for both backends in the
+ * kernels' shared C subset (compat_opencl.h on the device, sdk/src/kernel_compat.hpp on the
+ * CPU, whose loops call these on locals and still vectorise). Scalars in, what changes through
+ * pointers; each side passes an action's constants as arguments from its own storage
+ * (forces.cl unpacks FlActionParams, actions_more.hpp the action's struct).
+ *
+ * The fl_*_accel functions are a force as an acceleration at a state (integrate.hpp
+ * accumulate(), and the device's integrators): they ADD to *ax, *ay, *az. The others change
+ * the velocity over a step dt. Where a step is taken (a pull is zero, the particle is out of
+ * reach) the result is a select rather than an early return, so the CPU's loops vectorise and
+ * both sides add exactly the same terms. Sums of x, y, z go in glm's order. */
+#ifndef FLURRY_KERNELS_FORCES_H
+#define FLURRY_KERNELS_FORCES_H
+
+/* A force's falloff: (1 - r/radius)^power inside the radius around (cx, cy, cz), 0 outside,
+ * 1 everywhere for an infinite radius. */
+typedef struct FlFalloff {
+  float cx, cy, cz, radius, power;
+} FlFalloff;
+
+FL_INLINE float fl_falloff_weight(FlFalloff f, float px, float py, float pz) {
+  if (!(f.radius < INFINITY)) return 1.0f;
+  const float dx = px - f.cx, dy = py - f.cy, dz = pz - f.cz;
+  const float t = fl_maxf(0.0f, 1.0f - sqrt(dx * dx + dy * dy + dz * dz) / f.radius);
+  return f.power == 1.0f ? t : pow(t, f.power);
+}
+
+/* The fraction of the way an exponential approach at `rate` covers in dt: never above 1. */
+FL_INLINE float fl_approach(float rate, float dt) {
+  return 1.0f - exp(-rate * dt);
+}
+
+/* Charge over mass: a particle of zero (or negative) mass feels no field. */
+FL_INLINE float fl_charge_per_mass(float charge, float mass) {
+  return mass > 0.0f ? charge / mass : 0.0f;
+}
+
+/* v += a * s. */
+FL_INLINE void fl_add_scaled(float ax, float ay, float az, float s, float* vx, float* vy,
+                             float* vz) {
+  *vx = *vx + ax * s;
+  *vy = *vy + ay * s;
+  *vz = *vz + az * s;
+}
+
+/* ---- Softened pulls: OrbitPoint, OrbitLine, Gravitate, Follow ------------------------------ */
+
+/* magnitude d / (|d|^2 + eps)^(3/2) into o; zero beyond sqrt(maxR2) and at the centre, where
+ * s sqrt(s) underflows to 0 for eps below ~1e-26 and 0 inf would be NaN (the select keeps out
+ * what is computed there). Elsewhere a pull that overflows stays infinite, and the NaN guard
+ * kills the particle. */
+FL_INLINE void fl_soft_pull(float dx, float dy, float dz, float magnitude, float eps, float maxR2,
+                            float* ox, float* oy, float* oz) {
+  const float r2 = dx * dx + dy * dy + dz * dz;
+  const int pulls = (r2 <= maxR2) & (r2 > 0.0f);
+  const float s = r2 + eps;
+  const float k = magnitude / (s * sqrt(s));
+  *ox = pulls ? dx * k : 0.0f;
+  *oy = pulls ? dy * k : 0.0f;
+  *oz = pulls ? dz * k : 0.0f;
+}
+
+/* OrbitLine: the pull towards the nearest point of the line through (lx, ly, lz) along the unit
+ * axis (ux, uy, uz). */
+FL_INLINE void fl_orbit_line_pull(float lx, float ly, float lz, float ux, float uy, float uz,
+                                  float magnitude, float eps, float maxR2, float px, float py,
+                                  float pz, float* ox, float* oy, float* oz) {
+  const float wx = px - lx, wy = py - ly, wz = pz - lz;
+  const float d = wx * ux + wy * uy + wz * uz;
+  fl_soft_pull(-(wx - ux * d), -(wy - uy * d), -(wz - uz * d), magnitude, eps, maxR2, ox, oy, oz);
+}
+
+/* ---- Vortex ------------------------------------------------------------------------------- */
+
+/* Centre, unit axis, the swirl's speed (aroundSpeed up to the core's radius, then falling off
+ * as (core / r)^tightness), the inflow and the rise, and where it ends. */
+typedef struct FlVortex {
+  float cx, cy, cz, kx, ky, kz;
+  float around, core, tightness, in, up, maxR;
+} FlVortex;
+
+/* The vortex's velocity field at p into u; 0 beyond maxR (the particle is left alone). */
+FL_INLINE int fl_vortex_field(FlVortex v, float px, float py, float pz, float* ux, float* uy,
+                              float* uz) {
+  const float wx = px - v.cx, wy = py - v.cy, wz = pz - v.cz;
+  const float d = wx * v.kx + wy * v.ky + wz * v.kz;
+  const float rx = wx - v.kx * d, ry = wy - v.ky * d, rz = wz - v.kz * d;
+  const float r = sqrt(rx * rx + ry * ry + rz * rz);
+  /* On the axis there is no radial direction: no swirl, no inflow (finite, not NaN). */
+  const float hx = r > 0.0f ? rx / r : 0.0f, hy = r > 0.0f ? ry / r : 0.0f,
+              hz = r > 0.0f ? rz / r : 0.0f;
+  const float around = r < v.core ? v.around * r / v.core : v.around * pow(v.core / r, v.tightness);
+  *ux = (v.ky * hz - hy * v.kz) * around - hx * v.in + v.kx * v.up;
+  *uy = (v.kz * hx - hz * v.kx) * around - hy * v.in + v.ky * v.up;
+  *uz = (v.kx * hy - hx * v.ky) * around - hz * v.in + v.kz * v.up;
+  return r <= v.maxR;
+}
+
+/* The velocity carried towards the field by k (fl_approach of responsiveness). */
+FL_INLINE void fl_vortex_step(FlVortex v, float k, float px, float py, float pz, float* vx,
+                              float* vy, float* vz) {
+  float ux, uy, uz;
+  if (!fl_vortex_field(v, px, py, pz, &ux, &uy, &uz)) return;
+  *vx = *vx + (ux - *vx) * k;
+  *vy = *vy + (uy - *vy) * k;
+  *vz = *vz + (uz - *vz) * k;
+}
+
+FL_INLINE void fl_vortex_accel(FlVortex v, float responsiveness, float px, float py, float pz,
+                               float vx, float vy, float vz, float* ax, float* ay, float* az) {
+  float ux, uy, uz;
+  if (!fl_vortex_field(v, px, py, pz, &ux, &uy, &uz)) return;
+  *ax += (ux - vx) * responsiveness;
+  *ay += (uy - vy) * responsiveness;
+  *az += (uz - vz) * responsiveness;
+}
+
+/* ---- Jet ---------------------------------------------------------------------------------- */
+
+/* Whether p lies in the ball where the jet acts (its acceleration is drawn by each side's
+ * domain sampler). */
+FL_INLINE int fl_in_ball(float cx, float cy, float cz, float radius, float px, float py, float pz) {
+  const float dx = px - cx, dy = py - cy, dz = pz - cz;
+  return dx * dx + dy * dy + dz * dz <= radius * radius;
+}
+
+/* ---- Explosion ---------------------------------------------------------------------------- */
+
+/* A spherical pulse from (cx, cy, cz) whose front is at radius `front` (the caller computes it
+ * from the time, in double): magnitude exp(-(r - front)^2 inv2s2) / (r^2 + eps) outwards, over
+ * a step of dt. Nothing at the centre. inv2s2 = 1 / (2 stddev^2). */
+FL_INLINE void fl_explosion_step(float cx, float cy, float cz, float magnitude, float inv2s2,
+                                 float eps, float front, float dt, float px, float py, float pz,
+                                 float* vx, float* vy, float* vz) {
+  const float dx = px - cx, dy = py - cy, dz = pz - cz;
+  const float r = sqrt(dx * dx + dy * dy + dz * dz);
+  if (!(r > 0.0f)) return;
+  const float delta = r - front;
+  const float mag = magnitude * exp(-delta * delta * inv2s2) / (r * r + eps);
+  fl_add_scaled(dx, dy, dz, mag / r * dt, vx, vy, vz);
+}
+
+/* The same as an acceleration; twoS2 = 2 stddev^2. */
+FL_INLINE void fl_explosion_accel(float cx, float cy, float cz, float magnitude, float twoS2,
+                                  float eps, float front, float px, float py, float pz, float* ax,
+                                  float* ay, float* az) {
+  const float dx = px - cx, dy = py - cy, dz = pz - cz;
+  const float r = sqrt(dx * dx + dy * dy + dz * dz);
+  if (!(r > 0.0f)) return;
+  const float delta = r - front;
+  const float s = magnitude * exp(-delta * delta / twoS2) / (r * r + eps) / r;
+  *ax += dx * s;
+  *ay += dy * s;
+  *az += dz * s;
+}
+
+/* ---- Damping, fields ---------------------------------------------------------------------- */
+
+/* Damping with a falloff weight w: each component decays at its rate for dt. */
+FL_INLINE void fl_damping_step(float rx, float ry, float rz, float dt, float w, float* vx,
+                               float* vy, float* vz) {
+  *vx = *vx * exp(-rx * dt * w);
+  *vy = *vy * exp(-ry * dt * w);
+  *vz = *vz * exp(-rz * dt * w);
+}
+
+FL_INLINE void fl_damping_accel(float rx, float ry, float rz, float w, float vx, float vy, float vz,
+                                float* ax, float* ay, float* az) {
+  *ax += -rx * vx * w;
+  *ay += -ry * vy * w;
+  *az += -rz * vz * w;
+}
+
+/* MagneticField: v turns about the unit field direction k by theta = -(q/m)|B| dt w, exactly
+ * (Rodrigues), in double where the device has it, so that the speed does not drift. */
+FL_INLINE void fl_magnetic_turn(float kx, float ky, float kz, fl_real theta, float* vx, float* vy,
+                                float* vz) {
+  const fl_real ct = cos(theta), st = sin(theta);
+  const fl_real x = *vx, y = *vy, z = *vz;
+  const fl_real dx = kx, dy = ky, dz = kz;
+  const fl_real d = (dx * x + dy * y + dz * z) * ((fl_real)1.0 - ct);
+  *vx = (float)(x * ct + (dy * z - y * dz) * st + dx * d);
+  *vy = (float)(y * ct + (dz * x - z * dx) * st + dy * d);
+  *vz = (float)(z * ct + (dx * y - x * dy) * st + dz * d);
+}
+
+/* The Lorentz acceleration (v x B) q w; q is charge over mass. */
+FL_INLINE void fl_magnetic_accel(float Bx, float By, float Bz, float q, float w, float vx, float vy,
+                                 float vz, float* ax, float* ay, float* az) {
+  *ax += (vy * Bz - By * vz) * q * w;
+  *ay += (vz * Bx - Bz * vx) * q * w;
+  *az += (vx * By - Bx * vy) * q * w;
+}
+
+/* ---- Targets, speed limits ---------------------------------------------------------------- */
+
+/* A value carried towards its target by k (fl_approach of the rate). */
+FL_INLINE float fl_toward(float x, float target, float k) {
+  return x + (target - x) * k;
+}
+
+/* SpeedClamp: a speed above maxS comes down to it, one below minS (but moving) up to it. */
+FL_INLINE void fl_clamp_speed(float minS, float maxS, float* vx, float* vy, float* vz) {
+  const float x = *vx, y = *vy, z = *vz;
+  const float s = sqrt(x * x + y * y + z * z);
+  const int over = s > maxS, under = (s < minS) & (s > 0.0f);
+  const float k = over ? maxS / s : minS / s;
+  const int take = over | under;
+  *vx = take ? x * k : x;
+  *vy = take ? y * k : y;
+  *vz = take ? z * k : z;
+}
+
+/* ---- Curves over life --------------------------------------------------------------------- */
+
+/* Where a particle is in its life, 0 to 1 (1 for one without a lifetime). */
+FL_INLINE float fl_life_fraction(float age, float life) {
+  return life > 0.0f ? fl_clampf(age / life, 0.0f, 1.0f) : 1.0f;
+}
+
+/* Between two keys at t0 and t1: how far t is (1 where they coincide). */
+FL_INLINE float fl_key_weight(float t0, float t1, float t) {
+  const float span = t1 - t0;
+  return span > 0.0f ? (t - t0) / span : 1.0f;
+}
+
+#endif /* FLURRY_KERNELS_FORCES_H */
