@@ -504,3 +504,38 @@ TEST(OpenCLBackend, InstanceTransformsMatchTheCpuWithoutARebuild) {
   EXPECT_EQ(after.diskHits, before.diskHits);
   EXPECT_EQ(after.memoryHits, before.memoryHits);
 }
+
+// A new action list of other kinds over the same stored attributes needs another program
+// (the one built for the old list would run the old actions with the new constants).
+TEST(OpenCLBackend, NewActionKindsOverTheSameAttributesGetTheirProgram) {
+  FLURRY_REQUIRE_OPENCL();
+  auto run = [&](Backend backend) {
+    ContextOptions o;
+    o.backend = backend;
+    o.threads = 1;
+    o.dt = 0.05;
+    Context ctx(o);
+    Group& g = ctx.createGroup("g", 2000);
+    Emitter e;
+    e.rate = 400;
+    e.types[0].velocity = Domain::sphere(Vec3(0.0f, 2.0f, 0.0f), 1.0f);
+    e.types[0].lifetime = 100.0f;
+    g.addEmitter(e);
+    g.setActions({Gravity{Vec3(0.0f, -9.81f, 0.0f)}, Move{}});
+    ctx.run(10);
+    g.setActions({Damping{Vec3(0.5f)}, Move{}});
+    ctx.run(10);
+    test::RunResult r;
+    r.size = g.size();
+    r.stats = g.stats();
+    r.stored = g.attributes();
+    for (std::size_t i = 0; i < r.size; ++i) {
+      const Particle p = g.particle(i);
+      r.byId[p.id] = p;
+    }
+    return r;
+  };
+  const test::RunResult cpu = run(Backend::Cpu), cl = run(Backend::OpenCL);
+  ASSERT_GT(cpu.size, 300u);
+  test::expectSame(cpu, cl);
+}

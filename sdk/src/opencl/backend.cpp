@@ -227,6 +227,11 @@ class ClGroup final : public DeviceMirror {
   Program program_;
   ActionList programActions_;
   bool programValid_ = false;
+  // The program's source and options, and the action list version it was last checked for:
+  // a new list may need another program (other kinds of actions or domains), or only new
+  // constants (a transform, a parameter), which go up without a rebuild.
+  std::string programSource_, programOptions_;
+  std::uint64_t programCheckedVersion_ = ~std::uint64_t(0);
   std::string emitterSignature_;
   EmitterCodes emitterCodes_;  // the program's emitter codes, and the planning's scratch
   // The action constants as last packed: for actionsVersion and the step's dt (its bits).
@@ -343,6 +348,9 @@ void ClGroup::buildProgram(GroupImpl& g, bool cull) {
   neighbours_ = gen.neighbours;
   substepsByDistance_ = gen.substepsByDistance;
   programActions_ = g.actions;
+  programSource_ = gen.source;
+  programOptions_ = gen.options;
+  programCheckedVersion_ = g.actionsVersion;
   programValid_ = true;
 
   // The buffer arguments; scalars are set per step.
@@ -576,6 +584,14 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
       emitterSignature(emitterCodes_.variants) != emitterSignature_)
     programValid_ = false;
   if (g.hair.enabled != hairProgram_ || sp.cull != cullProgram_) programValid_ = false;
+  if (programValid_ && programCheckedVersion_ != g.actionsVersion) {
+    const GeneratedProgram gen =
+        generateProgram(g.actions, g.stored, shared_->fp64(),
+                        emissionSource(emitterCodes_.variants), g.hair.enabled, sp.cull);
+    if (gen.source != programSource_ || gen.options != programOptions_) programValid_ = false;
+    programActions_ = g.actions;
+    programCheckedVersion_ = g.actionsVersion;
+  }
   if (!programValid_) buildProgram(g, sp.cull);
 
   // The actions' constants: packed again only for a new list or a new dt (they hold
