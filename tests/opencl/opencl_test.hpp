@@ -44,8 +44,20 @@ struct RunResult {
   AttributeSet stored;
 };
 
-using Build = std::function<Group&(Context&)>;
+/// A group's particles by id, count, statistics and stored attributes.
+inline RunResult resultOf(const Group& g) {
+  RunResult r;
+  r.size = g.size();
+  r.stats = g.stats();
+  r.stored = g.attributes();
+  for (std::size_t i = 0; i < r.size; ++i) {
+    const Particle p = g.particle(i);
+    r.byId[p.id] = p;
+  }
+  return r;
+}
 
+using Build = std::function<Group&(Context&)>;
 inline RunResult runEffect(Backend backend, const Build& build, int steps, std::uint64_t seed = 7,
                            double dt = 1.0 / 30.0) {
   ContextOptions o;
@@ -56,15 +68,7 @@ inline RunResult runEffect(Backend backend, const Build& build, int steps, std::
   Context ctx(o);
   Group& g = build(ctx);
   ctx.run(std::size_t(steps));
-  RunResult r;
-  r.size = g.size();
-  r.stats = g.stats();
-  r.stored = g.attributes();
-  for (std::size_t i = 0; i < r.size; ++i) {
-    const Particle p = g.particle(i);
-    r.byId[p.id] = p;
-  }
-  return r;
+  return resultOf(g);
 }
 
 }  // namespace flurry::test

@@ -487,15 +487,7 @@ TEST(OpenCLBackend, InstanceTransformsMatchTheCpuWithoutARebuild) {
     inst.setTransform(t1);  // local space: the particles come along
     ctx.run(20);
     if (backend == Backend::OpenCL) after = detail::ocl::Runtime::cacheStats();
-    test::RunResult r;
-    r.size = g.size();
-    r.stats = g.stats();
-    r.stored = g.attributes();
-    for (std::size_t i = 0; i < r.size; ++i) {
-      const Particle p = g.particle(i);
-      r.byId[p.id] = p;
-    }
-    return r;
+    return test::resultOf(g);
   };
   const test::RunResult cpu = run(Backend::Cpu), cl = run(Backend::OpenCL);
   ASSERT_GT(cpu.size, 300u);
@@ -525,15 +517,7 @@ TEST(OpenCLBackend, NewActionKindsOverTheSameAttributesGetTheirProgram) {
     ctx.run(10);
     g.setActions({Damping{Vec3(0.5f)}, Move{}});
     ctx.run(10);
-    test::RunResult r;
-    r.size = g.size();
-    r.stats = g.stats();
-    r.stored = g.attributes();
-    for (std::size_t i = 0; i < r.size; ++i) {
-      const Particle p = g.particle(i);
-      r.byId[p.id] = p;
-    }
-    return r;
+    return test::resultOf(g);
   };
   const test::RunResult cpu = run(Backend::Cpu), cl = run(Backend::OpenCL);
   ASSERT_GT(cpu.size, 300u);
