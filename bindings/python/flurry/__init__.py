@@ -21,6 +21,7 @@ from ._flurry import (  # noqa: F401
     Context,
     Effect,
     EffectError,
+    EffectInstance,
     Error,
     Group,
     GroupStats,
@@ -36,7 +37,7 @@ from ._flurry import (  # noqa: F401
 from . import _flurry
 
 __all__ = [
-    "Context", "Effect", "EffectError", "Error", "Group", "GroupStats", "InvalidArgument",
+    "Context", "Effect", "EffectError", "EffectInstance", "Error", "Group", "GroupStats", "InvalidArgument",
     "IoError", "RenderError", "action", "actions", "builtin_effects", "domain", "domains",
     "effect", "emitter", "gather", "group", "load", "simulate",
 ]

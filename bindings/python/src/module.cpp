@@ -8,10 +8,12 @@
 // the storage outlives it whatever Python drops first.
 #include <nanobind/nanobind.h>
 #include <nanobind/ndarray.h>
+#include <nanobind/stl/array.h>
 #include <nanobind/stl/filesystem.h>
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/vector.h>
 
+#include <array>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -24,6 +26,7 @@
 #include "builtin.hpp"
 #include "flurry/effect.hpp"
 #include "flurry/flurry.hpp"
+#include "flurry/transform.hpp"
 #include "flurry/version.hpp"
 #ifdef FLURRY_PY_RENDER
 #include "flurry/render.hpp"
@@ -84,6 +87,38 @@ struct GroupRef {
   nb::object context;  // the Python Context: keeps the group alive
   ContextBox* pc;
   flurry::Group* g;
+};
+
+// A transform from Python values: position (x, y, z), rotation as a unit quaternion
+// (w, x, y, z), uniform scale.
+flurry::Transform transformOf(const std::array<float, 3>& p, const std::array<float, 4>& q,
+                              float scale) {
+  flurry::Transform t;
+  t.position = flurry::Vec3(p[0], p[1], p[2]);
+  t.rotation = glm::quat(q[0], q[1], q[2], q[3]);
+  t.scale = scale;
+  return t;
+}
+
+nb::dict transformDict(const flurry::Transform& t) {
+  nb::dict d;
+  d["position"] = std::array<float, 3>{t.position.x, t.position.y, t.position.z};
+  d["rotation"] = std::array<float, 4>{t.rotation.w, t.rotation.x, t.rotation.y, t.rotation.z};
+  d["scale"] = t.scale;
+  return d;
+}
+
+flurry::Space spaceOf(const std::string& name) {
+  if (name == "world") return flurry::Space::World;
+  if (name == "local") return flurry::Space::Local;
+  throw flurry::InvalidArgument("space", "must be \"world\" or \"local\", not \"" + name + "\"");
+}
+
+// An effect instance (Effect.instantiate): its groups, placed and prewarmed together.
+struct InstanceRef {
+  nb::object context;  // the Python Context: keeps the groups alive
+  ContextBox* pc;
+  flurry::EffectInstance instance;
 };
 
 flurry::Attribute attributeOf(const std::string& name) {
@@ -315,6 +350,26 @@ NB_MODULE(_flurry, m) {
       .def(
           "sync", [](GroupRef& pg) { std::as_const(*pg.g).ids(); },
           "Brings the host copy up to date (OpenCL); Context.step does it for groups with views.")
+      .def(
+          "set_transform",
+          [](GroupRef& pg, const std::array<float, 3>& position,
+             const std::array<float, 4>& rotation,
+             float scale) { pg.g->setTransform(transformOf(position, rotation, scale)); },
+          "position"_a = std::array<float, 3>{0, 0, 0},
+          "rotation"_a = std::array<float, 4>{1, 0, 0, 0}, "scale"_a = 1.0f,
+          "Places the group (its emitters and its actions' geometry follow): rotation is a unit "
+          "quaternion (w, x, y, z), scale uniform.")
+      .def_prop_ro(
+          "transform", [](const GroupRef& pg) { return transformDict(pg.g->transform()); },
+          "The group's transform: position, rotation (w, x, y, z), scale.")
+      .def_prop_rw(
+          "space",
+          [](const GroupRef& pg) {
+            return std::string(pg.g->space() == flurry::Space::Local ? "local" : "world");
+          },
+          [](GroupRef& pg, const std::string& space) { pg.g->setSpace(spaceOf(space)); },
+          "\"world\": born particles stay where they are when the group moves; \"local\": they "
+          "move with it.")
       .def("__repr__", [](const GroupRef& g) {
         return "<flurry.Group '" + g.g->name() + "' " + std::to_string(g.g->size()) + "/" +
                std::to_string(g.g->capacity()) + ">";
@@ -358,6 +413,16 @@ NB_MODULE(_flurry, m) {
             return GroupRef{nb::borrow(self), &pc, &pc.ctx->createGroup(std::move(name), capacity)};
           },
           "name"_a, "capacity"_a, "An empty group (no emitters, no actions).")
+      .def(
+          "prewarm",
+          [](ContextBox& pc, const std::vector<GroupRef>& groups, double seconds) {
+            std::vector<flurry::Group*> gs;
+            for (const auto& g : groups) gs.push_back(g.g);
+            nb::gil_scoped_release release;
+            return pc.ctx->prewarm(gs, seconds);
+          },
+          "groups"_a, "seconds"_a,
+          "Starts the groups as if they had run `seconds` already; returns the steps taken.")
       .def_prop_ro("time", [](const ContextBox& pc) { return pc.ctx->time(); })
       .def_prop_ro("step_index", [](const ContextBox& pc) { return pc.ctx->stepIndex(); })
       .def_prop_rw(
@@ -422,7 +487,41 @@ NB_MODULE(_flurry, m) {
             return out;
           },
           "context"_a, "max_capacity"_a = 0,
-          "Creates the effect's groups in `context`; max_capacity > 0 caps every group.");
+          "Creates the effect's groups in `context`; max_capacity > 0 caps every group.")
+      .def(
+          "instantiate",
+          [](const flurry::Effect& e, nb::handle context, const std::string& name,
+             std::size_t maxCapacity) {
+            ContextBox& pc = nb::cast<ContextBox&>(context);
+            return InstanceRef{nb::borrow(context), &pc, e.instantiate(*pc.ctx, name, maxCapacity)};
+          },
+          "context"_a, "name"_a, "max_capacity"_a = 0,
+          "Builds the effect as an instance named `name` (groups GROUP@name) to place and "
+          "prewarm.");
+
+  nb::class_<InstanceRef>(m, "EffectInstance", "One effect built into a Context, placed as one.")
+      .def_prop_ro("groups",
+                   [](const InstanceRef& pi) {
+                     std::vector<GroupRef> out;
+                     for (flurry::Group* g : pi.instance.groups())
+                       out.push_back(GroupRef{pi.context, pi.pc, g});
+                     return out;
+                   })
+      .def(
+          "set_transform",
+          [](InstanceRef& pi, const std::array<float, 3>& position,
+             const std::array<float, 4>& rotation,
+             float scale) { pi.instance.setTransform(transformOf(position, rotation, scale)); },
+          "position"_a = std::array<float, 3>{0, 0, 0},
+          "rotation"_a = std::array<float, 4>{1, 0, 0, 0}, "scale"_a = 1.0f,
+          "Places every group of the instance, all or none.")
+      .def(
+          "prewarm",
+          [](InstanceRef& pi, double seconds) {
+            nb::gil_scoped_release release;
+            return pi.instance.prewarm(seconds);
+          },
+          "seconds"_a, "Starts the instance as if it had run `seconds`; returns the steps taken.");
 
   m.def(
       "load",

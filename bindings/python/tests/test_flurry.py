@@ -288,3 +288,42 @@ def test_a_file_name_that_is_not_utf8_still_gives_its_message(tmp_path):
     with pytest.raises(flurry.EffectError) as info:
         flurry.load(os.fsdecode(bad))
     assert "caf" in str(info.value) and ".json" in str(info.value)
+
+
+# --- effect instances ------------------------------------------------------------------------
+
+_TORCH = {"groups": [{"name": "flames", "capacity": 2000,
+                      "emitters": [{"rate": 400, "shape": [0, 0, 0],
+                                    "types": [{"lifetime": 1, "velocity": {
+                                        "type": "cone", "base": [0, 1, 0], "outerRadius": 0.3}}]}],
+                      "actions": [{"type": "Move"}, {"type": "KillOld"}]}]}
+
+
+def test_an_instance_is_placed_and_prewarmed():
+    effect = flurry.Effect.parse(json.dumps(_TORCH))
+    ctx = flurry.Context(threads=1)
+    torch = effect.instantiate(ctx, "torch7")
+    (flames,) = torch.groups
+    assert flames.name == "flames@torch7"
+    assert torch.prewarm(2.0) == 60 and len(flames) > 300
+    turn = (0.9689124, 0.0, 0.247404, 0.0)  # 0.5 rad about y
+    torch.set_transform((4, 0, -2), turn, 1.0)
+    assert tuple(flames.transform["position"]) == (4, 0, -2)
+    ctx.step()
+    x = flames.lane("position", 0)
+    # World space: the flames born before the move stay at the origin, this step's are born
+    # at the torch's new place.
+    assert 5 < int((x > 3).sum()) < 30
+    flames.space = "local"
+    torch.set_transform((4, 1, -2), turn, 1.0)  # the live flames come along, one unit up
+    assert int((flames.lane("position", 1) > 0.99).sum()) == len(flames)
+
+
+def test_bad_transforms_name_the_field():
+    ctx = flurry.Context(threads=1)
+    g = ctx.create_group("g", 10)
+    with pytest.raises(flurry.InvalidArgument, match="transform.scale"):
+        g.set_transform((0, 0, 0), (1, 0, 0, 0), 0.0)
+    with pytest.raises(flurry.InvalidArgument, match="space"):
+        g.space = "orbit"
+    assert g.space == "world"
