@@ -791,9 +791,10 @@ flurry_status flurry_group_transform(const flurry_group* g, float position[3], f
 flurry_status flurry_group_set_space(flurry_group* g, flurry_space space) {
   return guard([&] {
     need(g, "group");
-    if (space != FLURRY_SPACE_WORLD && space != FLURRY_SPACE_LOCAL)
+    const long long v = rawValue(space);
+    if (v != FLURRY_SPACE_WORLD && v != FLURRY_SPACE_LOCAL)
       throw flurry::InvalidArgument("space", "not a flurry_space");
-    group(g).setSpace(space == FLURRY_SPACE_LOCAL ? flurry::Space::Local : flurry::Space::World);
+    group(g).setSpace(v == FLURRY_SPACE_LOCAL ? flurry::Space::Local : flurry::Space::World);
   });
 }
 flurry_status flurry_group_space(const flurry_group* g, flurry_space* space) {
