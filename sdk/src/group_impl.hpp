@@ -119,7 +119,10 @@ struct ActionPlan {
   // Per action: its result does not depend on the step's length or time (a sink by region,
   // KillOld, colour over life, ...), so it runs over a block of newborns as over any block.
   std::vector<std::uint8_t> timeFree;
-  bool guarded = false;              ///< some Move guards against Bounces
+  bool guarded = false;  ///< some Move guards against Bounces
+  /// The NaN guard must scan velocities too: not when an explicit-Euler Move follows every
+  /// action that changes them, as p + v·dt is then not finite wherever v is not.
+  bool guardVelocity = true;
   bool readsNeighbours = false;      ///< the pass reads a snapshot of the step's start
   std::uint32_t firstBlocker = ~0u;  ///< index of the list's first Block action
   std::vector<float> fastest;        ///< scratch: per chunk, the fastest squared speed

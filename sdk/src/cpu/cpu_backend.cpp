@@ -158,6 +158,18 @@ const ActionPlan& planActions(GroupImpl& g) {
   }
   plan.guarded = false;
   for (const auto& gs : plan.guardsOf) plan.guarded |= !gs.empty();
+  {
+    std::size_t lastMove = acts.size(), lastChange = acts.size();
+    for (std::size_t k = 0; k < acts.size(); ++k) {
+      if (std::holds_alternative<Move>(acts[k]))
+        lastMove = k;
+      else if (movesParticles(acts[k]))
+        lastChange = k;
+    }
+    plan.guardVelocity = plan.integrator != Integrator::SemiImplicitEuler ||
+                         lastMove == acts.size() ||
+                         (lastChange != acts.size() && lastChange > lastMove);
+  }
   plan.readsNeighbours = g.actions.readsNeighbours();
   plan.firstBlocker = ~0u;
   for (std::size_t k = 0; k < acts.size(); ++k)

@@ -303,8 +303,10 @@ bool anyNonFinite(const float* const* lane, std::size_t n) {
 
 // Kills what a step left NaN or infinite (an extreme input, a user callback): counted, never
 // propagated. Almost always none is: the lanes are scanned, and marked only when one is.
-void guardFinite(const Lanes& L, std::size_t n, std::uint32_t* __restrict dead) {
+// Velocities only where the plan says a non-finite one may leave the position finite.
+void guardFinite(const Lanes& L, std::size_t n, std::uint32_t* __restrict dead, bool velocity) {
   for (const float* const* lane : {L.p, L.v}) {
+    if (lane == L.v && !velocity) break;
     if (!lane[0] || !anyNonFinite(lane, n)) continue;
     for (int c = 0; c < 3; ++c) {
       const std::uint32_t* __restrict bits = reinterpret_cast<const std::uint32_t*>(lane[c]);
@@ -313,26 +315,33 @@ void guardFinite(const Lanes& L, std::size_t n, std::uint32_t* __restrict dead) 
   }
 }
 
-// Records a block's dead (ascending) in the block's own slice of deadIndex. Few die in a
-// step: runs of 16 with none are skipped after one vectorised test, the rest are gathered
-// without branches (writing at `count` <= i stays inside the slice).
+// Records a block's dead (ascending) in the block's own slice of deadIndex and clears their
+// flags, so that the flags are all zero again for the next block (no fill per block). Few
+// die in a step: runs of 16 with none are skipped after one vectorised test, and a run with
+// some is walked by the set bits of its mask.
 std::uint32_t collectDead(GroupImpl& g, std::size_t base, std::size_t n,
-                          const std::uint32_t* __restrict dead) {
+                          std::uint32_t* __restrict dead) {
   constexpr std::size_t kRun = 16;
   std::uint32_t count = 0;
   std::uint32_t* __restrict idx = g.deadIndex.data() + base;
   std::uint8_t* __restrict code = g.deadCode.data() + base;
-  for (std::size_t i0 = 0; i0 < n; i0 += kRun) {
-    const std::size_t end = std::min(n, i0 + kRun);
+  auto take = [&](std::size_t i) {
+    idx[count] = std::uint32_t(base + i);
+    code[count] = std::uint8_t(dead[i]);
+    dead[i] = 0u;
+    ++count;
+  };
+  std::size_t i0 = 0;
+  for (; i0 + kRun <= n; i0 += kRun) {
     std::uint32_t any = 0;
-    for (std::size_t i = i0; i < end; ++i) any |= dead[i];
+    for (std::size_t j = 0; j < kRun; ++j) any |= dead[i0 + j];
     if (any == 0u) continue;
-    for (std::size_t i = i0; i < end; ++i) {
-      idx[count] = std::uint32_t(base + i);
-      code[count] = std::uint8_t(dead[i]);
-      count += dead[i] != 0u;
-    }
+    std::uint32_t mask = 0;
+    for (std::size_t j = 0; j < kRun; ++j) mask |= std::uint32_t(dead[i0 + j] != 0u) << j;
+    for (; mask != 0u; mask &= mask - 1u) take(i0 + std::size_t(std::countr_zero(mask)));
   }
+  for (std::size_t i = i0; i < n; ++i)
+    if (dead[i] != 0u) take(i);
   return count;
 }
 
@@ -411,15 +420,23 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
   const bool cull = sp.cull && plan.list.cullable && lanes.v[0];
   if (sp.fused) {
     sp.pool->parallelFor(tasks, [&](std::size_t t) {
-      thread_local std::vector<std::uint32_t> deadStore;
-      std::vector<std::uint32_t>& dead = deadStore;  // one TLS lookup, not one per use
+      // The dead flags, all zero between blocks (collectDead clears what it takes); filled
+      // again only after a block that did not finish (an action threw).
+      struct DeadFlags {
+        std::vector<std::uint32_t> flags;
+        bool clean = true;
+      };
+      thread_local DeadFlags deadStore;
+      DeadFlags& store = deadStore;  // one TLS lookup, not one per use
+      std::vector<std::uint32_t>& dead = store.flags;
       if (dead.size() < B) dead.resize(B);
       const std::size_t end = std::min(blocks, (t + 1) * blocksPerTask);
       for (std::size_t b = t * blocksPerTask; b < end; ++b) {
         const std::size_t first = b * B, m = std::min(B, n - first);
         cpu::BlockContext ctx = base;
         ctx.base = first;
-        std::fill_n(dead.data(), m, 0u);
+        if (!store.clean) std::fill(dead.begin(), dead.end(), 0u);
+        store.clean = false;
         ctx.dead = dead.data();
         const Lanes blockLanes = lanes.offset(first);
         const std::size_t old = oldIn(first, m);
@@ -429,8 +446,9 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
                    remainingAt(first, old), s, t1, cull ? &culler : nullptr);
           g.culledCount[b] += culler.culled;
         }
-        guardFinite(blockLanes, m, dead.data());
+        guardFinite(blockLanes, m, dead.data(), plan.list.guardVelocity);
         g.deadCount[b] = collectDead(g, first, m, dead.data());
+        store.clean = true;
       }
     });
   } else {
@@ -454,7 +472,7 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
     }
     sp.pool->parallelFor(blocks, [&](std::size_t b) {
       const std::size_t first = b * B, m = std::min(B, n - first);
-      guardFinite(lanes.offset(first), m, g.deadFlags.data() + first);
+      guardFinite(lanes.offset(first), m, g.deadFlags.data() + first, plan.list.guardVelocity);
       g.deadCount[b] = collectDead(g, first, m, g.deadFlags.data() + first);
     });
   }

@@ -270,6 +270,21 @@ inline void bouncePlanarAll(float* __restrict px, float* __restrict py, float* _
   }
 }
 
+/// kernel::fl_planar_reaches for a normal along one axis (the other two components zero), from
+/// that axis' position q and velocity w. Without FMA contraction the zero terms add exactly
+/// nothing, so for finite particles the answer is the general test's bit for bit; where a
+/// coordinate is not finite it may say yes where the general says no, which only adds a
+/// candidate: the hit itself is decided by the general fl_planar_hit.
+inline int planarReachesAlong(float q, float w, float dt, float Pk, float Nk) {
+  const float d0 = (q - Pk) * Nk;
+  const float vn = w * Nk;
+  const float d1 = d0 + vn * dt;
+  const float side = d0 >= 0.0f ? 1.0f : -1.0f;
+  const float reach =
+      1.2e-7f * (std::abs(Nk) * (std::abs(q) + std::abs(Pk) + 2.0f * std::abs(w * dt))) + 1e-30f;
+  return (side * d1 <= reach) & (side * vn < 0.0f);
+}
+
 /// For each byte b, the positions j of its set bits in ascending order, packed one per byte
 /// of a little-endian word (bit j stands for flag j, as bouncePlanarLoop builds it).
 struct SetBitPositions {
@@ -299,14 +314,28 @@ inline void bouncePlanarLoop(float* __restrict px, float* __restrict py, float* 
   constexpr std::size_t kChunk = 256;
   const Reflect reflect{b.restitution, 1.0f - b.friction, b.cutoff * b.cutoff};
   alignas(32) std::uint8_t reaches[kChunk];
+  // A floor, a wall: a normal along an axis makes the test read two lanes, not six.
+  const int axis = N.y == 0.0f && N.z == 0.0f   ? 0
+                   : N.x == 0.0f && N.z == 0.0f ? 1
+                   : N.x == 0.0f && N.y == 0.0f ? 2
+                                                : -1;
+  const float Pk = axis == 0 ? P.x : axis == 1 ? P.y : P.z;
+  const float Nk = axis == 0 ? N.x : axis == 1 ? N.y : N.z;
   alignas(32) float g[7][kChunk];  // the packed candidates: x, y, z, vx, vy, vz, dt
   std::uint8_t idx[kChunk + 8];    // (eight are stored at once)
   for (std::size_t c0 = 0; c0 < n; c0 += kChunk) {
     const std::size_t m = std::min(kChunk, n - c0);
     float *x = px + c0, *y = py + c0, *z = pz + c0, *vx = vxs + c0, *vy = vys + c0, *vz = vzs + c0;
-    for (std::size_t i = 0; i < m; ++i)
-      reaches[i] = std::uint8_t(kernel::fl_planar_reaches(
-          x[i], y[i], z[i], vx[i], vy[i], vz[i], dts[c0 + i], P.x, P.y, P.z, N.x, N.y, N.z));
+    if (axis < 0) {
+      for (std::size_t i = 0; i < m; ++i)
+        reaches[i] = std::uint8_t(kernel::fl_planar_reaches(
+            x[i], y[i], z[i], vx[i], vy[i], vz[i], dts[c0 + i], P.x, P.y, P.z, N.x, N.y, N.z));
+    } else {
+      const float* __restrict q = (axis == 0 ? px : axis == 1 ? py : pz) + c0;
+      const float* __restrict w = (axis == 0 ? vxs : axis == 1 ? vys : vzs) + c0;
+      for (std::size_t i = 0; i < m; ++i)
+        reaches[i] = std::uint8_t(planarReachesAlong(q[i], w[i], dts[c0 + i], Pk, Nk));
+    }
     // The candidates' indices, eight flags at a time and without branches: the eight flags
     // make a byte, whose set bits' positions come from a table, stored eight at once (a
     // branch per candidate mispredicted about once a word where a floor holds many).
