@@ -663,13 +663,15 @@ TEST(EffectLoader, WarnsAboutListsThatCannotDoWhatTheyImply) {
   const std::string acts = R"(, "actions": [{"type": "Move"}, {"type": "KillOld"}])";
   EXPECT_EQ(warningsOf(withGroup(R"("primeEmitters": [{"rate": 1000, "maxEmitters": 100,
                 "child": {"lifetime": 2, "deathChildren": 3, "emitter": {"rate": 10},
-                          "next": {"lifetime": 0.5}}}])" + acts)),
+                          "next": {"lifetime": 0.5}}}])" +
+                                 acts)),
             (std::vector<std::string>{
                 "groups[0].primeEmitters[0]: keeps about 3500 emitters alive at once (rate and "
                 "largest burst times each level's lifetime and deathChildren), more than its "
                 "maxEmitters of 100: spawns past it are dropped"}));
   EXPECT_TRUE(warningsOf(withGroup(R"("primeEmitters": [{"rate": 10, "maxEmitters": 100,
-                "child": {"lifetime": 2, "emitter": {"rate": 10}}}])" + acts))
+                "child": {"lifetime": 2, "emitter": {"rate": 10}}}])" +
+                                   acts))
                   .empty());
   // A 2-D group: the inserted constraint does not shift the actions' JSON indices.
   const auto w2d = warningsOf(withGroup(emitter + R"(, "mode2d": true, "actions": [
@@ -680,4 +682,92 @@ TEST(EffectLoader, WarnsAboutListsThatCannotDoWhatTheyImply) {
   EXPECT_TRUE(
       warningsOf(withGroup(emitter + R"(, "actions": [{"type": "Move"}, {"type": "KillOld"}])"))
           .empty());
+}
+
+namespace {
+
+/// An emitter whose shape is `shape`, in a group of one emitter.
+std::string emitterShape(const std::string& shape) {
+  return withGroup(R"("emitters": [{"rate": 10, "shape": )" + shape + "}]");
+}
+
+}  // namespace
+
+TEST(EffectLoader, MeshFromAnObjFileRelativeToTheEffect) {
+  const auto dir = scratchDir("obj");
+  // A unit square as one quad (fanned into two triangles), with the lines a modeller writes:
+  // comments, normals, texture coordinates, groups, v/vt/vn corners, a negative index.
+  {
+    std::ofstream(dir / "square.obj") << "# a square\r\nmtllib x.mtl\no square\n"
+                                         "v 0 0 0\nv 1 0 0\nv 1 0 -1  # trailing comment\n"
+                                         "v 0 0 -1\nvn 0 1 0\nvt 0 0\ng top\ns off\n"
+                                         "f 1/1/1 2//1 3 -1\n";
+  }
+  { std::ofstream(dir / "fx.json") << emitterShape(R"({"type": "mesh", "obj": "square.obj"})"); }
+  const Effect fx = loadEffect(dir / "fx.json");
+  const Domain& shape = fx.groups.at(0).emitters.at(0).shape;
+  const auto* mesh = std::get_if<MeshDomain>(&shape.shape());
+  ASSERT_NE(mesh, nullptr);
+  ASSERT_EQ(mesh->mesh->vertices.size(), 4u);
+  ASSERT_EQ(mesh->mesh->triangles.size(), 2u);
+  EXPECT_EQ(mesh->mesh->triangles[0], glm::uvec3(0, 1, 2));
+  EXPECT_EQ(mesh->mesh->triangles[1], glm::uvec3(0, 2, 3));
+  EXPECT_EQ(mesh->mesh->vertices[2], Vec3(1, 0, -1));
+  EXPECT_NEAR(shape.measure(), 1.0, 1e-6);
+  // Counter-clockwise seen from +y: the normal points up.
+  EXPECT_EQ(shape.normal(Vec3(0.5f, 1.0f, -0.5f)), Vec3(0, 1, 0));
+  // Saved inline: the saved effect needs no file.
+  const Effect again = parseEffect(saveEffect(fx), "saved.json");
+  const auto* saved = std::get_if<MeshDomain>(&again.groups.at(0).emitters.at(0).shape.shape());
+  ASSERT_NE(saved, nullptr);
+  EXPECT_EQ(saved->mesh->triangles.size(), 2u);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(EffectLoader, ObjErrorsNameTheFileAndTheLine) {
+  const auto dir = scratchDir("objerr");
+  EffectLoadOptions opts;
+  opts.baseDir = dir;
+  const std::string field = "groups[0].emitters[0].shape.obj";
+  const std::string obj = (dir / "m.obj").string();
+  auto errorFor = [&](const std::string& text) {
+    { std::ofstream(dir / "m.obj") << text; }
+    return errorOf(emitterShape(R"({"type": "mesh", "obj": "m.obj"})"), opts);
+  };
+  const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  const struct {
+    std::string text, why;
+  } cases[] = {
+      {"v 0 0 0\nv 1 0\n", obj + ":2: a vertex needs x y z"},
+      {"v 0 0 0\nv 1 nan 0\n", obj + ":2: vertex coordinate \"nan\" is not a finite number"},
+      {"v 0 0 0\nv 1 0x 0\n", obj + ":2: vertex coordinate \"0x\" is not a finite number"},
+      {tri + "f 1 2\n", obj + ":4: a face needs at least 3 corners, got 2"},
+      {tri + "\nf 1 2 0\n", obj + ":5: face corner \"0\" is not a vertex index (1-based, or "
+                                  "negative from the end)"},
+      {tri + "f 1 2 a/1\n", obj + ":4: face corner \"a/1\" is not a vertex index (1-based, or "
+                                  "negative from the end)"},
+      {tri + "f 1 2 -4\n", obj + ":4: face corner -4 is before the first vertex (3 so far)"},
+      {tri + "f 1 2 3\n# more\nf 1 2 7\n", obj + ":6: face corner 7 is past the last vertex (3 "
+                                                 "in the file)"},
+      {tri + "vn 0 0 1\n", obj + ":4: no faces ('f' lines) in the file"},
+      // A zero-area face: the core's check, at the face's line.
+      {tri + "v 2 0 0\nf 1 2 3\nf 1 2 4\n", obj + ":6: zero area"},
+  };
+  for (const auto& c : cases) {
+    const EffectError e = errorFor(c.text);
+    EXPECT_EQ(e.file(), "test.json") << c.text;
+    EXPECT_EQ(e.path(), field) << c.text;
+    EXPECT_EQ(e.why(), c.why) << c.text;
+  }
+  EXPECT_EQ(errorOf(emitterShape(R"({"type": "mesh", "obj": "none.obj"})"), opts).why(),
+            (dir / "none.obj").string() + ": cannot open the file");
+  EXPECT_EQ(errorOf(emitterShape(R"({"type": "mesh", "obj": "."})"), opts).why(),
+            (dir / ".").string() + ": is a directory");
+  EXPECT_EQ(
+      errorOf(emitterShape(R"({"type": "mesh", "obj": "m.obj", "vertices": []})"), opts).why(),
+      "give either \"obj\" or \"vertices\" and \"triangles\", not both");
+  // A misspelt key suggests the file form too.
+  EXPECT_NE(errorOf(emitterShape(R"({"type": "mesh", "ojb": "m.obj"})"), opts).why().find("obj"),
+            std::string::npos);
+  std::filesystem::remove_all(dir);
 }

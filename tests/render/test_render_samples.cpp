@@ -165,7 +165,10 @@ INSTANTIATE_TEST_SUITE_P(
                       Expect{"comet", 60, 0.005, 0.2, 2, 0.01, 0.999, 0},
                       Expect{"waterfall", 60, 0.03, 0.4, 1, 0.01, 0.999, 300},
                       // Grey-blue drops: no hue asked; the window frame is drawn.
-                      Expect{"rain_on_glass", 60, 0.01, 0.3, 0, 0.01, 0.999, 300}),
+                      Expect{"rain_on_glass", 60, 0.01, 0.3, 0, 0.01, 0.999, 300},
+                      // Green blades over a drawn ground; a ginger coat.
+                      Expect{"grass", 2, 0.15, 0.6, 2, 0.02, 0.999, 300},
+                      Expect{"fur", 2, 0.05, 0.3, 1, 0.01, 0.999, 0}),
     [](const ::testing::TestParamInfo<Expect>& info) { return info.param.name; });
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include "effect/descriptors.hpp"
 #include "effect/effect_parts.hpp"
 #include "effect/json_writer.hpp"
+#include "effect/obj_mesh.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -45,6 +46,12 @@ constexpr std::size_t kMaxCapacity = std::size_t(1) << 30;
 constexpr std::size_t kMaxInlineSamples = std::size_t(1) << 24;  // dense fields, mesh vertices
 
 // ---- small helpers --------------------------------------------------------------------------
+
+std::string byteCount(std::size_t n) {
+  if (n >= (std::size_t(1) << 20) && n % (std::size_t(1) << 20) == 0)
+    return std::to_string(n >> 20) + " MiB";
+  return std::to_string(n) + " bytes";
+}
 
 std::size_t editDistance(std::string_view a, std::string_view b) {
   std::vector<std::size_t> row(b.size() + 1);
@@ -374,6 +381,55 @@ const std::vector<std::string> kDomainTypes = {"point", "line", "triangle", "pla
 
 Domain readDomain(const json& j, const std::string& path, const Loader& L);
 
+/// {"type": "mesh", "obj": "file.obj"}: a Wavefront OBJ file, relative to the effect file's
+/// folder. An error names the field, the file and its line.
+Domain readObjDomain(Obj& o) {
+  const Loader& L = o.loader();
+  std::string file;
+  o.req("obj", file);
+  if (o.has("vertices") || o.has("triangles"))
+    L.fail(o.at("obj"), "give either \"obj\" or \"vertices\" and \"triangles\", not both");
+  std::filesystem::path p(file);
+  if (p.is_relative() && !L.options->baseDir.empty()) p = L.options->baseDir / p;
+  const std::string where = o.at("obj");
+  std::error_code ec;
+  // A regular file only: a folder cannot be read, and a device (/dev/stdin) may never end.
+  const auto st = std::filesystem::status(p, ec);
+  if (std::filesystem::is_directory(st)) L.fail(where, p.string() + ": is a directory");
+  if (std::filesystem::exists(st) && !std::filesystem::is_regular_file(st))
+    L.fail(where, p.string() + ": not a regular file");
+  std::ifstream in(p, std::ios::binary);
+  if (!in) L.fail(where, p.string() + ": cannot open the file");
+  std::string text;
+  const std::size_t limit = L.options->maxFileBytes;
+  char buf[1 << 16];
+  while (in.read(buf, sizeof buf) || in.gcount() > 0) {
+    text.append(buf, std::size_t(in.gcount()));
+    if (text.size() > limit) L.fail(where, p.string() + ": larger than " + byteCount(limit));
+  }
+  if (in.bad()) L.fail(where, p.string() + ": cannot read the file");
+  detail::ObjMesh m;
+  try {
+    m = detail::parseObj(text, kMaxInlineSamples);
+  } catch (const detail::ObjError& e) {
+    L.fail(where, p.string() + ":" + std::to_string(e.line()) + ": " + e.why());
+  }
+  try {
+    return Domain::mesh(std::move(m.vertices), std::move(m.triangles));
+  } catch (const InvalidArgument& e) {
+    // "mesh.triangles[k]": a degenerate face; name the line it came from.
+    const std::string& param = e.parameter();
+    const std::string prefix = "mesh.triangles[";
+    std::size_t k = std::string::npos;
+    if (param.compare(0, prefix.size(), prefix) == 0)
+      std::from_chars(param.data() + prefix.size(), param.data() + param.size(), k);
+    const std::string why = std::string(e.what()).substr(param.size() + 2);
+    if (k < m.triangleLines.size())
+      L.fail(where, p.string() + ":" + std::to_string(m.triangleLines[k]) + ": " + why);
+    L.fail(where, p.string() + ": " + e.what());
+  }
+}
+
 Domain readDomainObject(Obj& o, const std::string& type) {
   const Loader& L = o.loader();
   std::optional<Domain> described;
@@ -386,7 +442,8 @@ Domain readDomainObject(Obj& o, const std::string& type) {
   });
   if (described) return std::move(*described);
   if (type == "mesh") {
-    const json& vs = o.require("vertices");
+    if (o.get("obj")) return readObjDomain(o);
+    const json& vs = o.require("vertices", "[[x, y, z], ...], or \"obj\": a file");
     const std::string vp = o.at("vertices");
     arrayOf(vs, vp, L, 0, "an array of [x, y, z]");
     if (vs.size() > kMaxInlineSamples) L.fail(vp, "too many vertices");
@@ -1251,14 +1308,6 @@ std::string saveEffect(const Effect& fx) {
   jsonio::print(o, out, 0);
   return out + "\n";
 }
-
-namespace {
-std::string byteCount(std::size_t n) {
-  if (n >= (std::size_t(1) << 20) && n % (std::size_t(1) << 20) == 0)
-    return std::to_string(n >> 20) + " MiB";
-  return std::to_string(n) + " bytes";
-}
-}  // namespace
 
 Effect loadEffect(const std::filesystem::path& file, EffectLoadOptions options) {
   namespace fs = std::filesystem;

@@ -126,12 +126,14 @@ ojson objectSchema(const char* type) {
 
 struct DomainKind {
   const char* name;
-  std::vector<std::pair<const char*, const char*>> fields;  // key, $def of its value
+  std::vector<std::pair<const char*, const char*>> fields;  // key, $def of its items (null: a path)
   std::vector<const char*> required;
 };
 const std::vector<DomainKind>& domainKinds() {
   static const std::vector<DomainKind> kinds = {
       {"mesh", {{"vertices", "vec3"}, {"triangles", "triangleIndices"}}, {"vertices", "triangles"}},
+      // The same mesh read from a Wavefront OBJ file (relative to the effect file).
+      {"mesh", {{"obj", nullptr}}, {"obj"}},
       {"union", {{"parts", "domain"}}, {"parts"}},
   };
   return kinds;
@@ -146,7 +148,8 @@ ojson domainSchema() {
   for (const DomainKind& k : domainKinds()) {
     ojson props = {{"type", {{"const", k.name}}}, {"$comment", {{"type", "string"}}}};
     for (const auto& [key, def] : k.fields) {
-      props[key] = {{"type", "array"}, {"items", defRef(def)}};
+      props[key] = def ? ojson{{"type", "array"}, {"items", defRef(def)}}
+                       : ojson{{"type", "string"}, {"description", "a file path"}};
     }
     ojson required = {"type"};
     for (const char* r : k.required) required.push_back(r);
@@ -410,7 +413,9 @@ std::string effectReference() {
   out +=
       "## Domains\n\n"
       "A domain is `[x, y, z]` (a point) or `{\"type\": \"kind\", ...fields}`; besides the "
-      "kinds below, `mesh` (`vertices` [[x, y, z], ...], `triangles` [[i, j, k], ...]) and "
+      "kinds below, `mesh` (`vertices` [[x, y, z], ...], `triangles` [[i, j, k], ...], or "
+      "`obj`: a Wavefront OBJ file, relative to the effect file, whose `v` and `f` lines are "
+      "read, polygons fanned into triangles) and "
       "`union` (`parts`: domains) hold lists.\n\n";
   desc::forEachDomainKind([&](auto tag) { out += table<typename decltype(tag)::type>("###"); });
   out.pop_back();  // one newline at the end
