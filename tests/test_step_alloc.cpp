@@ -44,3 +44,51 @@ TEST(StepAllocations, SteadySmallGroupAllocatesNothing) {
     EXPECT_EQ(allocationsPerSteadyStep(threads, Integrator::RK4), 0u) << threads;
   }
 }
+
+namespace {
+// The fountain above as an effect instance a game moves every frame: setTransform before
+// each step, and the emitters read through the non-const span (which may edit them) and the
+// const accessors (issue #15).
+std::size_t allocationsPerMovingStep(Space space) {
+  Context ctx;
+  Group& g = ctx.createGroup("moving", 1500);
+  Emitter e;
+  e.shape = Domain::disc(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f), 0.1f);
+  ParticleType t;
+  t.velocity = Domain::cone(Vec3(0.0f), Vec3(0.0f, 8.0f, 0.0f), 1.5f);
+  t.lifetime = Fuzzy::percent(2.0f, 10.0f);
+  e.types = {t};
+  e.rate = 500.0;
+  e.path = {{0.0, Vec3(0.0f)}, {10.0, Vec3(1.0f, 0.0f, 0.0f)}};
+  g.addEmitter(e);
+  g.setActions({Gravity{Vec3(0.0f, -9.81f, 0.0f)},
+                Bounce{Domain::plane(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f)), 0.4f, 0.1f, 0.0f},
+                Sink{Domain::sphere(Vec3(0.0f, 4.0f, 0.0f), 0.5f)}, Move{}, KillOld{}});
+  g.setSpace(space);
+  std::size_t frame = 0;
+  auto moveAndStep = [&] {
+    Transform at;
+    at.position = Vec3(0.01f * float(frame), 0.0f, 0.02f * float(frame));
+    at.rotation = glm::angleAxis(0.01f * float(frame), Vec3(0.0f, 1.0f, 0.0f));
+    at.scale = 1.0f + 0.001f * float(frame);
+    ++frame;
+    g.setTransform(at);
+    g.emitters()[0].rate = 500.0;  // an edit through the span, as a game's may
+    EXPECT_EQ(g.actions().size(), 5u);
+    EXPECT_EQ(g.transform().position, at.position);
+    ctx.step();
+  };
+  for (int k = 0; k < 150; ++k) moveAndStep();
+  allocations = 0;
+  counting = true;
+  for (int k = 0; k < 60; ++k) moveAndStep();
+  counting = false;
+  EXPECT_GT(g.size(), 800u);
+  return allocations;
+}
+}  // namespace
+
+TEST(StepAllocations, AnInstanceMovedEveryStepAllocatesNothing) {
+  EXPECT_EQ(allocationsPerMovingStep(Space::World), 0u);
+  EXPECT_EQ(allocationsPerMovingStep(Space::Local), 0u);
+}

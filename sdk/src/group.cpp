@@ -244,6 +244,7 @@ Group& Group::setActions(ActionList actions) {
   }
   impl_->actions = std::move(actions);
   ++impl_->actionsVersion;  // the fused pass's plan is rebuilt
+  ++impl_->actionsStructure;
   impl_->stats.killedByAction.assign(impl_->actions.size(), 0);
   impl_->ensureStorage();
   impl_->hostChanged();
@@ -296,6 +297,33 @@ void carryParticles(detail::GroupImpl& g, const Transform& from, const Transform
 
 }  // namespace
 
+namespace {
+
+// The world emitters and prime emitters as the frame's carried by t, in the storage of the
+// last ones: lists of the same lengths are assigned element by element, so that a group
+// moved every step allocates nothing (see carryEmitter for what still does).
+void deriveEmitters(detail::GroupImpl& g, const Transform& t) {
+  const detail::Frame& f = *g.frame;
+  const bool identity = t.isIdentity();
+  g.emitters = f.emitters;
+  if (!identity)
+    for (Emitter& e : g.emitters) detail::carryEmitter(e, t);
+  g.primes = f.primes;
+  if (!identity)
+    for (PrimeEmitter& p : g.primes) detail::carryPrime(p, t);
+  // A spec no live emitter holds is rewritten in place; one a live emitter holds stays as
+  // that emitter was spawned with.
+  g.primeSpecs.resize(g.primes.size());
+  for (std::size_t k = 0; k < g.primes.size(); ++k) {
+    if (g.primeSpecs[k] && g.primeSpecs[k].use_count() == 1)
+      *g.primeSpecs[k] = g.primes[k].child;
+    else
+      g.primeSpecs[k] = std::make_shared<EmitterSpec>(g.primes[k].child);
+  }
+}
+
+}  // namespace
+
 Group& Group::setTransform(const Transform& transform) {
   transform.validate("transform");
   Transform t = transform;
@@ -303,40 +331,35 @@ Group& Group::setTransform(const Transform& transform) {
   if (t.rotation == glm::quat(-1.0f, 0.0f, 0.0f, 0.0f)) t.rotation = glm::quat(1.0f, 0, 0, 0);
   auto& g = *impl_;
   const bool first = !g.frame;
-  const detail::Frame* f = g.frame.get();
-  const ActionList& local = f ? f->actions : g.actions;
-  const std::vector<Emitter>& localEmitters = f ? f->emitters : g.emitters;
-  const std::vector<PrimeEmitter>& localPrimes = f ? f->primes : g.primes;
-  // Everything derived first, so that a refused transform leaves the group as it was.
-  const bool identity = t.isIdentity();
-  ActionList world = identity ? local : detail::transformActions(local, t);
-  std::vector<Emitter> emitters;
-  std::vector<PrimeEmitter> primes;
-  emitters.reserve(localEmitters.size());
-  primes.reserve(localPrimes.size());
-  for (const Emitter& e : localEmitters)
-    emitters.push_back(identity ? e : detail::transformEmitter(e, t));
-  for (const PrimeEmitter& p : localPrimes)
-    primes.push_back(identity ? p : detail::transformPrime(p, t));
   if (first) {
+    // The lists as given become the frame's; the world's are their images at the identity.
     g.frame = std::make_unique<detail::Frame>();
     g.frame->actions = g.actions;
     g.frame->emitters = g.emitters;
     g.frame->primes = g.primes;
   }
   detail::Frame& fr = *g.frame;
+  // The world's lists are rewritten in place (a move allocates nothing); one that refuses the
+  // transform (a box turned by other than quarter turns) is derived again at the old one, so
+  // that the group is left as it was.
+  try {
+    if (!detail::placeActions(g.actions, fr.actions, t))
+      g.actions = detail::transformActions(fr.actions, t);
+    deriveEmitters(g, t);
+  } catch (...) {
+    if (!detail::placeActions(g.actions, fr.actions, fr.transform))
+      g.actions = detail::transformActions(fr.actions, fr.transform);
+    deriveEmitters(g, fr.transform);
+    if (first) g.frame.reset();
+    throw;
+  }
   if (fr.space == Space::Local) carryParticles(g, fr.transform, t);
   fr.transform = t;
-  // Only the actions' constants change: a device backend uploads them, and its program (which
-  // depends on the kinds of actions and domains alone) is kept.
-  g.actions = std::move(world);
+  // Only the actions' constants change (actionsStructure stays): a device backend uploads
+  // them, and its program (which depends on the kinds of actions and domains alone) is kept.
   ++g.actionsVersion;
-  g.emitters = std::move(emitters);
-  g.primes = std::move(primes);
-  g.primeSpecs.clear();
-  for (const PrimeEmitter& p : g.primes)
-    g.primeSpecs.push_back(std::make_shared<EmitterSpec>(p.child));
-  ++g.emittersVersion;
+  // The emitters' kinds stay too; their values are read every step.
+  if (first) ++g.emittersVersion;
   fr.emittersDerived = g.emittersVersion;
   return *this;
 }
@@ -358,15 +381,7 @@ Space Group::space() const {
 
 void detail::GroupImpl::placeEmitters() {
   if (!frame || frame->emittersDerived == emittersVersion) return;
-  const Transform& t = frame->transform;
-  const bool identity = t.isIdentity();
-  emitters.clear();
-  for (const Emitter& e : frame->emitters)
-    emitters.push_back(identity ? e : transformEmitter(e, t));
-  primes.clear();
-  for (const PrimeEmitter& p : frame->primes) primes.push_back(identity ? p : transformPrime(p, t));
-  primeSpecs.clear();
-  for (const PrimeEmitter& p : primes) primeSpecs.push_back(std::make_shared<EmitterSpec>(p.child));
+  deriveEmitters(*this, frame->transform);
   ++emittersVersion;
   frame->emittersDerived = emittersVersion;
 }

@@ -168,6 +168,10 @@ struct GroupImpl {
   AttributeSet stored;  ///< what the lanes hold now
   ActionList actions;   ///< replace through Group::setActions, which bumps actionsVersion
   std::uint64_t actionsVersion = 0;
+  /// Bumped by Group::setActions only: a move (Group::setTransform) changes the actions'
+  /// constants (actionsVersion), never their kinds or order, so that a device backend keeps
+  /// its program without generating it again.
+  std::uint64_t actionsStructure = 0;
   std::vector<Emitter> emitters;
   /// Bumped wherever the emitters or prime emitters may change (addEmitter, emitters(),
   /// addPrimeEmitter): the OpenCL backend rebuilds what it derives from them only then.
@@ -175,7 +179,9 @@ struct GroupImpl {
   std::vector<EmitterState> emitterState;
   std::vector<PrimeEmitter> primes;
   std::vector<EmitterState> primeState;
-  std::vector<std::shared_ptr<const EmitterSpec>> primeSpecs;  ///< primes[k].child, shared
+  /// primes[k].child, shared with the live emitters spawned from it (a move rewrites one
+  /// no live emitter holds in place).
+  std::vector<std::shared_ptr<EmitterSpec>> primeSpecs;
   std::vector<LiveEmitter> live;         ///< grown only up to the primes' maxEmitters together
   std::vector<std::uint32_t> primeLive;  ///< live emitters of each prime emitter
   std::uint32_t nextEmitterId = 0;

@@ -145,120 +145,175 @@ void carryMotion(E& e, const Transform& t) {
   for (Keyframe& k : e.path) k.position = t.point(k.position);
 }
 
-void carry(Falloff& f, const Transform& t) {
-  f.center = t.point(f.center);
-  f.radius *= t.scale;
+// A prime emitter's children: their emission (shape relative to the moving child, particle
+// types) and their launch velocities; their acceleration is a world one, like Gravity. The
+// `next` levels are shared with the frame's: each is replaced by a carried copy.
+void carrySpec(EmitterSpec& c, const Transform& t) {
+  c.emitter.shape = c.emitter.shape.transformed(linearOf(t));
+  c.emitter.velocity = t.direction(c.emitter.velocity);
+  for (ParticleType& type : c.emitter.types) carry(type, t);
+  c.emitter.spacing *= t.scale;
+  c.velocity = c.velocity.transformed(rotationOf(t));
+  if (c.next) {
+    auto n = std::make_shared<EmitterSpec>(*c.next);
+    carrySpec(*n, t);
+    c.next = std::move(n);
+  }
+}
+
+// What a transform does to each kind of geometry. The identity leaves every value as it is
+// (carried through t, -0 would become +0 and an infinite coordinate NaN).
+struct Carrier {
+  const Transform& t;
+  Transform r;  // the rotation alone
+  float s, s2;
+  bool identity;
+  explicit Carrier(const Transform& tr)
+      : t(tr), r(rotationOf(tr)), s(tr.scale), s2(tr.scale * tr.scale), identity(tr.isIdentity()) {}
+  Vec3 point(Vec3 p) const { return identity ? p : t.point(p); }
+  Vec3 direction(Vec3 v) const { return identity ? v : t.direction(v); }
+  float length(float x) const { return identity ? x : x * s; }
+  float area(float x) const { return identity ? x : x * s2; }
+  Domain place(const Domain& d) const { return identity ? d : d.transformed(t); }
+  Domain turn(const Domain& d) const { return identity ? d : d.transformed(r); }
+  Falloff falloff(Falloff f) const {
+    f.center = point(f.center);
+    f.radius = length(f.radius);
+    return f;
+  }
+};
+
+// Writes into w (a copy of l, or l's image under another transform: the same kind) the
+// geometry of l's image under c; what has no geometry is left as w has it.
+void carryAction(Action& w, const Action& l, const Carrier& c) {
+  std::visit(
+      [&](auto& x) {
+        using T = std::decay_t<decltype(x)>;
+        const T& y = std::get<T>(l);
+        if constexpr (std::is_same_v<T, Gravity> || std::is_same_v<T, Damping> ||
+                      std::is_same_v<T, Turbulence> || std::is_same_v<T, SampledField>) {
+          x.falloff = c.falloff(y.falloff);  // world fields; where they act follows
+        } else if constexpr (std::is_same_v<T, OrbitPoint>) {
+          x.center = c.point(y.center);
+          x.epsilon = c.area(y.epsilon);  // a squared length
+          x.maxRadius = c.length(y.maxRadius);
+        } else if constexpr (std::is_same_v<T, OrbitLine>) {
+          x.point = c.point(y.point);
+          x.axis = c.direction(y.axis);
+          x.epsilon = c.area(y.epsilon);
+          x.maxRadius = c.length(y.maxRadius);
+        } else if constexpr (std::is_same_v<T, Gravitate> || std::is_same_v<T, Follow> ||
+                             std::is_same_v<T, MatchVelocity> ||
+                             std::is_same_v<T, MatchRotVelocity>) {
+          x.epsilon = c.area(y.epsilon);
+          x.maxRadius = c.length(y.maxRadius);
+        } else if constexpr (std::is_same_v<T, Vortex>) {
+          x.center = c.point(y.center);
+          x.axis = c.direction(y.axis);
+          x.coreRadius = c.length(y.coreRadius);
+          x.maxRadius = c.length(y.maxRadius);
+        } else if constexpr (std::is_same_v<T, Jet>) {
+          x.center = c.point(y.center);
+          x.radius = c.length(y.radius);
+          x.acceleration = c.turn(y.acceleration);
+        } else if constexpr (std::is_same_v<T, Explosion>) {
+          x.center = c.point(y.center);
+          x.stddev = c.length(y.stddev);
+          x.epsilon = c.area(y.epsilon);
+        } else if constexpr (std::is_same_v<T, RandomAccel>) {
+          x.acceleration = c.turn(y.acceleration);
+          x.falloff = c.falloff(y.falloff);
+        } else if constexpr (std::is_same_v<T, RandomDisplace>) {
+          x.displacement = c.turn(y.displacement);
+        } else if constexpr (std::is_same_v<T, RandomVelocity>) {
+          x.velocity = c.turn(y.velocity);
+        } else if constexpr (std::is_same_v<T, RandomRotVelocity>) {
+          x.rotVelocity = c.turn(y.rotVelocity);
+        } else if constexpr (std::is_same_v<T, ElectricField> || std::is_same_v<T, MagneticField>) {
+          x.field = c.direction(y.field);
+          x.falloff = c.falloff(y.falloff);
+        } else if constexpr (std::is_same_v<T, Avoid>) {
+          x.obstacle = c.place(y.obstacle);
+          x.epsilon = c.area(y.epsilon);
+        } else if constexpr (std::is_same_v<T, TargetVelocity>) {
+          x.velocity = c.direction(y.velocity);
+        } else if constexpr (std::is_same_v<T, TargetRotVelocity>) {
+          x.rotVelocity = c.direction(y.rotVelocity);
+        } else if constexpr (std::is_same_v<T, Bounce>) {
+          x.surface = c.place(y.surface);
+          x.planeNormal = c.direction(y.planeNormal);
+        } else if constexpr (std::is_same_v<T, Sink> || std::is_same_v<T, Block>) {
+          x.region = c.place(y.region);
+        } else if constexpr (std::is_same_v<T, SinkVelocity>) {
+          x.velocity = c.turn(y.velocity);
+        } else if constexpr (std::is_same_v<T, Constrain2D>) {
+          x.point = c.point(y.point);
+          x.normal = c.direction(y.normal);
+        }
+        // The rest has no geometry (ages, colours, sizes, speeds, callbacks).
+      },
+      w);
+}
+
+Substeps carrySubsteps(Substeps sub, const Carrier& c) {
+  sub.maxDistance = c.length(sub.maxDistance);
+  return sub;
 }
 
 }  // namespace
 
+/// Gives the library's own code the list's actions to rewrite in place.
+struct ActionListAccess {
+  static std::vector<Action>& actions(ActionList& list) { return list.actions_; }
+};
+
+void carryEmitter(Emitter& e, const Transform& t) {
+  carryMotion(e, t);
+  for (ParticleType& type : e.types) carry(type, t);
+  e.spacing *= t.scale;  // a length travelled
+}
+
+void carryPrime(PrimeEmitter& e, const Transform& t) {
+  carryMotion(e, t);
+  carrySpec(e.child, t);
+}
+
 Emitter transformEmitter(const Emitter& e, const Transform& t) {
   Emitter w = e;
-  carryMotion(w, t);
-  for (ParticleType& type : w.types) carry(type, t);
-  w.spacing *= t.scale;  // a length travelled
+  carryEmitter(w, t);
   return w;
 }
 
 PrimeEmitter transformPrime(const PrimeEmitter& e, const Transform& t) {
   PrimeEmitter w = e;
-  carryMotion(w, t);
-  // The children: their emission (shape relative to the moving child, particle types) and
-  // their launch velocities; their acceleration is a world one, like Gravity.
-  auto carrySpec = [&](auto& self, const EmitterSpec& spec) -> std::shared_ptr<EmitterSpec> {
-    auto c = std::make_shared<EmitterSpec>(spec);
-    c->emitter.shape = c->emitter.shape.transformed(linearOf(t));
-    c->emitter.velocity = t.direction(c->emitter.velocity);
-    for (ParticleType& type : c->emitter.types) carry(type, t);
-    c->emitter.spacing *= t.scale;
-    c->velocity = c->velocity.transformed(rotationOf(t));
-    if (spec.next) c->next = self(self, *spec.next);
-    return c;
-  };
-  w.child = *carrySpec(carrySpec, e.child);
+  carryPrime(w, t);
   return w;
 }
 
 ActionList transformActions(const ActionList& list, const Transform& t) {
-  const Transform r = rotationOf(t);
-  const float s = t.scale, s2 = t.scale * t.scale;
+  const Carrier c(t);
   ActionList out;
   out.setIntegrator(list.integrator());
-  Substeps sub = list.substeps();
-  sub.maxDistance *= s;
-  out.setSubsteps(sub);
+  out.setSubsteps(carrySubsteps(list.substeps(), c));
   for (const Action& a : list.actions()) {
     Action w = a;
-    std::visit(
-        [&](auto& x) {
-          using T = std::decay_t<decltype(x)>;
-          if constexpr (std::is_same_v<T, Gravity> || std::is_same_v<T, Damping> ||
-                        std::is_same_v<T, Turbulence> || std::is_same_v<T, SampledField>) {
-            carry(x.falloff, t);  // world fields; where they act follows
-          } else if constexpr (std::is_same_v<T, OrbitPoint>) {
-            x.center = t.point(x.center);
-            x.epsilon *= s2;  // a squared length
-            x.maxRadius *= s;
-          } else if constexpr (std::is_same_v<T, OrbitLine>) {
-            x.point = t.point(x.point);
-            x.axis = t.direction(x.axis);
-            x.epsilon *= s2;
-            x.maxRadius *= s;
-          } else if constexpr (std::is_same_v<T, Gravitate> || std::is_same_v<T, Follow> ||
-                               std::is_same_v<T, MatchVelocity> ||
-                               std::is_same_v<T, MatchRotVelocity>) {
-            x.epsilon *= s2;
-            x.maxRadius *= s;
-          } else if constexpr (std::is_same_v<T, Vortex>) {
-            x.center = t.point(x.center);
-            x.axis = t.direction(x.axis);
-            x.coreRadius *= s;
-            x.maxRadius *= s;
-          } else if constexpr (std::is_same_v<T, Jet>) {
-            x.center = t.point(x.center);
-            x.radius *= s;
-            x.acceleration = x.acceleration.transformed(r);
-          } else if constexpr (std::is_same_v<T, Explosion>) {
-            x.center = t.point(x.center);
-            x.stddev *= s;
-            x.epsilon *= s2;
-          } else if constexpr (std::is_same_v<T, RandomAccel>) {
-            x.acceleration = x.acceleration.transformed(r);
-            carry(x.falloff, t);
-          } else if constexpr (std::is_same_v<T, RandomDisplace>) {
-            x.displacement = x.displacement.transformed(r);
-          } else if constexpr (std::is_same_v<T, RandomVelocity>) {
-            x.velocity = x.velocity.transformed(r);
-          } else if constexpr (std::is_same_v<T, RandomRotVelocity>) {
-            x.rotVelocity = x.rotVelocity.transformed(r);
-          } else if constexpr (std::is_same_v<T, ElectricField> ||
-                               std::is_same_v<T, MagneticField>) {
-            x.field = t.direction(x.field);
-            carry(x.falloff, t);
-          } else if constexpr (std::is_same_v<T, Avoid>) {
-            x.obstacle = x.obstacle.transformed(t);
-            x.epsilon *= s2;
-          } else if constexpr (std::is_same_v<T, TargetVelocity>) {
-            x.velocity = t.direction(x.velocity);
-          } else if constexpr (std::is_same_v<T, TargetRotVelocity>) {
-            x.rotVelocity = t.direction(x.rotVelocity);
-          } else if constexpr (std::is_same_v<T, Bounce>) {
-            x.surface = x.surface.transformed(t);
-            x.planeNormal = t.direction(x.planeNormal);
-          } else if constexpr (std::is_same_v<T, Sink> || std::is_same_v<T, Block>) {
-            x.region = x.region.transformed(t);
-          } else if constexpr (std::is_same_v<T, SinkVelocity>) {
-            x.velocity = x.velocity.transformed(r);
-          } else if constexpr (std::is_same_v<T, Constrain2D>) {
-            x.point = t.point(x.point);
-            x.normal = t.direction(x.normal);
-          }
-          // The rest has no geometry (ages, colours, sizes, speeds, callbacks).
-        },
-        w);
+    carryAction(w, a, c);
     out.add(std::move(w));
   }
   return out;
+}
+
+bool placeActions(ActionList& world, const ActionList& local, const Transform& t) {
+  std::vector<Action>& w = ActionListAccess::actions(world);
+  const std::vector<Action>& l = local.actions();
+  if (w.size() != l.size()) return false;
+  for (std::size_t k = 0; k < w.size(); ++k)
+    if (w[k].index() != l[k].index()) return false;
+  const Carrier c(t);
+  world.setSubsteps(carrySubsteps(local.substeps(), c));
+  world.setIntegrator(local.integrator());
+  for (std::size_t k = 0; k < w.size(); ++k) carryAction(w[k], l[k], c);
+  return true;
 }
 
 }  // namespace detail

@@ -721,6 +721,74 @@ static void test_transform(void) {
   OK(flurry_effect_destroy(fx));
 }
 
+/* Effect instances: built twice in one context, each placed, moved and prewarmed on its own;
+ * destroying one removes its groups. */
+static void test_instances(void) {
+  const char* json =
+      "{\"name\": \"t\", \"dt\": 0.1, \"groups\": [{\"name\": \"g\", \"capacity\": 4,"
+      " \"emitters\": [{\"bursts\": [{\"time\": 0, \"count\": 1}]}],"
+      " \"actions\": [{\"type\": \"Move\"}]}, {\"name\": \"h\", \"capacity\": 4}]}";
+  flurry_effect* fx = NULL;
+  flurry_context* ctx = NULL;
+  flurry_context_options o;
+  flurry_instance *a = NULL, *b = NULL, *dup = NULL;
+  flurry_group *g = NULL, *found = NULL;
+  const char* name = NULL;
+  const float* x = NULL;
+  size_t n = 0, stride = 0, count = 0;
+  float pos[3] = {5, 2, -3}, rot[4] = {0, 0, 0, 1}, back[3] = {0}, scale = 0;
+  const float zero[4] = {0, 0, 0, 0};
+  uint64_t steps = 0;
+  OK(flurry_effect_parse(json, "t", &fx));
+  OK(flurry_effect_context_options(fx, &o));
+  OK(flurry_context_create(&o, &ctx));
+  OK(flurry_effect_instantiate(fx, ctx, "a", 0, &a));
+  OK(flurry_effect_instantiate(fx, ctx, "b", 0, &b));
+  OK(flurry_instance_group_count(a, &count));
+  CHECK(count == 2);
+  OK(flurry_instance_group_at(a, 0, &g));
+  OK(flurry_group_name(g, &name));
+  CHECK(strcmp(name, "g@a") == 0);
+  OK(flurry_context_group(ctx, "g@a", &found));
+  CHECK(found == g);
+  OK(flurry_instance_set_transform(a, pos, rot, 2.0f));
+  OK(flurry_instance_transform(a, back, NULL, &scale));
+  CHECK(back[0] == 5.0f && scale == 2.0f);
+  OK(flurry_context_step(ctx));
+  OK(flurry_group_lane(g, FLURRY_ATTR_POSITION, 0, &x, &n, &stride));
+  CHECK(n == 1 && x[0] == 5.0f); /* born at the instance's place */
+  OK(flurry_instance_group_at(b, 0, &g));
+  OK(flurry_group_lane(g, FLURRY_ATTR_POSITION, 0, &x, &n, &stride));
+  CHECK(n == 1 && x[0] == 0.0f); /* the other instance stayed at the origin */
+  /* A refused transform leaves the instance where it was. */
+  FAILS(flurry_instance_set_transform(a, pos, zero, 1), FLURRY_ERROR_INVALID_ARGUMENT,
+        "transform.rotation");
+  OK(flurry_instance_transform(a, NULL, NULL, &scale));
+  CHECK(scale == 2.0f);
+  OK(flurry_instance_prewarm(b, 0.5, &steps));
+  CHECK(steps == 5);
+  FAILS(flurry_instance_prewarm(b, -1, NULL), FLURRY_ERROR_INVALID_ARGUMENT, "seconds");
+  FAILS(flurry_instance_group_at(a, 2, &g), FLURRY_ERROR_NOT_FOUND, "group index 2");
+  FAILS(flurry_effect_instantiate(fx, ctx, NULL, 0, &a), FLURRY_ERROR_NULL_ARGUMENT, "name");
+  FAILS(flurry_effect_instantiate(NULL, ctx, "c", 0, &a), FLURRY_ERROR_NULL_ARGUMENT, "effect");
+  FAILS(flurry_instance_set_transform(NULL, pos, rot, 1), FLURRY_ERROR_NULL_ARGUMENT, "instance");
+  FAILS(flurry_instance_set_transform(a, NULL, rot, 1), FLURRY_ERROR_NULL_ARGUMENT, "position");
+  FAILS(flurry_instance_group_count(NULL, &count), FLURRY_ERROR_NULL_ARGUMENT, "instance");
+  FAILS(flurry_instance_prewarm(NULL, 1, NULL), FLURRY_ERROR_NULL_ARGUMENT, "instance");
+  /* The same name twice is refused (its groups exist). */
+  CHECK(flurry_effect_instantiate(fx, ctx, "a", 0, &dup) != FLURRY_OK && dup == NULL);
+  OK(flurry_context_group_count(ctx, &count));
+  CHECK(count == 4);
+  OK(flurry_instance_destroy(a));
+  OK(flurry_context_group_count(ctx, &count));
+  CHECK(count == 2);
+  CHECK(flurry_context_group(ctx, "g@a", &found) == FLURRY_ERROR_NOT_FOUND);
+  OK(flurry_instance_destroy(NULL));
+  OK(flurry_instance_destroy(b));
+  OK(flurry_context_destroy(ctx));
+  OK(flurry_effect_destroy(fx));
+}
+
 int main(int argc, char** argv) {
   if (argc != 3) {
     fprintf(stderr, "usage: test_c_api FOUNTAIN_JSON OUT_DIR\n");
@@ -735,6 +803,7 @@ int main(int argc, char** argv) {
   test_group(argv[2]);
   test_visible();
   test_transform();
+  test_instances();
   if (failures) {
     fprintf(stderr, "%d checks failed\n", failures);
     return 1;

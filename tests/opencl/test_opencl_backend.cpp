@@ -497,6 +497,35 @@ TEST(OpenCLBackend, InstanceTransformsMatchTheCpuWithoutARebuild) {
   EXPECT_EQ(after.memoryHits, before.memoryHits);
 }
 
+// A move keeps the program except where its text holds a value the move scales: sub-steps
+// by distance write maxDistance as a literal, so a scaled instance needs its own program.
+TEST(OpenCLBackend, AScaledInstanceWithSubstepsByDistanceMatchesTheCpu) {
+  FLURRY_REQUIRE_OPENCL();
+  const Effect fx = parseEffect(R"({"name": "fast", "dt": 0.02,
+    "groups": [{"name": "fast", "capacity": 2000,
+      "emitters": [{"position": [0, 1, 0], "rate": 300, "types": [{"lifetime": 5,
+                    "velocity": {"type": "sphere", "center": [0, -30, 0], "outerRadius": 5}}]}],
+      "substeps": {"maxDistance": 0.05, "maxSubsteps": 16},
+      "actions": [{"type": "Gravity"}, {"type": "Bounce", "surface": {"type": "disc",
+                   "center": [0, 0, 0], "normal": [0, 1, 0], "outerRadius": 40},
+                   "restitution": 0.5}, {"type": "Move"}, {"type": "KillOld"}]}]})");
+  auto run = [&](Backend backend) {
+    ContextOptions o = fx.contextOptions();
+    o.backend = backend;
+    o.threads = 2;
+    Context ctx(o);
+    EffectInstance inst = fx.instantiate(ctx, "a");
+    inst.setTransform(Transform{Vec3(1, 0, 0), glm::quat(1, 0, 0, 0), 1.0f});
+    ctx.run(20);
+    inst.setTransform(Transform{Vec3(1, 0, 0), glm::quat(1, 0, 0, 0), 3.0f});
+    ctx.run(20);
+    return test::resultOf(*inst.groups()[0]);
+  };
+  const test::RunResult cpu = run(Backend::Cpu), cl = run(Backend::OpenCL);
+  ASSERT_GT(cpu.size, 100u);
+  test::expectSame(cpu, cl);
+}
+
 // A new action list of other kinds over the same stored attributes needs another program
 // (the one built for the old list would run the old actions with the new constants).
 TEST(OpenCLBackend, NewActionKindsOverTheSameAttributesGetTheirProgram) {

@@ -35,3 +35,31 @@ TEST(OpenCLStepAllocations, SteadyGroupAllocatesNothing) {
   EXPECT_EQ(allocationsPerSteadyStep(10000, 2000), 0u);
   EXPECT_EQ(allocationsPerSteadyStep(100000, 20000), 0u);
 }
+
+// An instance moved every step: the move only changes the actions' constants, which go up
+// without the program's text being generated again (issue #15).
+TEST(OpenCLStepAllocations, AnInstanceMovedEveryStepAllocatesNothing) {
+  FLURRY_REQUIRE_OPENCL();
+  ContextOptions o;
+  o.seed = 3;
+  o.threads = 2;
+  o.backend = Backend::OpenCL;
+  Context ctx(o);
+  Group& g = samples::buildFountain(ctx, 10000, 2000, 2.0f);
+  std::size_t frame = 0;
+  auto moveAndRun = [&](int steps) {
+    for (int k = 0; k < steps; ++k, ++frame) {
+      const float f = float(frame);
+      g.setTransform(Transform{Vec3(0.01f * f, 0.0f, 0.02f * f),
+                               glm::angleAxis(0.01f * f, Vec3(0.0f, 1.0f, 0.0f)), 1.0f});
+      ctx.step();
+    }
+  };
+  moveAndRun(90);
+  allocations = 0;
+  counting = true;
+  moveAndRun(30);
+  counting = false;
+  EXPECT_GT(g.size(), 2000u);
+  EXPECT_EQ(allocations, 0u);
+}

@@ -82,6 +82,7 @@ typedef struct flurry_group flurry_group;
 typedef struct flurry_effect flurry_effect;
 typedef struct flurry_action_list flurry_action_list;
 typedef struct flurry_emitter flurry_emitter;
+typedef struct flurry_instance flurry_instance;
 
 /* ---- version and errors ------------------------------------------------------------------ */
 
@@ -268,6 +269,37 @@ FLURRY_C_EXPORT flurry_status flurry_group_space(const flurry_group* group, flur
 FLURRY_C_EXPORT flurry_status flurry_context_prewarm(flurry_context* ctx,
                                                      flurry_group* const* groups, size_t count,
                                                      double seconds, uint64_t* steps);
+
+/* ---- effect instances ------------------------------------------------------------------- */
+
+/** Builds the effect into `ctx` as an instance a game places, moves and prewarms
+ * (flurry::Effect::instantiate): its groups are named "GROUP@NAME", so that one effect can be
+ * built many times in a context; max_capacity > 0 caps each group's capacity. The handle
+ * belongs to the caller: flurry_instance_destroy it while `ctx` lives. */
+FLURRY_C_EXPORT flurry_status flurry_effect_instantiate(const flurry_effect* effect,
+                                                        flurry_context* ctx, const char* name,
+                                                        size_t max_capacity, flurry_instance** out);
+/** Removes the instance's groups from its context and frees the handle (NULL is fine). */
+FLURRY_C_EXPORT flurry_status flurry_instance_destroy(flurry_instance* instance);
+/** Places every group of the instance (as flurry_group_set_transform), all or nothing: a
+ * transform a group refuses leaves the whole instance where it was. A move allocates nothing
+ * once the instance has been placed. */
+FLURRY_C_EXPORT flurry_status flurry_instance_set_transform(flurry_instance* instance,
+                                                            const float position[3],
+                                                            const float rotation[4], float scale);
+/** The instance's transform (the identity until one is set); any output may be NULL. */
+FLURRY_C_EXPORT flurry_status flurry_instance_transform(const flurry_instance* instance,
+                                                        float position[3], float rotation[4],
+                                                        float* scale);
+/** Starts the instance as if it had run `seconds` already (flurry_context_prewarm of its
+ * groups); *steps (may be NULL) gets the steps taken. */
+FLURRY_C_EXPORT flurry_status flurry_instance_prewarm(flurry_instance* instance, double seconds,
+                                                      uint64_t* steps);
+FLURRY_C_EXPORT flurry_status flurry_instance_group_count(const flurry_instance* instance,
+                                                          size_t* count);
+/** Group `index` of the instance, in the effect's order (FLURRY_ERROR_NOT_FOUND past them). */
+FLURRY_C_EXPORT flurry_status flurry_instance_group_at(const flurry_instance* instance,
+                                                       size_t index, flurry_group** out);
 
 /** Live particles: indices [0, size). */
 FLURRY_C_EXPORT flurry_status flurry_group_size(const flurry_group* group, size_t* size);

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <new>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -44,6 +45,9 @@ struct flurry_action_list {
 };
 struct flurry_emitter {
   json fields = json::object();
+};
+struct flurry_instance {
+  flurry::EffectInstance instance;
 };
 
 namespace {
@@ -816,6 +820,81 @@ flurry_status flurry_context_prewarm(flurry_context* ctx, flurry_group* const* g
     }
     const std::uint64_t n = ctx->ctx.prewarm(gs, seconds);
     if (steps) *steps = n;
+  });
+}
+flurry_status flurry_effect_instantiate(const flurry_effect* effect, flurry_context* ctx,
+                                        const char* name, size_t max_capacity,
+                                        flurry_instance** out) {
+  return guard([&] {
+    need(effect, "effect");
+    need(ctx, "ctx");
+    need(name, "name");
+    need(out, "out");
+    *out = nullptr;
+    auto inst = std::make_unique<flurry_instance>();
+    inst->instance = effect->fx.instantiate(ctx->ctx, name, max_capacity);
+    *out = inst.release();
+  });
+}
+flurry_status flurry_instance_destroy(flurry_instance* inst) {
+  return guard([&] {
+    if (!inst) return;  // as free(NULL)
+    std::unique_ptr<flurry_instance> owned(inst);
+    owned->instance.destroy();
+  });
+}
+flurry_status flurry_instance_set_transform(flurry_instance* inst, const float position[3],
+                                            const float rotation[4], float scale) {
+  return guard([&] {
+    need(inst, "instance");
+    need(position, "position");
+    need(rotation, "rotation");
+    flurry::Transform t;
+    t.position = flurry::Vec3(position[0], position[1], position[2]);
+    t.rotation = glm::quat(rotation[3], rotation[0], rotation[1], rotation[2]);  // w, x, y, z
+    t.scale = scale;
+    inst->instance.setTransform(t);
+  });
+}
+flurry_status flurry_instance_transform(const flurry_instance* inst, float position[3],
+                                        float rotation[4], float* scale) {
+  return guard([&] {
+    need(inst, "instance");
+    const flurry::Transform& t = inst->instance.transform();
+    if (position)
+      position[0] = t.position.x, position[1] = t.position.y, position[2] = t.position.z;
+    if (rotation)
+      rotation[0] = t.rotation.x, rotation[1] = t.rotation.y, rotation[2] = t.rotation.z,
+      rotation[3] = t.rotation.w;
+    if (scale) *scale = t.scale;
+  });
+}
+flurry_status flurry_instance_prewarm(flurry_instance* inst, double seconds, uint64_t* steps) {
+  return guard([&] {
+    need(inst, "instance");
+    const std::uint64_t n = inst->instance.prewarm(seconds);
+    if (steps) *steps = n;
+  });
+}
+flurry_status flurry_instance_group_count(const flurry_instance* inst, size_t* count) {
+  return guard([&] {
+    need(inst, "instance");
+    need(count, "count");
+    *count = inst->instance.groups().size();
+  });
+}
+flurry_status flurry_instance_group_at(const flurry_instance* inst, size_t index,
+                                       flurry_group** out) {
+  return guard([&] {
+    need(inst, "instance");
+    need(out, "out");
+    *out = nullptr;
+    const std::vector<flurry::Group*>& all = inst->instance.groups();
+    if (index >= all.size())
+      throw Failure{FLURRY_ERROR_NOT_FOUND, "group index " + std::to_string(index) +
+                                                ": the instance has " + std::to_string(all.size()) +
+                                                " groups"};
+    *out = handle(*all[index]);
   });
 }
 flurry_status flurry_group_size(const flurry_group* g, size_t* size) {

@@ -392,6 +392,10 @@ struct Substeps {
   std::uint32_t maxSubsteps = 64;
 };
 
+namespace detail {
+struct ActionListAccess;
+}
+
 /// An ordered list of actions, applied to a group every step.
 class ActionList {
  public:
@@ -422,6 +426,7 @@ class ActionList {
   const Substeps& substeps() const { return substeps_; }
 
  private:
+  friend struct detail::ActionListAccess;  // moves an effect instance's list in place
   std::vector<Action> actions_;
   Integrator integrator_ = Integrator::SemiImplicitEuler;
   Substeps substeps_;

@@ -59,6 +59,26 @@ void setArg(cl_kernel k, cl_uint i, const T& v) {
   check(clSetKernelArg(k, i, sizeof(T), &v), "clSetKernelArg");
 }
 
+// The values of an action list that a move (Group::setTransform) may change and that the
+// program's text depends on (codegen.cpp): the sub-step distance, written as a literal, and
+// whether a Gravity's or Damping's falloff radius is finite (a large one scaled up may
+// overflow). Everything else the text reads is a kind, which a move keeps. Allocates nothing
+// once `out` has grown to the list's length.
+void moveKey(const ActionList& list, std::vector<std::uint32_t>& out) {
+  out.clear();
+  std::uint32_t d;
+  std::memcpy(&d, &list.substeps().maxDistance, sizeof d);
+  out.push_back(d);
+  for (const Action& a : list.actions()) {
+    if (const auto* g = std::get_if<Gravity>(&a))
+      out.push_back(g->falloff.radius < kInfinity);
+    else if (const auto* dm = std::get_if<Damping>(&a))
+      out.push_back(dm->falloff.radius < kInfinity);
+    else
+      out.push_back(2u);
+  }
+}
+
 }  // namespace
 
 /// What every group of one Context shares: the device's runtime and one in-order queue.
@@ -227,11 +247,14 @@ class ClGroup final : public DeviceMirror {
   Program program_;
   ActionList programActions_;
   bool programValid_ = false;
-  // The program's source and options, and the action list version it was last checked for:
-  // a new list may need another program (other kinds of actions or domains), or only new
-  // constants (a transform, a parameter), which go up without a rebuild.
+  // The program's source and options, and the action list structure it was last checked for
+  // (GroupImpl::actionsStructure): a new list may need another program (other kinds of
+  // actions or domains), or only new constants (a parameter), which go up without a
+  // rebuild. A move keeps the structure: only its moveKey is compared (no text generated).
   std::string programSource_, programOptions_;
-  std::uint64_t programCheckedVersion_ = ~std::uint64_t(0);
+  std::uint64_t programCheckedStructure_ = ~std::uint64_t(0);
+  std::uint64_t programCheckedVersion_ = ~std::uint64_t(0);  // actionsVersion, likewise
+  std::vector<std::uint32_t> programMoveKey_, moveKeyScratch_;
   std::string emitterSignature_;
   EmitterCodes emitterCodes_;  // the program's emitter codes, and the planning's scratch
   // The action constants as last packed: for actionsVersion and the step's dt (its bits).
@@ -350,7 +373,9 @@ void ClGroup::buildProgram(GroupImpl& g, bool cull) {
   programActions_ = g.actions;
   programSource_ = gen.source;
   programOptions_ = gen.options;
+  programCheckedStructure_ = g.actionsStructure;
   programCheckedVersion_ = g.actionsVersion;
+  moveKey(g.actions, programMoveKey_);
   programValid_ = true;
 
   // The buffer arguments; scalars are set per step.
@@ -585,11 +610,19 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     programValid_ = false;
   if (g.hair.enabled != hairProgram_ || sp.cull != cullProgram_) programValid_ = false;
   if (programValid_ && programCheckedVersion_ != g.actionsVersion) {
-    const GeneratedProgram gen =
-        generateProgram(g.actions, g.stored, shared_->fp64(),
-                        emissionSource(emitterCodes_.variants), g.hair.enabled, sp.cull);
-    if (gen.source != programSource_ || gen.options != programOptions_) programValid_ = false;
-    programActions_ = g.actions;
+    if (programCheckedStructure_ == g.actionsStructure) {
+      moveKey(g.actions, moveKeyScratch_);
+      if (moveKeyScratch_ != programMoveKey_) programCheckedStructure_ = ~std::uint64_t(0);
+    }
+    if (programCheckedStructure_ != g.actionsStructure) {
+      const GeneratedProgram gen =
+          generateProgram(g.actions, g.stored, shared_->fp64(),
+                          emissionSource(emitterCodes_.variants), g.hair.enabled, sp.cull);
+      if (gen.source != programSource_ || gen.options != programOptions_) programValid_ = false;
+      programActions_ = g.actions;
+      programCheckedStructure_ = g.actionsStructure;
+      moveKey(g.actions, programMoveKey_);
+    }
     programCheckedVersion_ = g.actionsVersion;
   }
   if (!programValid_) buildProgram(g, sp.cull);
