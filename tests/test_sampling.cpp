@@ -6,6 +6,7 @@
 
 #include "flurry/flurry.hpp"
 #include "sampling.hpp"
+#include "shape_math.hpp"
 
 using namespace flurry;
 
@@ -14,7 +15,7 @@ TEST(Sampling, SinCos2PiMatchesLibm) {
   for (int i = 0; i < 100000; ++i) {
     const float u = float(i) / 100000.0f;
     float s, c;
-    detail::sinCos2Pi(u, s, c);
+    detail::kernel::fl_sincos_2pi(u, &s, &c);
     worst = std::max(
         {worst, std::abs(s - std::sin(2 * M_PI * u)), std::abs(c - std::cos(2 * M_PI * u))});
   }
@@ -26,10 +27,11 @@ TEST(Sampling, CubeRootIsAccurate) {
   for (int i = 0; i <= 100000; ++i) {
     const float x = std::pow(float(i) / 100000.0f, 3.0f) * 1000.0f;
     const double exact = std::cbrt(double(x));
-    worst = std::max(worst, std::abs(detail::cbrtNonNegative(x) - exact) / std::max(exact, 1e-30));
+    worst = std::max(worst,
+                     std::abs(detail::kernel::fl_cbrt_nonneg(x) - exact) / std::max(exact, 1e-30));
   }
   EXPECT_LT(worst, 5e-7);
-  EXPECT_EQ(detail::cbrtNonNegative(0.0f), 0.0f);
+  EXPECT_EQ(detail::kernel::fl_cbrt_nonneg(0.0f), 0.0f);
 }
 
 // A newborn of a one-type emitter equals the one-by-one recipe: Random(seed, id, group index,

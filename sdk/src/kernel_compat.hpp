@@ -6,6 +6,7 @@
 // (isa_namespace.hpp), so each build keeps its own copy of every function.
 #pragma once
 
+#include <bit>
 #include <cmath>
 #include <cstdint>
 
@@ -26,10 +27,18 @@ using float3 = Vec3;
 inline float3 make_float3(float x, float y, float z) {
   return Vec3(x, y, z);
 }
+inline uint as_uint(float f) {
+  return std::bit_cast<uint>(f);
+}
+inline float as_float(uint u) {
+  return std::bit_cast<float>(u);
+}
+using std::copysign;
 using std::cos;
 using std::exp;
 using std::fabs;
 using std::floor;
+using std::log;
 using std::pow;
 using std::sin;
 using std::sqrt;

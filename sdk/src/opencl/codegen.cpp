@@ -8,6 +8,7 @@
 #include <type_traits>
 
 #include "../action_traits.hpp"
+#include "../shape_math.hpp"
 #include "flurry/error.hpp"
 
 namespace flurry::detail::ocl {
@@ -68,14 +69,10 @@ std::string laneDecl(const LaneRef& l) {
          "* restrict l_" + l.name;
 }
 
-// Two unit vectors completing unit n to an orthonormal basis: domain.cpp's basis(), so the
-// device samples discs, cylinders and cones with the very same frame.
+// The frame the CPU's sampler draws discs, cylinders and cones in (kernels/domain.h), so the
+// device samples them with the very same one.
 void basis(Vec3 n, Vec3& b1, Vec3& b2) {
-  const float s = std::copysign(1.0f, n.z);
-  const float a = -1.0f / (s + n.z);
-  const float b = n.x * n.y * a;
-  b1 = Vec3(1.0f + s * n.x * n.x * a, s * b, -s * n.x);
-  b2 = Vec3(b, s + n.y * n.y * a, -n.y);
+  kernel::fl_basis(n, &b1, &b2);
 }
 
 }  // namespace
@@ -154,7 +151,7 @@ cl::FlDomain packDomain(const Domain& d) {
             axis = s.base - s.apex;
           }
           Vec3 e1, e2;
-          basis(glm::normalize(axis), e1, e2);
+          basis(kernel::fl_normalize(axis), e1, e2);
           putVec(v, 0, origin);
           putVec(v, 3, axis);
           putVec(v, 6, e1);
@@ -651,9 +648,9 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   s << " } while (0)\n#define FL_LANE_ARGS ";
   for (std::size_t k = 0; k < all.size(); ++k) s << (k ? ", " : "") << "l_" << all[k].name;
   s << "\n";
-  for (const char* f :
-       {"compat_opencl.h", "math.h", "params.h", "philox.h", "noise.h", "deflect.h", "domain.cl",
-        "forces.h", "absorb.h", "actions.cl", "forces.cl", "surfaces.cl", "compact.cl", "emit.cl"})
+  for (const char* f : {"compat_opencl.h", "math.h", "params.h", "philox.h", "noise.h", "deflect.h",
+                        "domain.h", "domain.cl", "forces.h", "absorb.h", "actions.cl", "forces.cl",
+                        "surfaces.cl", "compact.cl", "emit.cl"})
     s << "/* ---- " << f << " */\n" << embeddedKernel(f) << "\n";
 
   s << "/* ---- generated: emission */\n" << emitSource;
