@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "flurry/flurry.hpp"
+#include "pass_options.hpp"
 
 using namespace flurry;
 
@@ -349,8 +350,9 @@ TEST(Emitter, NewbornsRunTheActionsForTheirOwnPartOfTheStep) {
   ContextOptions o;
   o.dt = dt;
   o.threads = 2;
-  o.blockSize = 64;  // the newborns begin inside a block and fill several
   Context ctx(o);
+  detail::setPassOptions(ctx,
+                         {.blockSize = 64});  // the newborns begin inside a block and fill several
   Group& g = ctx.createGroup("g", 10000);
   Emitter e;
   e.rate = rate;

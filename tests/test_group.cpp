@@ -10,6 +10,7 @@
 
 #include "builtin.hpp"
 #include "flurry/flurry.hpp"
+#include "pass_options.hpp"
 
 using namespace flurry;
 
@@ -22,10 +23,9 @@ struct Snapshot {
 Snapshot runFountain(unsigned threads, bool fused, std::size_t block = 0, int steps = 90) {
   ContextOptions o;
   o.threads = threads;
-  o.fused = fused;
-  o.blockSize = block;
   o.seed = 99;
   Context ctx(o);
+  detail::setPassOptions(ctx, {.blockSize = block, .fused = fused});
   Group& g = samples::buildFountain(ctx, 200000, 60000.0, 0.5f);
   g.setActions({Gravity{Vec3(0, -9.81f, 0)},
                 Bounce{Domain::plane(Vec3(0), Vec3(0, 1, 0)), 0.4f, 0.1f, 0.0f},
@@ -376,6 +376,27 @@ constexpr bool kHasPublicImpl = requires(G& g) {
 TEST(Group, InternalsAreNotPublic) {
   EXPECT_FALSE(kHasPublicImpl<Group>);
   EXPECT_FALSE(kHasPublicImpl<const Group>);
+}
+
+// Nor does ContextOptions carry the benchmarks' knobs: they are detail::PassOptions
+// (sdk/src/pass_options.hpp), which the tests and benchmarks set through their private path.
+template <class O>
+constexpr bool kHasBlockSize = requires(O& o) {
+  o.blockSize;
+};
+template <class O>
+constexpr bool kHasFused = requires(O& o) {
+  o.fused;
+};
+TEST(Context, BenchmarkKnobsAreNotPublic) {
+  EXPECT_FALSE(kHasBlockSize<ContextOptions>);
+  EXPECT_FALSE(kHasFused<ContextOptions>);
+  Context ctx;
+  EXPECT_EQ(detail::passOptions(ctx).blockSize, 0u);
+  EXPECT_TRUE(detail::passOptions(ctx).fused);
+  detail::setPassOptions(ctx, {.blockSize = 64, .fused = false});
+  EXPECT_EQ(detail::passOptions(ctx).blockSize, 64u);
+  EXPECT_FALSE(detail::passOptions(ctx).fused);
 }
 
 // ---- instance transforms and prewarm ----------------------------------------------------------

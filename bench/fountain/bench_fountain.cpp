@@ -31,6 +31,7 @@
 
 #include "builtin.hpp"
 #include "flurry/flurry.hpp"
+#include "pass_options.hpp"  // sdk/src: the unfused baseline is not public API
 
 using namespace flurry;
 
@@ -56,8 +57,8 @@ void UpdatePass(benchmark::State& state, bool fused) {
   const auto n = std::size_t(state.range(0));
   ContextOptions o;
   o.threads = threads();
-  o.fused = fused;
   Context ctx(o);
+  detail::setPassOptions(ctx, {.fused = fused});
   Group& g = ctx.createGroup("fountain", n);
   Emitter e;
   e.shape = Domain::disc(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f), 0.1f);

@@ -9,6 +9,7 @@
 #include "flurry/error.hpp"
 #include "flurry/version.hpp"
 #include "log.hpp"
+#include "pass_options.hpp"
 
 namespace flurry {
 
@@ -18,6 +19,7 @@ const char* versionString() {
 
 struct Context::Impl {
   ContextOptions options;
+  detail::PassOptions pass;
   std::vector<std::unique_ptr<Group>> groups;
   std::unique_ptr<detail::ThreadPool> pool;
   std::unique_ptr<detail::BackendImpl> backend;
@@ -154,8 +156,8 @@ detail::StepParams Context::Impl::params() const {
   sp.dt = options.dt;
   sp.seed = options.seed;
   sp.step = step;
-  sp.blockSize = options.blockSize;
-  sp.fused = options.fused;
+  sp.blockSize = pass.blockSize;
+  sp.fused = pass.fused;
   sp.cull = options.cull;
   sp.pool = pool.get();
   return sp;
@@ -236,5 +238,19 @@ const std::string& Context::backendFallback() const {
 const ContextOptions& Context::options() const {
   return impl_->options;
 }
+
+namespace detail {
+struct ContextAccess {
+  static Context::Impl& of(Context& c) { return *c.impl_; }
+  static const Context::Impl& of(const Context& c) { return *c.impl_; }
+};
+
+void setPassOptions(Context& context, const PassOptions& options) {
+  ContextAccess::of(context).pass = options;
+}
+PassOptions passOptions(const Context& context) {
+  return ContextAccess::of(context).pass;
+}
+}  // namespace detail
 
 }  // namespace flurry

@@ -379,15 +379,14 @@ NB_MODULE(_flurry, m) {
       .def(
           "__init__",
           [](ContextBox* self, std::uint64_t seed, double dt, unsigned threads,
-             const std::string& backend, const std::string& device, std::size_t blockSize,
-             bool fused, bool cull) {
+             const std::string& backend, const std::string& device, bool cull) {
             flurry::ContextOptions o;
             o.seed = seed, o.dt = dt, o.threads = threads, o.backend = backendOf(backend);
-            o.device = device, o.blockSize = blockSize, o.fused = fused, o.cull = cull;
+            o.device = device, o.cull = cull;
             new (self) ContextBox{std::make_unique<flurry::Context>(o), {}};
           },
           "seed"_a = 1, "dt"_a = 1.0 / 30.0, "threads"_a = 0, "backend"_a = "cpu", "device"_a = "",
-          "block_size"_a = 0, "fused"_a = true, "cull"_a = true)
+          "cull"_a = true)
       .def(
           "step", [](ContextBox& pc, std::size_t steps) { step(pc, steps); }, "steps"_a = 1,
           "Advances every group by `steps` steps (the GIL is released while stepping).")

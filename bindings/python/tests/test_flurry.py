@@ -327,3 +327,12 @@ def test_bad_transforms_name_the_field():
     with pytest.raises(flurry.InvalidArgument, match="space"):
         g.space = "orbit"
     assert g.space == "world"
+
+
+def test_the_benchmark_knobs_are_not_public():
+    # The pass's block size and the unfused baseline are the C++ tests' and benchmarks' knobs
+    # (sdk/src/pass_options.hpp), not options a user sets.
+    for knob in ("block_size", "fused"):
+        with pytest.raises(TypeError):
+            flurry.Context(threads=1, **{knob: 0})
+    assert flurry.Context(threads=1, cull=False).threads == 1

@@ -12,6 +12,10 @@
 
 namespace flurry {
 
+namespace detail {
+struct ContextAccess;  // the library's way in (sdk/src/context.cpp)
+}  // namespace detail
+
 enum class Backend { Cpu, OpenCL, Auto };
 
 struct ContextOptions {
@@ -22,12 +26,6 @@ struct ContextOptions {
   /// OpenCL: a substring of the platform or device name to use; empty takes the first GPU,
   /// else the first device.
   std::string device;
-  /// Particles per block of the fused pass: every action runs over a block while it is in
-  /// cache, so memory is read and written once per step. 0 picks the default.
-  std::size_t blockSize = 0;
-  /// false runs one pass over the whole group per action: the unfused baseline that the
-  /// benchmarks compare against. Results are identical either way.
-  bool fused = true;
   /// CPU fused pass: skips an action with a finite reach (a deflector on a finite piece, an
   /// absorber, a blocker, a force's falloff radius) for a block of particles that cannot
   /// reach it this step. Exact: results are bitwise the same either way; false is for
@@ -86,6 +84,7 @@ class Context {
   const ContextOptions& options() const;
 
  private:
+  friend struct detail::ContextAccess;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
