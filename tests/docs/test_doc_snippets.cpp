@@ -6,6 +6,7 @@
 // from its file, or a file that stops compiling or doing what the text says, fails.
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -100,6 +101,145 @@ TEST(DocSnippets, CheckerFindsNamesAndBodies) {
   EXPECT_EQ(blocks[2].file, "docs/snippets/b.json");
   EXPECT_EQ(blocks[2].body, "{}\n");
   EXPECT_EQ(blocks[3].language, "sh");
+}
+
+// ---- docs/adding-an-action.md -----------------------------------------------------------------
+// The page walks through a real action by its files and names rather than by code blocks:
+// every path and every name in its `code spans` must exist in the sources, so that a rename
+// or a move fails here instead of leaving the page wrong.
+
+/// The `spans` of a page outside its fenced blocks.
+std::vector<std::string> codeSpans(const std::string& markdown) {
+  std::vector<std::string> spans;
+  std::istringstream in(markdown);
+  bool fenced = false;
+  for (std::string l; std::getline(in, l);) {
+    if (l.rfind("```", 0) == 0) {
+      fenced = !fenced;
+      continue;
+    }
+    if (fenced) continue;
+    for (std::size_t a = l.find('`'); a != std::string::npos; a = l.find('`', a)) {
+      const std::size_t b = l.find('`', a + 1);
+      if (b == std::string::npos) break;
+      spans.push_back(l.substr(a + 1, b - a - 1));
+      a = b + 1;
+    }
+  }
+  return spans;
+}
+
+/// The text of the sources a page may name: the library, kernels, bindings, tests, benchmarks.
+std::string sourceText() {
+  static const std::set<std::string> kExt = {".hpp", ".cpp", ".h",     ".cl",
+                                             ".c",   ".txt", ".cmake", ".py"};
+  std::string all;
+  for (const char* dir : {"sdk", "kernels", "bindings", "tests", "bench", "samples"})
+    for (const auto& e : std::filesystem::recursive_directory_iterator(kRoot / dir))
+      if (e.is_regular_file() && kExt.count(e.path().extension().string()))
+        all += readText(e.path()) + "\n";
+  return all;
+}
+
+bool isWordChar(char c) {
+  return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+}
+
+/// `word` in `text`, not as part of a longer identifier.
+bool hasWord(const std::string& text, const std::string& word) {
+  for (std::size_t i = text.find(word); i != std::string::npos; i = text.find(word, i + 1)) {
+    const bool before = i > 0 && isWordChar(text[i - 1]);
+    const bool after = i + word.size() < text.size() && isWordChar(text[i + word.size()]);
+    if (!before && !after) return true;
+  }
+  return false;
+}
+
+enum class SpanKind { Path, Name, Other };
+
+SpanKind kindOf(const std::string& s) {
+  if (s.empty() || (s.find(' ') != std::string::npos && s.rfind("TEST(", 0) != 0))
+    return SpanKind::Other;
+  if (s.find('/') != std::string::npos) return SpanKind::Path;
+  const char c = s[0];
+  if (!std::isalpha(static_cast<unsigned char>(c)) && c != '_') return SpanKind::Other;
+  for (char x : s)
+    if (!isWordChar(x) && std::string(":<>.(), ").find(x) == std::string::npos)
+      return SpanKind::Other;
+  return SpanKind::Name;
+}
+
+/// Whether a name on the page is in the sources: `TEST(A, B)` and `A.B` as a test, `x()` and
+/// `a::b` as written or by their last part, `Describe<X>` as written.
+bool nameExists(const std::string& text, std::string n) {
+  if (n.size() > 2 && n.compare(n.size() - 2, 2, "()") == 0) n.resize(n.size() - 2);
+  if (n.rfind("TEST(", 0) == 0) return text.find(n) != std::string::npos;
+  const std::size_t dot = n.rfind('.');
+  if (dot != std::string::npos) {
+    if (std::isupper(static_cast<unsigned char>(n[0])))  // a GoogleTest suite.name
+      return text.find("TEST(" + n.substr(0, dot) + ", " + n.substr(dot + 1) + ")") !=
+             std::string::npos;
+    // A CTest name: as written, or made by CMake from its prefix and a listed last part.
+    return text.find(n) != std::string::npos ||
+           (text.find(n.substr(0, dot + 1)) != std::string::npos &&
+            hasWord(text, n.substr(dot + 1)));
+  }
+  if (hasWord(text, n)) return true;
+  const std::size_t colons = n.rfind("::");
+  return colons != std::string::npos && hasWord(text, n.substr(colons + 2));
+}
+
+TEST(DocSnippets, AddingAnActionNamesWhatExists) {
+  const std::string page = readText(kRoot / "docs/adding-an-action.md");
+  for (const Block& b : codeBlocks(page))
+    EXPECT_TRUE(b.language != "cpp" && b.language != "c" && b.language != "json")
+        << "line " << b.line << ": a code block here is checked by nothing; name files and "
+        << "functions instead";
+  const std::string text = sourceText();
+  std::size_t paths = 0, names = 0;
+  for (const std::string& s : codeSpans(page)) {
+    switch (kindOf(s)) {
+      case SpanKind::Path: {
+        ++paths;
+        const std::filesystem::path p = s.find('*') == std::string::npos
+                                            ? kRoot / s
+                                            : (kRoot / s).parent_path();  // kernels/*.h
+        EXPECT_TRUE(std::filesystem::exists(p)) << "docs/adding-an-action.md names " << s;
+        break;
+      }
+      case SpanKind::Name:
+        ++names;
+        EXPECT_TRUE(nameExists(text, s))
+            << "docs/adding-an-action.md names " << s << ", which is in no source";
+        break;
+      case SpanKind::Other:
+        break;
+    }
+  }
+  // The page is a walk-through by name: if these fall, the spans are no longer read.
+  EXPECT_GT(paths, 20u);
+  EXPECT_GT(names, 40u);
+}
+
+TEST(DocSnippets, TheNameCheckerRefusesWhatIsNot) {
+  const std::string text =
+      "TEST(A, B) {}\nvoid fl_x(); namespace k { int y; }\n"
+      "add_test(NAME e.gen.${what}) foreach(w schema)\n";
+  EXPECT_TRUE(nameExists(text, "fl_x"));
+  EXPECT_TRUE(nameExists(text, "fl_x()"));
+  EXPECT_TRUE(nameExists(text, "k::y"));
+  EXPECT_TRUE(nameExists(text, "A.B"));
+  EXPECT_TRUE(nameExists(text, "TEST(A, B)"));
+  EXPECT_TRUE(nameExists(text, "e.gen.schema"));
+  EXPECT_FALSE(nameExists(text, "fl_"));
+  EXPECT_FALSE(nameExists(text, "k::z"));
+  EXPECT_FALSE(nameExists(text, "A.C"));
+  EXPECT_FALSE(nameExists(text, "e.gen.dict"));
+  EXPECT_EQ(kindOf("kernels/forces.h"), SpanKind::Path);
+  EXPECT_EQ(kindOf("Describe<SpeedClamp>"), SpanKind::Name);
+  EXPECT_EQ(kindOf("code spans"), SpanKind::Other);
+  EXPECT_EQ(kindOf("f[0]"), SpanKind::Other);
+  EXPECT_EQ(codeSpans("a `x` b `y/z`\n```sh\n`no`\n```\n"), (std::vector<std::string>{"x", "y/z"}));
 }
 
 }  // namespace
