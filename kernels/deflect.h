@@ -16,13 +16,13 @@ typedef struct FlReflect {
   float restitution, keep, cutoff2;
 } FlReflect;
 
-/* Reflects the velocity (vx, vy, vz) at the hit point h (unit normal n, time of impact tau)
- * and places the particle so that the following Move ends it at the reflected point. */
-FL_INLINE void fl_reflect(FlReflect r, float* px, float* py, float* pz, float* vx, float* vy,
-                          float* vz, float hx, float hy, float hz, float nx, float ny, float nz,
-                          float tau) {
-  const float vn = *vx * nx + *vy * ny + *vz * nz;
-  const float vnx = vn * nx, vny = vn * ny, vnz = vn * nz;
+/* Reflects the velocity (vx, vy, vz) at the hit point h (normal n, time of impact tau) and
+ * places the particle so that the following Move ends it at the reflected point. vns is the
+ * normal part's length along n, (v·n)/(n·n): v·n for a unit normal. */
+FL_INLINE void fl_reflect_vn(FlReflect r, float* px, float* py, float* pz, float* vx, float* vy,
+                             float* vz, float hx, float hy, float hz, float nx, float ny, float nz,
+                             float vns, float tau) {
+  const float vnx = vns * nx, vny = vns * ny, vnz = vns * nz;
   const float tx = *vx - vnx, ty = *vy - vny, tz = *vz - vnz;
   const float t2 = tx * tx + ty * ty + tz * tz;
   const float f = t2 > r.cutoff2 ? r.keep : 1.0f; /* the one select: vectorises */
@@ -32,6 +32,26 @@ FL_INLINE void fl_reflect(FlReflect r, float* px, float* py, float* pz, float* v
   *px = hx - *vx * tau;
   *py = hy - *vy * tau;
   *pz = hz - *vz * tau;
+}
+
+/* fl_reflect_vn at a unit normal n (planes, box faces). */
+FL_INLINE void fl_reflect(FlReflect r, float* px, float* py, float* pz, float* vx, float* vy,
+                          float* vz, float hx, float hy, float hz, float nx, float ny, float nz,
+                          float tau) {
+  fl_reflect_vn(r, px, py, pz, vx, vy, vz, hx, hy, hz, nx, ny, nz, *vx * nx + *vy * ny + *vz * nz,
+                tau);
+}
+
+/* fl_reflect_vn at a normal d of any nonzero length: a sphere's h - C. Its computed hit point
+ * is off the sphere by rounding (|h - C|² - R² up to ~20 ulps of R², more where the time of
+ * impact cancels), so (h - C)/R is not unit, and mirroring about it changes |v|² by
+ * 4·cos²·(|n|² - 1) per bounce: a drift at restitution 1 that grows with the bounces. Dividing
+ * by d·d mirrors exactly in exact arithmetic, whatever |d|: a few ulps of |v|² are left. */
+FL_INLINE void fl_reflect_any(FlReflect r, float* px, float* py, float* pz, float* vx, float* vy,
+                              float* vz, float hx, float hy, float hz, float dx, float dy, float dz,
+                              float tau) {
+  const float vns = (*vx * dx + *vy * dy + *vz * dz) / (dx * dx + dy * dy + dz * dz);
+  fl_reflect_vn(r, px, py, pz, vx, vy, vz, hx, hy, hz, dx, dy, dz, vns, tau);
 }
 
 /* A sphere (centre C, radius R, R2 = R², invR = 1/R, scale = |C|₁ + R) deflecting from
@@ -57,7 +77,7 @@ FL_INLINE void fl_bounce_sphere_once(FlReflect rf, float Cx, float Cy, float Cz,
   const float hx = x + vx * tau, hy = y + vy * tau, hz = z + vz * tau;
   const float nnx = (hx - Cx) * invR, nny = (hy - Cy) * invR, nnz = (hz - Cz) * invR;
   float nx = x, ny = y, nz = z, nvx = vx, nvy = vy, nvz = vz;
-  fl_reflect(rf, &nx, &ny, &nz, &nvx, &nvy, &nvz, hx, hy, hz, nnx, nny, nnz, tau);
+  fl_reflect_any(rf, &nx, &ny, &nz, &nvx, &nvy, &nvz, hx, hy, hz, hx - Cx, hy - Cy, hz - Cz, tau);
   const float qx = nx + nvx * dt - Cx, qy = ny + nvy * dt - Cy, qz = nz + nvz * dt - Cz;
   /* Signed clearance on the allowed side: outside it is |q| - R, inside R - |q|. */
   const float ql = sqrt(qx * qx + qy * qy + qz * qz);
@@ -78,9 +98,9 @@ FL_INLINE void fl_bounce_sphere_once(FlReflect rf, float Cx, float Cy, float Cz,
 /* Inside a sphere, after fl_bounce_sphere_once: a particle that crosses the sphere more than
  * once in a step bounces at every exit for what is left of the step, from where it began;
  * past 16 bounces it ends inside. Particles whose step ends inside are left as they are. */
-FL_INLINE void fl_bounce_sphere_again(FlReflect rf, float Cx, float Cy, float Cz, float R,
-                                      float R2, float invR, float dt, float* px, float* py,
-                                      float* pz, float* vxs, float* vys, float* vzs) {
+FL_INLINE void fl_bounce_sphere_again(FlReflect rf, float Cx, float Cy, float Cz, float R, float R2,
+                                      float dt, float* px, float* py, float* pz, float* vxs,
+                                      float* vys, float* vzs) {
   const float x = *px, y = *py, z = *pz;
   float vx = *vxs, vy = *vys, vz = *vzs;
   const float speed = sqrt(vx * vx + vy * vy + vz * vz);
@@ -106,9 +126,8 @@ FL_INLINE void fl_bounce_sphere_again(FlReflect rf, float Cx, float Cy, float Cz
     cz += vz * t;
     left -= t;
     /* On the sphere: never the centre. */
-    const float nx = (cx - Cx) * invR, ny = (cy - Cy) * invR, nz = (cz - Cz) * invR;
     float qx = cx, qy = cy, qz = cz;
-    fl_reflect(rf, &qx, &qy, &qz, &vx, &vy, &vz, cx, cy, cz, nx, ny, nz, 0.0f);
+    fl_reflect_any(rf, &qx, &qy, &qz, &vx, &vy, &vz, cx, cy, cz, cx - Cx, cy - Cy, cz - Cz, 0.0f);
   }
   float ox = cx + vx * left, oy = cy + vy * left, oz = cz + vz * left;
   /* Inside by more than Move's rounding of p + v·dt, which grows with |v|·dt. */
@@ -207,8 +226,8 @@ FL_INLINE void fl_bounce_box_outside(FlReflect rf, const float* lo, const float*
   nrm[axis] = v[axis] > 0.0f ? -1.0f : 1.0f;
   const float hx = p[0] + v[0] * tEnter, hy = p[1] + v[1] * tEnter, hz = p[2] + v[2] * tEnter;
   float np[3] = {p[0], p[1], p[2]}, nv[3] = {v[0], v[1], v[2]};
-  fl_reflect(rf, &np[0], &np[1], &np[2], &nv[0], &nv[1], &nv[2], hx, hy, hz, nrm[0], nrm[1],
-             nrm[2], tEnter);
+  fl_reflect(rf, &np[0], &np[1], &np[2], &nv[0], &nv[1], &nv[2], hx, hy, hz, nrm[0], nrm[1], nrm[2],
+             tEnter);
   /* Keep the end of the step outside the entry face. */
   const float face = nrm[axis] > 0.0f ? hi[axis] : lo[axis];
   const float q = np[axis] + nv[axis] * dt;

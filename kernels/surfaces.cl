@@ -138,8 +138,8 @@ FL_INLINE void fl_bounce_sphere(__global const FlActionParams* a, int inside, fl
   fl_bounce_sphere_once(rf, a->f[0], a->f[1], a->f[2], a->f[10], a->f[11], a->f[12], a->f[9],
                         inside, dt, px, py, pz, vxs, vys, vzs);
   if (inside)
-    fl_bounce_sphere_again(rf, a->f[0], a->f[1], a->f[2], a->f[10], a->f[11], a->f[12], dt, px,
-                           py, pz, vxs, vys, vzs);
+    fl_bounce_sphere_again(rf, a->f[0], a->f[1], a->f[2], a->f[10], a->f[11], dt, px, py, pz,
+                           vxs, vys, vzs);
 }
 
 /* A box keeping particles in (inside == 1) or deflecting them from outside: kernels/deflect.h.

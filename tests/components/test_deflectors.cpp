@@ -1,6 +1,7 @@
 // Deflectors (closed shapes, 2-D segments), absorbers by mode, and blockers.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -50,6 +51,51 @@ TEST(Bounce, FastRadialBurstInsideASphereStaysFiniteAndInside) {
       ASSERT_TRUE(std::isfinite(glm::length(q.position)) && std::isfinite(glm::length(q.velocity))) << i;
       ASSERT_LE(glm::length(q.position - C), 1.0f) << i;
     }
+  }
+}
+
+// A sphere at restitution 1 without friction keeps |v|: mirroring v about the computed
+// normal. The hit point is on the sphere only up to rounding, which grows with its distance
+// from the origin (ulp(1000) = 6e-5 here, against R = 1), so the normal (h - C)/R was not
+// unit and every bounce changed |v|² by 4·cos²·(|n|² - 1): up to ~5e-4 here, a drift of 1e-2
+// in 30 steps. Mirrored about h - C by (v·d)/(d·d), the change is rounding only: first order,
+// ≤ 34 ulps (2^-24) of |v|² per bounce (the dot product and d·d, 3 ulps each, the quotient,
+// times 4·cos² ≤ 4; the three component roundings, ≤ 6), and ≤ 17 bounces a step (one, then
+// up to 16 more inside).
+TEST(Bounce, SphereAwayFromTheOriginKeepsTheSpeedAtRestitutionOne) {
+  const Vec3 C(1000.0f, -1000.0f, 1000.0f);
+  const double perBounce = 34.0 * std::ldexp(1.0, -24);
+  const int steps = 30;
+  for (bool inside : {true, false}) {
+    SCOPED_TRACE(inside ? "inside" : "outside");
+    Context ctx = makeContext(1.0 / 60.0);
+    Group& g = ctx.createGroup("g", 2000);
+    g.setActions({Bounce{Domain::sphere(C, 1.0f), 1.0f, 0.0f, 0.0f, inside}, Move{}});
+    Random rng(5, 0, 0, 0);
+    std::vector<double> speed2;
+    for (int i = 0; i < 2000; ++i) {
+      const Vec3 dir = Domain::sphere(Vec3(0.0f), 1.0f, 1.0f).sample(rng);
+      Particle p;
+      // Inside: 1000 units/s, 16 bounces every step. Outside: aimed at the sphere from 1 to 6
+      // units away at 60 units/s, each bounces once.
+      p.position = inside ? C + Domain::sphere(Vec3(0.0f), 0.9f).sample(rng)
+                          : C - dir * (2.0f + 5.0f * rng.uniform());
+      p.velocity = inside ? dir * 1000.0f : dir * 60.0f;
+      g.add(p);
+      speed2.push_back(glm::dot(glm::dvec3(p.velocity), glm::dvec3(p.velocity)));
+    }
+    double drift = 0.0;
+    for (int s = 0; s < steps; ++s) ctx.step();
+    ASSERT_EQ(g.size(), 2000u);
+    std::size_t bounced = 0;
+    for (std::size_t i = 0; i < g.size(); ++i) {
+      const Particle q = g.particle(i);
+      const glm::dvec3 v(q.velocity);
+      drift = std::max(drift, std::abs(glm::dot(v, v) / speed2[i] - 1.0));
+      bounced += inside || glm::dot(glm::dvec3(q.position - C), v) > 0.0;
+    }
+    EXPECT_GT(bounced, 1000u);  // the outside ones came back out
+    EXPECT_LE(drift, (inside ? steps * 17 : 1) * perBounce) << "relative change of |v|²";
   }
 }
 

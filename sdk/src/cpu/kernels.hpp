@@ -480,7 +480,7 @@ inline void bounceSphereLoop(float* __restrict px, float* __restrict py, float* 
   }
   if constexpr (Inside)
     for (std::size_t i = 0; i < n; ++i)
-      kernel::fl_bounce_sphere_again(rf, C.x, C.y, C.z, R, R2, invR, dts[i], &px[i], &py[i], &pz[i],
+      kernel::fl_bounce_sphere_again(rf, C.x, C.y, C.z, R, R2, dts[i], &px[i], &py[i], &pz[i],
                                      &vxs[i], &vys[i], &vzs[i]);
 }
 
