@@ -130,8 +130,12 @@ const ActionPlan& planActions(GroupImpl& g) {
   const auto& acts = g.actions.actions();
   plan.integrator = g.actions.integrator();
   plan.gathered.assign(acts.size(), 0);
-  plan.forcesOf.assign(acts.size(), {});
-  plan.guardsOf.assign(acts.size(), {});
+  // Resized and cleared, not replaced: a moved instance rebuilds its plan every step, and
+  // the inner lists keep their storage.
+  plan.forcesOf.resize(acts.size());
+  plan.guardsOf.resize(acts.size());
+  for (auto& f : plan.forcesOf) f.clear();
+  for (auto& b : plan.guardsOf) b.clear();
   plan.curvedBy.assign(acts.size(), 0);
   plan.timeFree.assign(acts.size(), 0);
   for (std::size_t k = 0; k < acts.size(); ++k) plan.timeFree[k] = isTimeFree(acts[k]);
@@ -140,7 +144,11 @@ const ActionPlan& planActions(GroupImpl& g) {
                       plan.integrator == Integrator::VelocityVerlet ||
                       plan.integrator == Integrator::RK4;
   if (plan.integrator != Integrator::SemiImplicitEuler) {
-    std::vector<std::uint32_t> pending, bounces;
+    thread_local std::vector<std::uint32_t> pendingStore, bouncesStore;
+    std::vector<std::uint32_t>& pending = pendingStore;
+    std::vector<std::uint32_t>& bounces = bouncesStore;
+    pending.clear();
+    bounces.clear();
     for (std::uint32_t k = 0; k < acts.size(); ++k) {
       if (isForce(acts[k])) pending.push_back(k);
       if (std::holds_alternative<Bounce>(acts[k])) bounces.push_back(k);
@@ -149,8 +157,8 @@ const ActionPlan& planActions(GroupImpl& g) {
         for (std::uint32_t b : bounces)
           if (curved && !pending.empty() && cpu::isPlanarBounce(std::get<Bounce>(acts[b])))
             plan.curvedBy[b] = k + 1;
-        plan.forcesOf[k] = std::move(pending);
-        plan.guardsOf[k] = std::move(bounces);
+        plan.forcesOf[k].assign(pending.begin(), pending.end());
+        plan.guardsOf[k].assign(bounces.begin(), bounces.end());
         pending.clear();
         bounces.clear();
       }
