@@ -66,18 +66,25 @@ FL_INLINE void fl_restore(__global const FlActionParams* a, float dt, fl_real ti
 /* ---- Spatial culling per work-group (fused_pass.cpp Culler) ------------------------------ */
 
 /* The work-group's swept bounds: the box its straight paths p .. p + v*dt lie in and the
- * longest path |v|*dt, which it returns. Every work-item of the group calls it (it holds
- * barriers); those past the live particles (live == 0) add nothing, and a NaN or infinite
- * particle makes the box unbounded (nothing is culled then). Each work-item adds its own
- * path: a newborn's dt is its own. The decisions are taken here, once per work-group: for
- * each of the n actions (reach: their FL_REACH_FLOATS floats), red[FL_CULL_GAP + k] is how far
- * the paths may leave the box with the action still out of their reach (-1: it is not). */
-#define FL_CULL_GAP (7 * FL_ACT_LOCAL + 56 + 1)
-#define FL_CULL_LOCAL_FLOATS FL_CULL_GAP /* plus one per action */
+ * longest path |v|*dt. Every work-item of the group puts its own path (fl_cull_put; a
+ * newborn's dt is its own) into red[c * FL_ACT_LOCAL + lid], as ordered integer keys (the
+ * reductions are then integer min and max, which a compiler may vectorise); those past the
+ * live particles (live == 0) add nothing, and a NaN or infinite particle makes the box
+ * unbounded (nothing is culled then). After a barrier one work-item reduces them
+ * (fl_cull_box) and takes every action's decision for the group (fl_cull_gap; the generated
+ * code, codegen.cpp cullingBody): PoCL runs a work-group's work-items one after another, so
+ * one work-item doing it costs what many would, and one barrier fewer. red holds
+ * FL_CULL_LOCAL ints, then the decisions (generated). */
+#define FL_CULL_LOCAL (7 * FL_ACT_LOCAL)
+/* An order-preserving integer for a non-NaN float (-0 just below +0). */
+FL_INLINE int fl_cull_key(float f) {
+  const int b = as_int(f);
+  return b >= 0 ? b : b ^ 0x7fffffff;
+}
+FL_INLINE float fl_cull_unkey(int k) { return as_float(k >= 0 ? k : k ^ 0x7fffffff); }
 FL_INLINE uint fl_cull_apart(const float* box, float grow, __global const float* r);
-FL_INLINE float fl_cull_gather(__local float* red, uint live, float dt, float px, float py,
-                               float pz, float vx, float vy, float vz,
-                               __global const float* reach, uint n) {
+FL_INLINE void fl_cull_put(__local int* red, uint live, float dt, float px, float py, float pz,
+                           float vx, float vy, float vz) {
   const uint lid = get_local_id(0);
   const float p[3] = {px, py, pz}, v[3] = {vx, vy, vz};
   int bad = 0;
@@ -85,54 +92,34 @@ FL_INLINE float fl_cull_gather(__local float* red, uint live, float dt, float px
   for (int c = 0; c < 3; ++c) {
     const float s = fabs(v[c]) * dt;
     const float lo = bad ? -INFINITY : p[c] - s, hi = bad ? INFINITY : p[c] + s;
-    red[c * FL_ACT_LOCAL + lid] = live ? lo : INFINITY;
-    red[(c + 3) * FL_ACT_LOCAL + lid] = live ? hi : -INFINITY;
+    red[c * FL_ACT_LOCAL + lid] = fl_cull_key(live ? lo : INFINITY);
+    red[(c + 3) * FL_ACT_LOCAL + lid] = fl_cull_key(live ? hi : -INFINITY);
   }
   const float len = sqrt(vx * vx + vy * vy + vz * vz) * dt;
-  red[6 * FL_ACT_LOCAL + lid] = live ? (bad ? INFINITY : len) : 0.0f;
-  /* Two levels: 56 work-items take 32 values each (7 bounds x 8 parts), then each work-item
-   * that decides for an action reduces the 56 itself. Three barriers in all: each costs PoCL
-   * a parallel region. The next call writes red (and the part, the decisions) only after
-   * barriers that follow every read of this one. */
-  barrier(CLK_LOCAL_MEM_FENCE);
-  __local float* part = red + 7 * FL_ACT_LOCAL;
-  if (lid < 56u) {
-    const uint c = lid >> 3;
-    __local const float* x = red + c * FL_ACT_LOCAL + (lid & 7u) * (FL_ACT_LOCAL / 8);
-    float m = x[0];
-    for (uint k = 1u; k < FL_ACT_LOCAL / 8; ++k)
-      m = c < 3u ? (x[k] < m ? x[k] : m) : (x[k] > m ? x[k] : m);
-    part[lid] = m;
+  red[6 * FL_ACT_LOCAL + lid] = fl_cull_key(live ? (bad ? INFINITY : len) : 0.0f);
+}
+/* box[0..2]: low corner, [3..5]: high corner, [6]: the longest path. */
+FL_INLINE void fl_cull_box(__local const int* red, float* box) {
+  for (int c = 0; c < 7; ++c) {
+    __local const int* x = red + c * FL_ACT_LOCAL;
+    int m = x[0];
+    if (c < 3)
+      for (uint k = 1u; k < FL_ACT_LOCAL; ++k) m = min(m, x[k]);
+    else
+      for (uint k = 1u; k < FL_ACT_LOCAL; ++k) m = max(m, x[k]);
+    box[c] = fl_cull_unkey(m);
   }
-  barrier(CLK_LOCAL_MEM_FENCE);
-  if (lid < n || lid == 0u) {
-    float box[7];
-    for (uint c = 0u; c < 7u; ++c) {
-      __local const float* x = part + c * 8u;
-      float m = x[0];
-      for (uint k = 1u; k < 8u; ++k) m = c < 3u ? (x[k] < m ? x[k] : m) : (x[k] > m ? x[k] : m);
-      box[c] = m;
-    }
-    if (lid == 0u) red[FL_CULL_GAP - 1] = box[6];
-    for (uint k = lid; k < n; k += FL_ACT_LOCAL) {
-      __global const float* r = reach + k * FL_REACH_FLOATS;
-      float gap = -1.0f;
-      if (r[6] >= 0.0f && fl_cull_apart(box, 0.0f, r)) {
-        /* apart is monotonic in the widening: the largest of a few that still holds. */
-        float d = 0.0f;
-        for (int c = 0; c < 3; ++c) d = fmax(d, fmax(box[c] - r[3 + c], r[c] - box[3 + c]));
-        gap = 0.0f;
-        for (float f = 0.9f; f > 0.05f; f *= 0.5f)
-          if (fl_cull_apart(box, f * d, r)) {
-            gap = f * d;
-            break;
-          }
-      }
-      red[FL_CULL_GAP + k] = gap;
-    }
-  }
-  barrier(CLK_LOCAL_MEM_FENCE);
-  return red[FL_CULL_GAP - 1];
+}
+/* How far the paths may leave the box with the action of reach r (FL_REACH_FLOATS) still out
+ * of their reach; -1: it is not (or the action is not culled this step). */
+FL_INLINE float fl_cull_gap(const float* box, __global const float* r) {
+  if (!(r[6] >= 0.0f) || !fl_cull_apart(box, 0.0f, r)) return -1.0f;
+  /* apart is monotonic in the widening: the largest of a few that still holds. */
+  float d = 0.0f;
+  for (int c = 0; c < 3; ++c) d = fmax(d, fmax(box[c] - r[3 + c], r[c] - box[3 + c]));
+  for (float f = 0.9f; f > 0.05f; f *= 0.5f)
+    if (fl_cull_apart(box, f * d, r)) return f * d;
+  return 0.0f;
 }
 
 /* Whether no particle of the work-group can reach the action's reach box r (FL_REACH_FLOATS):

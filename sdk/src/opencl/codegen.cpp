@@ -467,53 +467,102 @@ std::string followCode(const Action& a, const std::string& r) {
 }
 
 // The list's body with spatial culling. The work-group's swept bounds are gathered
-// (fl_cull_gather: barriers) at points chosen here: before the first action that may be
-// culled, and again before the next one after an action that moves particles in a way the
-// bounds cannot follow (followCode; a Move). Each gather is unconditional, under no branch
-// but the sub-step loop (whose count is the same for the whole group), as PoCL needs
-// (barriers under run-time branches hung it), and a gather costs PoCL a parallel region per
-// barrier: hence few of them. An action whose reach (the host's, in extra) the bounds
-// cannot touch, widened by how far the paths may have left them since (fl_grow), is
-// skipped: the gather decides for every action once per work-group (PoCL would test each
-// work-item). fl_grow and fl_rmax have one value in the work-group (the reduced bounds, the
-// list's constants), so the skips are the group's; the skipped code holds no barrier. A
+// (fl_cull_put into local memory, a barrier, one work-item reduces them and decides, a
+// barrier) at points chosen here: before the first action that may be culled, and again
+// before the next one after an action that moves particles in a way the bounds cannot
+// follow (followCode; a Move). Each gather is unconditional, under no branch but the
+// sub-step loop (whose count is the same for the whole group), as PoCL needs (barriers under
+// run-time branches hung it), and a barrier costs PoCL a parallel region: hence few of them.
+// The deciding work-item takes every decision up to the next gather: an action whose reach
+// (the host's, in extra) the bounds cannot touch, widened by how far the paths may have left
+// them since (fl_grow, which it follows through the actions that run), is skipped. It leaves
+// a flag per action and the list of the actions that run, so that a run of consecutive
+// actions that may be culled and do nothing when culled is one loop over that list (PoCL
+// runs each work-item's code on its own: 32 skipped floors were 32 tests per particle). A
 // skip is counted once per work-group.
 std::string cullingBody(const std::vector<Action>& acts, const std::string& body,
                         const std::vector<std::size_t>& marks, const std::vector<int>& placed) {
-  std::ostringstream s;
-  s << "    float fl_rmax = 0.0f; /* the longest path of the group */\n"
-       "    /* How far paths may have left the bounds since they were gathered (infinite: the\n"
-       "     * bounds are lost) */\n"
-       "    float fl_grow = INFINITY;\n"
-       "    const float fl_dtmax = (float)(fl_real_from_bits(dtBits) / (fl_real)nsub);\n"
-       "    (void)fl_rmax; (void)fl_grow; (void)fl_dtmax;\n";
-  bool stale = true;  // no bounds gathered since the sub-step's start or the last move
-  std::string culled;
-  for (std::size_t k = 0; k < acts.size(); ++k) {
-    std::string piece = body.substr(marks[k], marks[k + 1] - marks[k]);
+  const std::size_t n = acts.size();
+  const std::string flags = "FL_CULL_LOCAL + ",
+                    list = "FL_CULL_LOCAL + " + std::to_string(n) + "u + ";
+  const std::string count = "FL_CULL_LOCAL + " + std::to_string(2 * n) + "u";
+  std::vector<std::string> piece(n), follow(n), culled(n);
+  std::vector<bool> cull(n), moves(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    piece[k] = body.substr(marks[k], marks[k + 1] - marks[k]);
     // A user's callback may write global memory itself: only for live particles.
     if (std::holds_alternative<Callback>(acts[k]))
-      piece = "    if (fl_live) {\n" + piece + "    }\n";
+      piece[k] = "    if (fl_live) {\n" + piece[k] + "    }\n";
     const std::string r = "(extra + reachOff + " + std::to_string(k * FL_REACH_FLOATS) + "u)";
-    const bool moves = placed[k] != 0 && mayMove(acts[k]);
-    const std::string follow = placed[k] == 1 && moves ? followCode(acts[k], r) : "";
-    if (placed[k] == 1 && culledCode(acts[k], k, culled)) {
-      if (stale)
-        s << "    fl_rmax = fl_cull_gather(fl_red, fl_live, dt, px, py, pz, vx, vy, vz, extra + "
-             "reachOff, "
-          << acts.size() << "u);\n    fl_grow = 0.0f;\n";
+    moves[k] = placed[k] != 0 && mayMove(acts[k]);
+    follow[k] = placed[k] == 1 && moves[k] ? followCode(acts[k], r) : "";
+    cull[k] = placed[k] == 1 && culledCode(acts[k], k, culled[k]);
+  }
+  // In a list run: may be culled, and does nothing when culled.
+  const auto listed = [&](std::size_t k) { return cull[k] && culled[k].empty(); };
+  std::ostringstream s;
+  s << "    uint fl_na = 0u, fl_e = 0u; /* the actions that run, and the next one */\n"
+       "    (void)fl_na; (void)fl_e;\n";
+  bool stale = true;  // no bounds gathered since the sub-step's start or the last move
+  for (std::size_t k = 0; k < n; ++k) {
+    if (cull[k] && stale) {
+      // The decisions up to the next gather, by one work-item.
+      s << "    fl_cull_put(fl_red, fl_live, dt, px, py, pz, vx, vy, vz);\n"
+           "    barrier(CLK_LOCAL_MEM_FENCE);\n"
+           "    if (get_local_id(0) == 0u) {\n"
+           "      float fl_box[7];\n"
+           "      fl_cull_box(fl_red, fl_box);\n"
+           "      /* The longest path, how far paths may have left the box since */\n"
+           "      float fl_rmax = fl_box[6], fl_grow = 0.0f;\n"
+           "      const float fl_dtmax = (float)(fl_real_from_bits(dtBits) / (fl_real)nsub);\n"
+           "      uint fl_run, fl_skip = 0u;\n"
+           "      (void)fl_rmax; (void)fl_dtmax;\n"
+           "      fl_na = 0u;\n";
+      for (std::size_t j = k; j < n; ++j) {
+        const std::string r = "(extra + reachOff + " + std::to_string(j * FL_REACH_FLOATS) + "u)";
+        if (cull[j]) {
+          s << "      fl_run = !(fl_grow <= fl_cull_gap(fl_box, " << r << "));\n"
+            << "      fl_red[" << flags << j << "u] = (int)fl_run;\n"
+            << "      if (fl_run) {\n";
+          if (listed(j)) s << "      fl_red[" << list << "fl_na++] = " << j << ";\n";
+          s << follow[j] << "      } else {\n        ++fl_skip;\n      }\n";
+        } else if (moves[j]) {
+          if (follow[j].empty()) break;  // the next gather decides from here
+          s << follow[j];
+        }
+      }
+      s << "      fl_red[" << count << "] = (int)fl_na;\n"
+        << "      if (fl_skip) atomic_add(&state[FL_STATE_CULLED], fl_skip);\n"
+           "    }\n"
+           "    barrier(CLK_LOCAL_MEM_FENCE);\n"
+           "    fl_na = (uint)fl_red["
+        << count << "];\n    fl_e = 0u;\n";
       stale = false;
-      s << "    if (!(fl_grow <= fl_red[FL_CULL_GAP + " << k << "u])) {\n"
-        << piece << (moves ? follow : "") << "    } else {\n"
-        << "    if (get_local_id(0) == 0u) atomic_inc(&state[FL_STATE_CULLED]);\n";
-      std::istringstream lines(culled);
+    }
+    if (listed(k)) {
+      std::size_t last = k;
+      while (last + 1 < n && listed(last + 1)) ++last;
+      if (last == k) {
+        s << "    if (fl_red[" << flags << k << "u]) {\n" << piece[k] << "    }\n";
+      } else {
+        s << "    for (; fl_e < fl_na; ++fl_e) {\n"
+             "      const int fl_k = fl_red["
+          << list << "fl_e];\n      if (fl_k > " << last << ") break;\n"
+          << "      switch (fl_k) {\n";
+        for (std::size_t j = k; j <= last; ++j)
+          s << "      case " << j << ": {\n" << piece[j] << "      } break;\n";
+        s << "      default: break;\n      }\n    }\n";
+      }
+      k = last;
+    } else if (cull[k]) {
+      s << "    if (fl_red[" << flags << k << "u]) {\n" << piece[k] << "    } else {\n";
+      std::istringstream lines(culled[k]);
       for (std::string line; std::getline(lines, line);) s << "    " << line << "\n";
       s << "    }\n";
     } else {
-      s << piece;
-      if (moves && !stale) s << follow;
+      s << piece[k];
     }
-    if (moves && follow.empty()) stale = true;
+    if (moves[k] && follow[k].empty()) stale = true;
   }
   return s.str();
 }
@@ -724,7 +773,7 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
        "    uint step, uint streamBase, uint nsubStep, uint snapStride,\n"
        "    __global float* restrict tau, uint i, uint n0, uint n, uint snapN, fl_real t0,\n"
        "    fl_real t1"
-    << (g.culls ? ", uint reachOff, uint fl_live, __local float* fl_red" : "")
+    << (g.culls ? ", uint reachOff, uint fl_live, __local int* fl_red" : "")
     << ") {\n"
        "  (void)state; (void)extra; (void)snap; (void)snapN; (void)snapStride; (void)seedLo;\n"
        "  (void)seedHi; (void)step; (void)n;\n"
@@ -735,8 +784,8 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
       "codes, ap, state, extra, snap, dtBits, seedLo, seedHi, step, streamBase, nsubStep,\n"
       "      snapStride, tau, i, n0, n, snapN, t0, t1";
   call += g.culls ? ", reachOff, i < n, fl_red);\n" : ");\n";
-  const std::string local = g.culls ? "  __local float fl_red[FL_CULL_LOCAL_FLOATS + " +
-                                          std::to_string(acts.size() + 1) +
+  const std::string local = g.culls ? "  __local int fl_red[FL_CULL_LOCAL + " +
+                                          std::to_string(2 * acts.size() + 1) +
                                           "]; /* the culling's reduction and decisions */\n"
                                     : "";
   const char* size = g.culls ? "__attribute__((reqd_work_group_size(FL_ACT_LOCAL, 1, 1))) " : "";
