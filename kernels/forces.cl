@@ -312,26 +312,25 @@ FL_INLINE void fl_magnetic_acc(__global const FlActionParams* a, float px, float
  * float in extra (xyz per sample, x fastest), u[1..3] dims, u[4] 1 for Mode::Velocity;
  * falloff ---------------------------------------------------------------------------------- */
 
-/* field.hpp VectorField::sample: trilinear, positions outside take the border's value. */
+/* field.hpp VectorField::sample: the cell and the blend are forces.h's. */
 FL_INLINE float3 fl_field_sample(__global const FlActionParams* a, __global const float* extra,
                                  float px, float py, float pz) {
   const int nx = (int)a->u[1], ny = (int)a->u[2], nz = (int)a->u[3];
   const float vs = a->f[3];
-  const float fx = fl_clampf((px - a->f[0]) / vs, 0.0f, (float)(nx - 1));
-  const float fy = fl_clampf((py - a->f[1]) / vs, 0.0f, (float)(ny - 1));
-  const float fz = fl_clampf((pz - a->f[2]) / vs, 0.0f, (float)(nz - 1));
-  const int x0 = min((int)fx, nx - 1), y0 = min((int)fy, ny - 1), z0 = min((int)fz, nz - 1);
-  const int x1 = min(x0 + 1, nx - 1), y1 = min(y0 + 1, ny - 1), z1 = min(z0 + 1, nz - 1);
-  const float tx = fx - (float)x0, ty = fy - (float)y0, tz = fz - (float)z0;
+  int x0, x1, y0, y1, z0, z1;
+  const float tx = fl_field_axis((px - a->f[0]) / vs, nx, &x0, &x1);
+  const float ty = fl_field_axis((py - a->f[1]) / vs, ny, &y0, &y1);
+  const float tz = fl_field_axis((pz - a->f[2]) / vs, nz, &z0, &z1);
   __global const float* g = extra + a->u[0];
 #define FL_AT(x, y, z) vload3((uint)(x) + (uint)nx * ((uint)(y) + (uint)ny * (uint)(z)), g)
-  const float3 sx = (float3)(1.0f - tx), sy = (float3)(1.0f - ty), sz = (float3)(1.0f - tz);
-  const float3 c00 = FL_AT(x0, y0, z0) * sx + FL_AT(x1, y0, z0) * tx;
-  const float3 c10 = FL_AT(x0, y1, z0) * sx + FL_AT(x1, y1, z0) * tx;
-  const float3 c01 = FL_AT(x0, y0, z1) * sx + FL_AT(x1, y0, z1) * tx;
-  const float3 c11 = FL_AT(x0, y1, z1) * sx + FL_AT(x1, y1, z1) * tx;
+  const float3 c000 = FL_AT(x0, y0, z0), c100 = FL_AT(x1, y0, z0), c010 = FL_AT(x0, y1, z0),
+               c110 = FL_AT(x1, y1, z0), c001 = FL_AT(x0, y0, z1), c101 = FL_AT(x1, y0, z1),
+               c011 = FL_AT(x0, y1, z1), c111 = FL_AT(x1, y1, z1);
 #undef FL_AT
-  return (c00 * sy + c10 * ty) * sz + (c01 * sy + c11 * ty) * tz;
+#define FL_BLEND(k) \
+  fl_field_blend(c000.k, c100.k, c010.k, c110.k, c001.k, c101.k, c011.k, c111.k, tx, ty, tz)
+  return make_float3(FL_BLEND(x), FL_BLEND(y), FL_BLEND(z));
+#undef FL_BLEND
 }
 
 FL_INLINE void fl_sampled_field(__global const FlActionParams* a, __global const float* extra,

@@ -192,6 +192,33 @@ FL_INLINE void fl_magnetic_accel(float Bx, float By, float Bz, float q, float w,
   *az += (vx * By - Bx * vy) * q * w;
 }
 
+/* ---- SampledField: a trilinear lookup in a grid of vectors (field.hpp VectorField::sample),
+ * positions outside taking the border's value. Each side reads the eight corners from its
+ * own storage (the CPU's vector, the device's buffer) and blends them here. */
+
+/* Along an axis of n samples, at g voxels from the grid's origin: the cell's lower sample
+ * *i0 and upper *i1 (the same at the last sample), and the weight of *i1. The clamp is
+ * libstdc++'s std::clamp, min(max()): the same values as fl_clampf (a NaN passes through
+ * both), but GCC makes it maxss/minss where fl_clampf's nested select became two branches,
+ * mispredicted for positions in and out of the grid (1.7x slower on the CPU). */
+FL_INLINE float fl_field_axis(float g, int n, int* i0, int* i1) {
+  const float f = fl_minf(fl_maxf(g, 0.0f), (float)(n - 1));
+  const int lo = fl_mini((int)f, n - 1);
+  *i0 = lo;
+  *i1 = fl_mini(lo + 1, n - 1);
+  return f - (float)lo;
+}
+
+/* One component blended from the eight corners, cXYZ at the lower (0) or upper (1) sample
+ * along each axis, by the upper samples' weights tx, ty, tz: along x, then y, then z. */
+FL_INLINE float fl_field_blend(float c000, float c100, float c010, float c110, float c001,
+                               float c101, float c011, float c111, float tx, float ty, float tz) {
+  const float sx = 1.0f - tx, sy = 1.0f - ty;
+  const float c00 = c000 * sx + c100 * tx, c10 = c010 * sx + c110 * tx;
+  const float c01 = c001 * sx + c101 * tx, c11 = c011 * sx + c111 * tx;
+  return (c00 * sy + c10 * ty) * (1.0f - tz) + (c01 * sy + c11 * ty) * tz;
+}
+
 /* ---- Targets, speed limits ---------------------------------------------------------------- */
 
 /* A value carried towards its target by k (fl_approach of the rate). */
