@@ -31,6 +31,10 @@ FL_INLINE float3 fl_emitter_at(__global const FlEmitter* e, __global const FlKey
     return fl_v3(e->position) + fl_v3(e->velocity) * (float)(t - fl_real_from_bits(e->start));
   __global const FlKeyframe* k = keys + e->pathFirst;
   const uint last = e->pathCount - 1;
+  if (e->pathLoop != 0 && t > fl_real_from_bits(k[last].time)) {
+    const fl_real t0 = fl_real_from_bits(k[0].time);
+    t = t0 + fmod(t - t0, fl_real_from_bits(k[last].time) - t0);
+  }
   if (t <= fl_real_from_bits(k[0].time)) return fl_v3(k[0].position);
   if (t >= fl_real_from_bits(k[last].time)) return fl_v3(k[last].position);
   uint b = 1; /* the first key later than t */

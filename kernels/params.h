@@ -74,6 +74,8 @@ typedef struct FlEmitter {
   fl_u32 typeFirst, typeCount; /* types [typeFirst, typeFirst + typeCount) */
   float totalWeight;           /* the types' weights summed in order, as the CPU does */
   fl_u32 variant;              /* the case of the generated fl_emit for its kinds */
+  fl_u32 pathLoop;             /* Emitter::pathLoop: 1 repeats the path after its last key */
+  fl_u32 pad;
 } FlEmitter;
 
 typedef struct FlKeyframe {

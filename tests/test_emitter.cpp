@@ -99,6 +99,33 @@ TEST(Emitter, PathKeyframesAreInterpolated) {
   EXPECT_EQ(e.positionAt(9.0), Vec3(10, 20, 0));
 }
 
+// A looping path starts again from its first key after its last: births at rate 10 along
+// a there-and-back path of period 2 s keep tracing it, where a path that stops would
+// leave every birth after 2 s at its end.
+TEST(Emitter, LoopingPathWrapsToTheFirstKey) {
+  Emitter e;
+  e.path = {{0.5, Vec3(0)}, {1.5, Vec3(10, 0, 0)}, {2.5, Vec3(0)}};
+  e.pathLoop = true;
+  EXPECT_EQ(e.positionAt(0.0), Vec3(0));  // before the first key: held
+  EXPECT_EQ(e.positionAt(2.75), Vec3(2.5f, 0, 0));
+  EXPECT_EQ(e.positionAt(8.0), Vec3(5, 0, 0));  // three loops and 1.5 s: on the way back
+  ContextOptions o;
+  o.dt = 0.1;
+  Context ctx(o);
+  Group& g = ctx.createGroup("g", 1000);
+  e.rate = 4.0;  // births at 0.25, 0.5, ...: on the keys and halfway between
+  g.addEmitter(e);
+  ctx.run(60);
+  ASSERT_EQ(g.size(), 24u);
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const Particle p = g.particle(i);
+    const double t = 0.25 * (p.id + 1);
+    const double phase = t < 0.5 ? 0.0 : std::fmod(t - 0.5, 2.0);  // 0..2 s around the loop
+    const double x = phase <= 1.0 ? 10.0 * phase : 10.0 * (2.0 - phase);
+    EXPECT_NEAR(p.position.x, x, 1e-4) << "born at " << t;
+  }
+}
+
 TEST(Emitter, CapacityOverflowIsCountedNotACrash) {
   Context ctx;
   Group& g = ctx.createGroup("g", 100);
@@ -168,6 +195,10 @@ TEST(Emitter, InvalidParametersNameTheField) {
   Emitter f;
   f.path = {{1.0, Vec3(0)}, {0.5, Vec3(1)}};
   expectParam(f, "emitters[0].path[1].time");
+  Emitter h;
+  h.path = {{1.0, Vec3(0)}};
+  h.pathLoop = true;  // a period of 0 s
+  expectParam(h, "emitters[0].pathLoop");
 }
 
 TEST(Emitter, BurstRepeatedForeverCostsTheSameEveryStep) {

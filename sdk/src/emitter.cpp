@@ -14,6 +14,11 @@ bool finite(Vec3 v) {
 
 Vec3 Emitter::positionAt(double t) const {
   if (path.empty()) return position + velocity * float(t - start);
+  if (pathLoop && t > path.back().time) {
+    // fmod is exact, so the device (kernels/emit.cl fl_emitter_at) wraps to the same time.
+    const double t0 = path.front().time;
+    t = t0 + std::fmod(t - t0, path.back().time - t0);
+  }
   if (t <= path.front().time) return path.front().position;
   if (t >= path.back().time) return path.back().position;
   const auto it = std::upper_bound(path.begin(), path.end(), t,
@@ -46,6 +51,7 @@ void Emitter::validate(const std::string& where) const {
     if (i > 0 && path[i].time <= path[i - 1].time)
       fail(f + ".time", "keyframe times must increase");
   }
+  if (pathLoop && path.size() < 2) fail("pathLoop", "a looping path needs at least two keys");
   if (types.empty()) fail("types", "an emitter needs at least one particle type");
   double total = 0;
   for (std::size_t i = 0; i < types.size(); ++i) {
@@ -86,6 +92,7 @@ Vec3 PrimeEmitter::positionAt(double t) const {
   e.position = position;
   e.velocity = velocity;
   e.path = path;
+  e.pathLoop = pathLoop;
   e.start = start;
   return e.positionAt(t);
 }
@@ -97,6 +104,7 @@ void PrimeEmitter::validate(const std::string& where) const {
   e.position = position;
   e.velocity = velocity;
   e.path = path;
+  e.pathLoop = pathLoop;
   e.start = start;
   e.stop = stop;
   e.validate(where);

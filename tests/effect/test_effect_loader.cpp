@@ -354,7 +354,8 @@ TEST(EffectLoader, EmittersAndPrimeEmitters) {
     "emitters": [{"name": "e", "shape": {"type": "sphere", "outerRadius": 1}, "rate": 10.5,
                   "bursts": [{"time": 1, "count": 5, "interval": 0.5, "repeat": 3}],
                   "path": [{"time": 0, "position": [0, 0, 0]}, {"time": 2, "position": [2, 0, 0]}],
-                  "start": 0.5, "stop": 9, "spacing": 0.1, "normalSpeed": [1, 0.1],
+                  "pathLoop": true, "start": 0.5, "stop": 9, "spacing": 0.1,
+                  "normalSpeed": [1, 0.1],
                   "types": [{"weight": 2, "velocity": [0, 1, 0]}, {"weight": 1}]}],
     "primeEmitters": [{"name": "p", "rate": 2, "child": {
         "lifetime": 1, "deathChildren": 3, "emitter": {"rate": 50},
@@ -366,6 +367,7 @@ TEST(EffectLoader, EmittersAndPrimeEmitters) {
   EXPECT_EQ(e.bursts[0].repeat, 3u);
   ASSERT_EQ(e.path.size(), 2u);
   EXPECT_EQ(e.path[1].position.x, 2.0f);
+  EXPECT_TRUE(e.pathLoop);
   EXPECT_EQ(e.stop, 9.0);
   ASSERT_EQ(e.types.size(), 2u);
   EXPECT_EQ(e.types[0].weight, 2.0f);
@@ -374,6 +376,14 @@ TEST(EffectLoader, EmittersAndPrimeEmitters) {
   ASSERT_TRUE(p.child.next);
   EXPECT_EQ(p.child.next->deathBurst, 10u);
   EXPECT_EQ(p.child.emitter.rate, 50.0);
+  EXPECT_FALSE(p.pathLoop);
+  // Written back and read again: the loop stays, and a path that does not loop says nothing.
+  const std::string saved = saveEffect(fx);
+  EXPECT_NE(saved.find("\"pathLoop\": true"), std::string::npos) << saved;
+  EXPECT_EQ(saved.find("pathLoop"), saved.rfind("pathLoop")) << saved;
+  EXPECT_TRUE(parseEffect(saved, "saved.json").groups[0].emitters[0].pathLoop);
+  EXPECT_EQ(errorOf(withGroup(R"("emitters": [{"pathLoop": true}])")).path(),
+            "groups[0].emitters[0].pathLoop");
   // deathChildren without a next level: the core's check, at the JSON path.
   const EffectError noNext =
       errorOf(withGroup(R"("primeEmitters": [{"rate": 1, "child": {"deathChildren": 2}}])"));

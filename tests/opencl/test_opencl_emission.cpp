@@ -88,6 +88,28 @@ TEST(OpenCLEmission, Spacing) {
   });
 }
 
+// Emitter::pathLoop: the device wraps each birth time to the path's first key as the CPU
+// does, for births by rate and by distance (200 steps of 1/30 s: the 1.2 s loop five times).
+TEST(OpenCLEmission, LoopingPath) {
+  checkParity([](Context& ctx) -> Group& {
+    Group& g = ctx.createGroup("loop", 20000);
+    Emitter e;
+    e.path = {{0.1, Vec3(0.0f)},
+              {0.5, Vec3(2.0f, 0.0f, 0.0f)},
+              {0.9, Vec3(1.0f, 2.0f, 1.0f)},
+              {1.3, Vec3(0.0f)}};
+    e.pathLoop = true;
+    e.rate = 90;
+    e.spacing = 0.05f;
+    e.shape = Domain::sphere(Vec3(0.0f), 0.1f);
+    e.types = {drawingType(Domain::sphere(Vec3(0.0f), 0.5f))};
+    g.addEmitter(e);
+    g.setActions({Gravity{kDown}, Move{}, KillOld{}});
+    g.require(kAll);
+    return g;
+  });
+}
+
 // Emitter::normalSpeed on every shape: the normal where each particle is born (faces, the
 // nearest face of a box or a mesh, the axial frames of cylinders and cones, a union's
 // nearest leaf), uniform and normal speeds, one type (the CPU's batch path) and several.

@@ -40,6 +40,9 @@ struct Burst {
 };
 
 /// A keyframe of an emitter's path; positions are interpolated linearly between keys.
+/// Before the first key the emitter stays at it; after the last it stays there too, or, with
+/// the emitter's `pathLoop`, the path repeats: time wraps to the first key's time, every
+/// `last.time - first.time` seconds. A closed loop repeats the first key's position last.
 struct Keyframe {
   double time = 0.0;
   Vec3 position{0.0f};
@@ -61,6 +64,8 @@ struct Emitter {
   Vec3 position{0.0f};
   Vec3 velocity{0.0f};
   std::vector<Keyframe> path;
+  /// After the path's last key, start it again from the first (needs two keys or more).
+  bool pathLoop = false;
   double start = 0.0;
   double stop = std::numeric_limits<double>::infinity();
   std::vector<ParticleType> types{ParticleType{}};
@@ -115,6 +120,7 @@ struct PrimeEmitter {
   Vec3 position{0.0f};
   Vec3 velocity{0.0f};
   std::vector<Keyframe> path;
+  bool pathLoop = false;  ///< as Emitter::pathLoop
   double start = 0.0;
   double stop = std::numeric_limits<double>::infinity();
   EmitterSpec child;

@@ -605,6 +605,7 @@ constexpr auto countingFields() {
       field("position", &E::position, "units", kAny, "offset of the shape"),
       field("velocity", &E::velocity, "units/s", kAny, "the emitter's own motion"),
       field("path", &E::path, "", kAny, "keyframed positions"),
+      field("pathLoop", &E::pathLoop, "", kAny, "repeat the path after its last key"),
       field("start", &E::start, "s", kAny, "emits from"),
       field("stop", &E::stop, "s", kAny, "emits until (inf: for ever)"),
   };

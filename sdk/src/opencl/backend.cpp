@@ -34,7 +34,7 @@ namespace flurry::detail::ocl {
 static_assert(sizeof(cl::FlDomain) == 72 && alignof(cl::FlDomain) == 4);
 static_assert(sizeof(cl::FlFuzzy) == 16);
 static_assert(sizeof(cl::FlParticleType) == 4 * 72 + 5 * 16 + 8);
-static_assert(sizeof(cl::FlEmitter) == 72 + 16 + 32 + 16 + 24 &&
+static_assert(sizeof(cl::FlEmitter) == 72 + 16 + 32 + 16 + 32 &&
               offsetof(cl::FlEmitter, start) == 72);
 static_assert(sizeof(cl::FlKeyframe) == 24 && offsetof(cl::FlKeyframe, position) == 8);
 static_assert(sizeof(cl::FlBirthRun) == 64 && offsetof(cl::FlBirthRun, emitter) == 56);

@@ -120,6 +120,7 @@ std::uint32_t packEmitter(const Emitter& em, std::uint32_t variant, StepTables& 
   o.normalSpeed = packFuzzy(em.normalSpeed);
   o.pathFirst = cl::fl_u32(t.keys.size());
   o.pathCount = cl::fl_u32(em.path.size());
+  o.pathLoop = em.pathLoop ? 1u : 0u;
   for (const Keyframe& k : em.path)
     t.keys.push_back({doubleBits(k.time), {k.position.x, k.position.y, k.position.z, 0.0f}});
   o.typeFirst = cl::fl_u32(t.types.size());
