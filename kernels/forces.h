@@ -198,11 +198,13 @@ FL_INLINE void fl_magnetic_accel(float Bx, float By, float Bz, float q, float w,
 
 /* Along an axis of n samples, at g voxels from the grid's origin: the cell's lower sample
  * *i0 and upper *i1 (the same at the last sample), and the weight of *i1. The clamp is
- * libstdc++'s std::clamp, min(max()): the same values as fl_clampf (a NaN passes through
- * both), but GCC makes it maxss/minss where fl_clampf's nested select became two branches,
- * mispredicted for positions in and out of the grid (1.7x slower on the CPU). */
+ * max(0, min()): the same values as fl_clampf, but GCC makes it minss/maxss where
+ * fl_clampf's nested select became two branches, mispredicted for positions in and out of
+ * the grid (1.7x slower on the CPU); and a NaN position (an earlier action's, before the
+ * step's guard kills it) samples the first cell instead of casting NaN to int (undefined
+ * behaviour, INT_MIN on x86: a read far outside the grid). */
 FL_INLINE float fl_field_axis(float g, int n, int* i0, int* i1) {
-  const float f = fl_minf(fl_maxf(g, 0.0f), (float)(n - 1));
+  const float f = fl_maxf(0.0f, fl_minf(g, (float)(n - 1))); /* NaN -> 0 */
   const int lo = fl_mini((int)f, n - 1);
   *i0 = lo;
   *i1 = fl_mini(lo + 1, n - 1);

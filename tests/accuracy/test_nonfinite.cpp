@@ -37,12 +37,24 @@ template <class F>
 
 TEST(NonFinite, ActionParametersAreRefused) {
   for (float bad : {kNaN, kInf, -kInf}) {
-    EXPECT_TRUE(refuses([&] { ActionList{}.add(Gravity{Vec3(0.0f, bad, 0.0f)}); },
-                        "Gravity.acceleration"));
+    EXPECT_TRUE(
+        refuses([&] { ActionList{}.add(Gravity{Vec3(0.0f, bad, 0.0f)}); }, "Gravity.acceleration"));
     EXPECT_TRUE(refuses([&] { ActionList{}.add(Damping{Vec3(bad)}); }, "Damping.rate"));
-    EXPECT_TRUE(refuses([&] { ActionList{}.add(OrbitPoint{Vec3(bad), 1.0f}); }, "OrbitPoint.center"));
-    EXPECT_TRUE(refuses([&] { ActionList{}.add(OrbitPoint{Vec3(0.0f), bad}); }, "OrbitPoint.magnitude"));
-    EXPECT_TRUE(refuses([&] { ActionList{}.add(OrbitPoint{Vec3(0.0f), 1.0f, bad}); }, "OrbitPoint.epsilon"));
+    EXPECT_TRUE(refuses(
+        [&] {
+          ActionList{}.add(OrbitPoint{Vec3(bad), 1.0f});
+        },
+        "OrbitPoint.center"));
+    EXPECT_TRUE(refuses(
+        [&] {
+          ActionList{}.add(OrbitPoint{Vec3(0.0f), bad});
+        },
+        "OrbitPoint.magnitude"));
+    EXPECT_TRUE(refuses(
+        [&] {
+          ActionList{}.add(OrbitPoint{Vec3(0.0f), 1.0f, bad});
+        },
+        "OrbitPoint.epsilon"));
     Vortex v;
     v.aroundSpeed = bad;
     EXPECT_TRUE(refuses([&] { ActionList{}.add(v); }, "Vortex.aroundSpeed"));
@@ -50,8 +62,11 @@ TEST(NonFinite, ActionParametersAreRefused) {
                         "MagneticField.field"));
     EXPECT_TRUE(refuses([&] { ActionList{}.add(ElectricField{Vec3(bad, 0.0f, 0.0f)}); },
                         "ElectricField.field"));
-    EXPECT_TRUE(refuses([&] { ActionList{}.add(TargetVelocity{Vec3(bad), 1.0f}); },
-                        "TargetVelocity.velocity"));
+    EXPECT_TRUE(refuses(
+        [&] {
+          ActionList{}.add(TargetVelocity{Vec3(bad), 1.0f});
+        },
+        "TargetVelocity.velocity"));
     EXPECT_TRUE(refuses(
         [&] {
           ActionList{}.add(Bounce{Domain::plane(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f)), bad});
@@ -70,7 +85,11 @@ TEST(NonFinite, StepSizesSubstepsAndEmittersAreRefused) {
   EXPECT_NO_THROW(makeContext(10.0));  // the maximum is allowed
   for (double bad : {double(kNaN), double(kInf), -1.0}) {
     EXPECT_TRUE(refuses([&] { ActionList{}.setSubsteps(Substeps{bad, 0.0f, 8}); }, "substeps"));
-    EXPECT_TRUE(refuses([&] { ActionList{}.setSubsteps(Substeps{0.0, float(bad), 8}); }, "substeps"));
+    EXPECT_TRUE(refuses(
+        [&] {
+          ActionList{}.setSubsteps(Substeps{0.0, float(bad), 8});
+        },
+        "substeps"));
   }
   Context ctx = makeContext(1.0 / 60);
   Group& g = ctx.createGroup("g", 10);
@@ -95,6 +114,19 @@ TEST(NonFinite, ImportedFieldsAreRefused) {
   EXPECT_TRUE(refuses([&] { ActionList{}.add(s); }, "SampledField.field"));
 }
 
+// A NaN position (an earlier action's, before the step's guard) samples a field inside the
+// grid: a NaN cast to int would index far outside it.
+TEST(NonFinite, AFieldSampledAtNaNStaysInsideTheGrid) {
+  VectorField field;
+  field.dims = glm::ivec3(3, 2, 2);
+  field.data.assign(12, Vec3(1.0f, 2.0f, 3.0f));
+  for (Vec3 p :
+       {Vec3(kNaN, 0.5f, 0.5f), Vec3(0.5f, kNaN, 0.5f), Vec3(0.5f, 0.5f, kNaN), Vec3(kNaN)}) {
+    const Vec3 s = field.sample(p);
+    EXPECT_EQ(s, Vec3(1.0f, 2.0f, 3.0f));
+  }
+}
+
 // A callback that writes NaN or Inf into a position or a velocity: exactly those particles
 // die in that step and are counted; nothing non-finite is left; the others are untouched.
 TEST(NonFinite, ACallbackWritingNaNKillsAndCountsTheParticle) {
@@ -106,15 +138,25 @@ TEST(NonFinite, ACallbackWritingNaNKillsAndCountsTheParticle) {
     cb.function = [](Particle& p, const CallbackContext& c) {
       if (c.step != 3) return;
       switch (p.id % 10) {
-        case 1: p.position.x = kNaN; break;
-        case 2: p.velocity.y = kInf; break;
-        case 3: p.velocity.z = -kInf; break;
-        case 4: p.position.z = kInf; break;
-        default: break;
+        case 1:
+          p.position.x = kNaN;
+          break;
+        case 2:
+          p.velocity.y = kInf;
+          break;
+        case 3:
+          p.velocity.z = -kInf;
+          break;
+        case 4:
+          p.position.z = kInf;
+          break;
+        default:
+          break;
       }
     };
     g.setActions(withIntegrator({Gravity{Vec3(0.0f, -9.81f, 0.0f)}, cb, Move{}}, integ));
-    for (int i = 0; i < 100; ++i) g.add(particleAt(Vec3(float(i), 0.0f, 0.0f), Vec3(0.0f, 1.0f, 0.0f)));
+    for (int i = 0; i < 100; ++i)
+      g.add(particleAt(Vec3(float(i), 0.0f, 0.0f), Vec3(0.0f, 1.0f, 0.0f)));
     ctx.run(3);
     EXPECT_EQ(g.size(), 100u);
     EXPECT_EQ(g.stats().killedNonFinite, 0u);

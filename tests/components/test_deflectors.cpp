@@ -48,7 +48,8 @@ TEST(Bounce, FastRadialBurstInsideASphereStaysFiniteAndInside) {
     ASSERT_EQ(g.size(), 10000u);
     for (std::size_t i = 0; i < g.size(); ++i) {
       const Particle q = g.particle(i);
-      ASSERT_TRUE(std::isfinite(glm::length(q.position)) && std::isfinite(glm::length(q.velocity))) << i;
+      ASSERT_TRUE(std::isfinite(glm::length(q.position)) && std::isfinite(glm::length(q.velocity)))
+          << i;
       ASSERT_LE(glm::length(q.position - C), 1.0f) << i;
     }
   }
@@ -151,7 +152,8 @@ TEST(Bounce, ClosedShapesNeverLeakAtHighSpeed) {
     {
       Context ctx = makeContext();
       Group& g = ctx.createGroup("in-sphere", 2000);
-      g.setActions({Gravity{}, Bounce{Domain::sphere(Vec3(1, 2, 3), 5.0f), 0.9f, 0.1f, 0.0f, true}, Move{}});
+      g.setActions(
+          {Gravity{}, Bounce{Domain::sphere(Vec3(1, 2, 3), 5.0f), 0.9f, 0.1f, 0.0f, true}, Move{}});
       fill(g, 2000, Domain::sphere(Vec3(1, 2, 3), 4.9f), velocities);
       for (int s = 0; s < 60; ++s) {
         ctx.step();
@@ -210,8 +212,8 @@ TEST(Bounce, BoxFromOutsideReflectsOffTheEntryFace) {
 TEST(Bounce, SegmentDeflectsIn2D) {
   Context ctx = makeContext(0.05);
   Group& g = ctx.createGroup("g", 200);
-  g.setActions({Gravity{}, Bounce{Domain::line(Vec3(-5, 0, 0), Vec3(5, 0, 0)), 0.5f},
-                Constrain2D{}, Move{}});
+  g.setActions({Gravity{}, Bounce{Domain::line(Vec3(-5, 0, 0), Vec3(5, 0, 0)), 0.5f}, Constrain2D{},
+                Move{}});
   fill(g, 200, Domain::rectangle(Vec3(-4, 1, 0), Vec3(8, 0, 0), Vec3(0, 3, 0)),
        Domain::disc(Vec3(0), Vec3(0, 0, 1), 20.0f));
   for (int s = 0; s < 100; ++s) {
@@ -297,7 +299,8 @@ TEST(Sink, PassThroughIsAFractionOfParticlesInEveryMode) {
 TEST(Sink, EachAbsorberCountsWhatItTook) {
   Context ctx = makeContext(0.1);
   Group& g = ctx.createGroup("g", 100);
-  g.setActions({Sink{Domain::sphere(Vec3(-5, 0, 0), 1.0f)}, Sink{Domain::sphere(Vec3(5, 0, 0), 1.0f)}});
+  g.setActions(
+      {Sink{Domain::sphere(Vec3(-5, 0, 0), 1.0f)}, Sink{Domain::sphere(Vec3(5, 0, 0), 1.0f)}});
   for (int i = 0; i < 30; ++i) {
     Particle p;
     p.position = Vec3(i < 10 ? -5.0f : (i < 30 ? 5.0f : 0.0f), 0, 0);
