@@ -281,6 +281,24 @@ void checkLane(const flurry::Group& g, flurry::Attribute a, int c) {
                                                " (flurry_group_require it before stepping)"};
 }
 
+// A transform from the C arrays (rotation as x, y, z, w), and back; absent outputs skipped.
+flurry::Transform transformOf(const float position[3], const float rotation[4], float scale) {
+  need(position, "position");
+  need(rotation, "rotation");
+  flurry::Transform t;
+  t.position = flurry::Vec3(position[0], position[1], position[2]);
+  t.rotation = glm::quat(rotation[3], rotation[0], rotation[1], rotation[2]);  // w, x, y, z
+  t.scale = scale;
+  return t;
+}
+void writeTransform(const flurry::Transform& t, float position[3], float rotation[4],
+                    float* scale) {
+  if (position) position[0] = t.position.x, position[1] = t.position.y, position[2] = t.position.z;
+  if (rotation)
+    rotation[0] = t.rotation.x, rotation[1] = t.rotation.y, rotation[2] = t.rotation.z,
+    rotation[3] = t.rotation.w;
+  if (scale) *scale = t.scale;
+}
 }  // namespace
 
 extern "C" {
@@ -770,12 +788,7 @@ flurry_status flurry_group_set_transform(flurry_group* g, const float position[3
                                          const float rotation[4], float scale) {
   return guard([&] {
     need(g, "group");
-    need(position, "position");
-    need(rotation, "rotation");
-    flurry::Transform t;
-    t.position = flurry::Vec3(position[0], position[1], position[2]);
-    t.rotation = glm::quat(rotation[3], rotation[0], rotation[1], rotation[2]);  // w, x, y, z
-    t.scale = scale;
+    const flurry::Transform t = transformOf(position, rotation, scale);
     group(g).setTransform(t);
   });
 }
@@ -784,12 +797,7 @@ flurry_status flurry_group_transform(const flurry_group* g, float position[3], f
   return guard([&] {
     need(g, "group");
     const flurry::Transform& t = group(g).transform();
-    if (position)
-      position[0] = t.position.x, position[1] = t.position.y, position[2] = t.position.z;
-    if (rotation)
-      rotation[0] = t.rotation.x, rotation[1] = t.rotation.y, rotation[2] = t.rotation.z,
-      rotation[3] = t.rotation.w;
-    if (scale) *scale = t.scale;
+    writeTransform(t, position, rotation, scale);
   });
 }
 flurry_status flurry_group_set_space(flurry_group* g, flurry_space space) {
@@ -847,12 +855,7 @@ flurry_status flurry_instance_set_transform(flurry_instance* inst, const float p
                                             const float rotation[4], float scale) {
   return guard([&] {
     need(inst, "instance");
-    need(position, "position");
-    need(rotation, "rotation");
-    flurry::Transform t;
-    t.position = flurry::Vec3(position[0], position[1], position[2]);
-    t.rotation = glm::quat(rotation[3], rotation[0], rotation[1], rotation[2]);  // w, x, y, z
-    t.scale = scale;
+    const flurry::Transform t = transformOf(position, rotation, scale);
     inst->instance.setTransform(t);
   });
 }
@@ -861,12 +864,7 @@ flurry_status flurry_instance_transform(const flurry_instance* inst, float posit
   return guard([&] {
     need(inst, "instance");
     const flurry::Transform& t = inst->instance.transform();
-    if (position)
-      position[0] = t.position.x, position[1] = t.position.y, position[2] = t.position.z;
-    if (rotation)
-      rotation[0] = t.rotation.x, rotation[1] = t.rotation.y, rotation[2] = t.rotation.z,
-      rotation[3] = t.rotation.w;
-    if (scale) *scale = t.scale;
+    writeTransform(t, position, rotation, scale);
   });
 }
 flurry_status flurry_instance_prewarm(flurry_instance* inst, double seconds, uint64_t* steps) {
