@@ -8,13 +8,8 @@
 using namespace flurry;
 
 namespace {
-// About 1000 live fountain particles (rate 500/s, lifetime 2 s), with the curved
-// integrators' guard too.
-std::size_t allocationsPerSteadyStep(unsigned threads, Integrator integrator) {
-  ContextOptions o;
-  o.threads = threads;
-  Context ctx(o);
-  Group& g = ctx.createGroup("small", 1500);
+// A fountain's nozzle: about 1000 live particles at 500/s for 2 s.
+Emitter fountainEmitter() {
   Emitter e;
   e.shape = Domain::disc(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f), 0.1f);
   ParticleType t;
@@ -22,6 +17,17 @@ std::size_t allocationsPerSteadyStep(unsigned threads, Integrator integrator) {
   t.lifetime = Fuzzy::percent(2.0f, 10.0f);
   e.types = {t};
   e.rate = 500.0;
+  return e;
+}
+
+// About 1000 live fountain particles (rate 500/s, lifetime 2 s), with the curved
+// integrators' guard too.
+std::size_t allocationsPerSteadyStep(unsigned threads, Integrator integrator) {
+  ContextOptions o;
+  o.threads = threads;
+  Context ctx(o);
+  Group& g = ctx.createGroup("small", 1500);
+  Emitter e = fountainEmitter();
   g.addEmitter(e);
   ActionList list{Gravity{Vec3(0.0f, -9.81f, 0.0f)},
                   Bounce{Domain::plane(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f)), 0.4f, 0.1f, 0.0f},
@@ -52,13 +58,7 @@ namespace {
 std::size_t allocationsPerMovingStep(Space space, Integrator integrator) {
   Context ctx;
   Group& g = ctx.createGroup("moving", 1500);
-  Emitter e;
-  e.shape = Domain::disc(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f), 0.1f);
-  ParticleType t;
-  t.velocity = Domain::cone(Vec3(0.0f), Vec3(0.0f, 8.0f, 0.0f), 1.5f);
-  t.lifetime = Fuzzy::percent(2.0f, 10.0f);
-  e.types = {t};
-  e.rate = 500.0;
+  Emitter e = fountainEmitter();
   e.path = {{0.0, Vec3(0.0f)}, {10.0, Vec3(1.0f, 0.0f, 0.0f)}};
   g.addEmitter(e);
   ActionList list{Gravity{Vec3(0.0f, -9.81f, 0.0f)},
