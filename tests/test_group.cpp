@@ -64,6 +64,38 @@ TEST(Group, FusedUnfusedAndBlockSizesGiveTheSameParticles) {
   EXPECT_TRUE(bitwiseEqual(fused, runFountain(2, true, 100000)));
 }
 
+// The holes of the dead are closed from the tail: every survivor is kept exactly once, with
+// all its lanes, and the group is dense, wherever the deaths fall (every block, the tail).
+TEST(Group, CompactionKeepsEverySurvivorOnceWithItsLanes) {
+  for (std::size_t block : {std::size_t(64), std::size_t(1000), std::size_t(0)}) {
+    Context ctx;
+    detail::setPassOptions(ctx, {.blockSize = block});
+    // Over several of the pass's tasks (32768 particles each).
+    Group& g = ctx.createGroup("g", 80000);
+    for (std::size_t i = 0; i < 80000; ++i) {
+      // Every third dies now, and the last 10000 all die: holes in every block, a dead tail.
+      Particle p;
+      p.position = Vec3(float(i), i % 3 == 0 || i >= 70000 ? -1.0f : 1.0f, 0.0f);
+      p.velocity = Vec3(0.0f);
+      ASSERT_TRUE(g.add(p));
+    }
+    g.setActions(
+        {Sink{Domain::box(Vec3(-1.0f, -2.0f, -1.0f), Vec3(90000.0f, 0.0f, 1.0f))}, Move{}});
+    ctx.step();
+    std::set<float> xs;
+    const auto x = g.lane(Attribute::Position, 0), y = g.lane(Attribute::Position, 1);
+    for (std::size_t i = 0; i < g.size(); ++i) {
+      EXPECT_EQ(y[i], 1.0f) << "a dead particle kept at " << i << " (block " << block << ")";
+      xs.insert(x[i]);
+      EXPECT_EQ(std::uint32_t(x[i]), g.ids()[i]) << "lanes out of step at " << i;
+    }
+    std::size_t expected = 0;
+    for (std::size_t i = 0; i < 70000; ++i) expected += i % 3 != 0;
+    EXPECT_EQ(g.size(), expected);
+    EXPECT_EQ(xs.size(), expected) << "a survivor was lost or copied twice (block " << block << ")";
+  }
+}
+
 TEST(Group, CountsAddUpAndIdsStayUnique) {
   Context ctx;
   Group& g = samples::buildFountain(ctx, 50000, 30000.0, 0.4f);
