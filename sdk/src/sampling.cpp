@@ -199,9 +199,11 @@ namespace {
 // Philox4x32-10 on W counters at once, for this translation unit's instruction set (it is
 // compiled once per set, sdk/CMakeLists.txt): the same function as Philox4x32::generate, bit
 // for bit. GCC vectorises the scalar loop but packs the 32x32->64-bit products with
-// cross-lane shuffles; here the products of the even lanes and of the odd lanes (shifted down)
-// come from two unsigned 32-bit multiplies, and their high and low words are merged back with
-// in-lane blends. Only the first counter word varies across lanes (the particle id).
+// cross-lane shuffles. Here the even and the odd lanes of a vector run apart, each word in the
+// low half of a 64-bit slot: an unsigned 32-bit multiply (which reads only the low halves)
+// then gives the full product, its low half is the next round's word as it stands and its
+// high half one shift away; the halves are blended back into 32-bit lanes once, at the end.
+// Only the first counter word varies across lanes (the particle id).
 #if defined(__AVX512F__)
 // GCC 12 takes the undefined pass-through operand of its AVX-512 intrinsics for an
 // uninitialised read (GCC bug 105593).
@@ -219,11 +221,11 @@ struct Lanes {
   static V load(const std::uint32_t* p) { return _mm512_loadu_si512(p); }
   static V xor2(V a, V b) { return _mm512_xor_si512(a, b); }
   static V xor3(V a, V b, V c) { return _mm512_ternarylogic_epi32(a, b, c, 0x96); }
-  static void mulhilo(V m, V c, V& hi, V& lo) {
-    const V even = _mm512_mul_epu32(c, m);
-    const V odd = _mm512_mul_epu32(_mm512_srli_epi64(c, 32), m);
-    hi = _mm512_mask_blend_epi32(0xAAAA, _mm512_srli_epi64(even, 32), odd);
-    lo = _mm512_mask_blend_epi32(0xAAAA, even, _mm512_slli_epi64(odd, 32));
+  static constexpr int kInFlight = 2;  // 32 registers
+  static V mul(V a, V b) { return _mm512_mul_epu32(a, b); }
+  static V high(V a) { return _mm512_srli_epi64(a, 32); }
+  static V pack(V even, V odd) {
+    return _mm512_mask_blend_epi32(0xAAAA, even, _mm512_slli_epi64(odd, 32));
   }
   // uniformFloat: w >> 8 < 2^24 converts exactly as a signed int.
   static void storeUniform(float* p, V w) {
@@ -244,11 +246,11 @@ struct Lanes {
   }
   static V xor2(V a, V b) { return _mm256_xor_si256(a, b); }
   static V xor3(V a, V b, V c) { return xor2(xor2(a, b), c); }
-  static void mulhilo(V m, V c, V& hi, V& lo) {
-    const V even = _mm256_mul_epu32(c, m);
-    const V odd = _mm256_mul_epu32(_mm256_srli_epi64(c, 32), m);
-    hi = _mm256_blend_epi32(_mm256_srli_epi64(even, 32), odd, 0xAA);
-    lo = _mm256_blend_epi32(even, _mm256_slli_epi64(odd, 32), 0xAA);
+  static constexpr int kInFlight = 1;  // 16 registers
+  static V mul(V a, V b) { return _mm256_mul_epu32(a, b); }
+  static V high(V a) { return _mm256_srli_epi64(a, 32); }
+  static V pack(V even, V odd) {
+    return _mm256_blend_epi32(even, _mm256_slli_epi64(odd, 32), 0xAA);
   }
   static void storeUniform(float* p, V w) {
     _mm256_storeu_ps(p, _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_srli_epi32(w, 8)),
@@ -266,13 +268,11 @@ struct Lanes {
   static V load(const std::uint32_t* p) { return _mm_loadu_si128(reinterpret_cast<const V*>(p)); }
   static V xor2(V a, V b) { return _mm_xor_si128(a, b); }
   static V xor3(V a, V b, V c) { return xor2(xor2(a, b), c); }
-  static void mulhilo(V m, V c, V& hi, V& lo) {
-    // No blend before SSE4.1: merge the words with masks.
-    const V odd64 = _mm_set1_epi64x(std::int64_t(0xFFFFFFFF00000000ull));
-    const V even = _mm_mul_epu32(c, m);
-    const V odd = _mm_mul_epu32(_mm_srli_epi64(c, 32), m);
-    hi = _mm_or_si128(_mm_srli_epi64(even, 32), _mm_and_si128(odd, odd64));
-    lo = _mm_or_si128(_mm_andnot_si128(odd64, even), _mm_slli_epi64(odd, 32));
+  static constexpr int kInFlight = 1;
+  static V mul(V a, V b) { return _mm_mul_epu32(a, b); }
+  static V high(V a) { return _mm_srli_epi64(a, 32); }
+  static V pack(V even, V odd) {  // no blend before SSE4.1
+    return _mm_or_si128(_mm_and_si128(even, _mm_set1_epi64x(0xFFFFFFFF)), _mm_slli_epi64(odd, 32));
   }
   static void storeUniform(float* p, V w) {
     _mm_storeu_ps(
@@ -305,8 +305,8 @@ struct Listed {
 };
 
 #ifdef FLURRY_PHILOX_LANES
-// Blocks (ids[i], c1, c2, c3) for i < n as uniforms; U vectors in flight hide the multiplies'
-// latency (a round is a dependent chain of multiply, shift, blend and xor).
+// Blocks (ids[i], c1, c2, c3) for i < n as uniforms. A round is a dependent chain (multiply,
+// shift, xor): the even and odd halves of kInFlight vectors run side by side to hide it.
 template <class Ids>
 void philoxUniforms(Ids ids, std::uint32_t c1, std::uint32_t c2, std::uint32_t c3, std::uint32_t k0,
                     std::uint32_t k1, std::size_t n, float* __restrict u0, float* __restrict u1,
@@ -314,7 +314,7 @@ void philoxUniforms(Ids ids, std::uint32_t c1, std::uint32_t c2, std::uint32_t c
   using L = Lanes;
   using V = L::V;
   constexpr std::size_t W = L::kWidth;
-  constexpr int U = 2;
+  constexpr int U = L::kInFlight;
   // Round 1's product of c2 is the same for every lane: its results are broadcast.
   const std::uint64_t p1 = std::uint64_t(kM1) * c2;
   const V r1c0 = L::set1(std::uint32_t(p1 >> 32) ^ c1 ^ k0), r1c1 = L::set1(std::uint32_t(p1));
@@ -326,31 +326,29 @@ void philoxUniforms(Ids ids, std::uint32_t c1, std::uint32_t c2, std::uint32_t c
     key1[r] = L::set1(k1 + std::uint32_t(r) * kW1);
   }
   auto blocks = [&](auto lanesOf, float* o0, float* o1, float* o2, float* o3, auto count) {
-    constexpr int N = decltype(count)::value;
+    constexpr int N = 2 * decltype(count)::value;  // halves: 2v even lanes, 2v + 1 odd lanes
     V x0[N], x1[N], x2[N], x3[N];
-    for (int v = 0; v < N; ++v) {
-      V hi, lo;
-      L::mulhilo(m0, lanesOf(v), hi, lo);
-      x0[v] = r1c0;
-      x1[v] = r1c1;
-      x2[v] = L::xor2(hi, c3k1);
-      x3[v] = lo;
+    for (int h = 0; h < N; ++h) {
+      const V c0 = h % 2 ? L::high(lanesOf(h / 2)) : lanesOf(h / 2);
+      const V p0 = L::mul(c0, m0);
+      x0[h] = r1c0;
+      x1[h] = r1c1;
+      x2[h] = L::xor2(L::high(p0), c3k1);
+      x3[h] = p0;
     }
     for (int r = 1; r < 10; ++r)
-      for (int v = 0; v < N; ++v) {
-        V hi0, lo0, hi1, lo1;
-        L::mulhilo(m0, x0[v], hi0, lo0);
-        L::mulhilo(m1, x2[v], hi1, lo1);
-        x0[v] = L::xor3(hi1, x1[v], key0[r]);
-        x1[v] = lo1;
-        x2[v] = L::xor3(hi0, x3[v], key1[r]);
-        x3[v] = lo0;
+      for (int h = 0; h < N; ++h) {
+        const V p0 = L::mul(x0[h], m0), p1 = L::mul(x2[h], m1);
+        x0[h] = L::xor3(L::high(p1), x1[h], key0[r]);
+        x1[h] = p1;
+        x2[h] = L::xor3(L::high(p0), x3[h], key1[r]);
+        x3[h] = p0;
       }
-    for (int v = 0; v < N; ++v) {
-      L::storeUniform(o0 + v * W, x0[v]);
-      L::storeUniform(o1 + v * W, x1[v]);
-      L::storeUniform(o2 + v * W, x2[v]);
-      L::storeUniform(o3 + v * W, x3[v]);
+    for (int v = 0; v < N / 2; ++v) {
+      L::storeUniform(o0 + v * W, L::pack(x0[2 * v], x0[2 * v + 1]));
+      L::storeUniform(o1 + v * W, L::pack(x1[2 * v], x1[2 * v + 1]));
+      L::storeUniform(o2 + v * W, L::pack(x2[2 * v], x2[2 * v + 1]));
+      L::storeUniform(o3 + v * W, L::pack(x3[2 * v], x3[2 * v + 1]));
     }
   };
   std::size_t i = 0;
