@@ -3,12 +3,29 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <vector>
 
 #include "flurry/flurry.hpp"
 #include "sampling.hpp"
 #include "shape_math.hpp"
 
 using namespace flurry;
+
+// Every instruction set's build of the batch draws (sdk/src/sampling.cpp), called directly so
+// that each is checked on a CPU that has it, whichever the dispatcher would pick.
+#define FLURRY_TEST_DECLARE_BATCH(isa)                                                         \
+  namespace flurry::detail::isa {                                                              \
+  void uniformBatch(std::uint64_t, std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t, \
+                    std::size_t, float*, float*, float*, float*);                              \
+  void uniformBatchOfIds(std::uint64_t, const std::uint32_t*, std::uint32_t, std::uint32_t,    \
+                         std::uint32_t, std::size_t, float*, float*, float*, float*);          \
+  }
+#ifdef FLURRY_HAS_ISA_VARIANTS
+FLURRY_TEST_DECLARE_BATCH(isa_avx2)
+FLURRY_TEST_DECLARE_BATCH(isa_avx512)
+#endif
+#undef FLURRY_TEST_DECLARE_BATCH
 
 TEST(Sampling, SinCos2PiMatchesLibm) {
   double worst = 0;
@@ -71,4 +88,86 @@ TEST(Sampling, NewbornsFollowTheDocumentedDrawOrder) {
     EXPECT_EQ(p.color.a, t.alpha.sample(rng));
     EXPECT_FLOAT_EQ(p.size, std::max(0.0f, t.size.sample(rng)));
   }
+}
+
+namespace {
+struct BatchVariant {
+  const char* name;
+  bool supported;
+  decltype(&detail::uniformBatch) consecutive;
+  decltype(&detail::uniformBatchOfIds) listed;
+};
+std::vector<BatchVariant> batchVariants() {
+  std::vector<BatchVariant> v = {
+      {"this build", true, &detail::uniformBatch, &detail::uniformBatchOfIds}};
+#ifdef FLURRY_HAS_ISA_VARIANTS
+  __builtin_cpu_init();
+  v.push_back({"avx2", __builtin_cpu_supports("avx2") != 0, &detail::isa_avx2::uniformBatch,
+               &detail::isa_avx2::uniformBatchOfIds});
+  v.push_back({"avx512",
+               __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+                   __builtin_cpu_supports("avx512vl"),
+               &detail::isa_avx512::uniformBatch, &detail::isa_avx512::uniformBatchOfIds});
+#endif
+  return v;
+}
+std::uint32_t floatBits(float f) {
+  std::uint32_t b;
+  std::memcpy(&b, &f, sizeof b);
+  return b;
+}
+}  // namespace
+
+// The vectorised Philox draws are Philox4x32::generate + uniformFloat bit for bit, in every
+// lane and in the partial last vector, and write nothing past n (the OpenCL backend and the
+// one-by-one path draw the scalar function).
+TEST(Sampling, UniformBatchIsScalarPhiloxBitForBit) {
+  const std::uint64_t seeds[] = {0u, 1234u, 0xDEADBEEFCAFEF00Dull, ~0ull};
+  std::vector<std::size_t> counts;
+  for (std::size_t n = 0; n <= 40; ++n) counts.push_back(n);
+  counts.push_back(1000);
+  const std::uint32_t firsts[] = {0u, 7u, 0xFFFFFFF3u};  // the last wraps around
+  constexpr std::size_t kGuard = 3;
+  constexpr float kUntouched = -1.0f;
+  std::vector<std::uint32_t> idStore(1000 + 5);
+  for (std::size_t i = 0; i < idStore.size(); ++i)
+    idStore[i] = std::uint32_t(i * 2654435761u) ^ 0x5A5A1234u;
+  const std::uint32_t* ids = idStore.data() + 3;  // not vector-aligned
+  std::size_t checked = 0;
+  for (const BatchVariant& var : batchVariants()) {
+    if (!var.supported) continue;
+    for (std::uint64_t seed : seeds)
+      for (std::size_t n : counts)
+        for (int listed = 0; listed < 2; ++listed)
+          for (std::uint32_t first : firsts) {
+            if (listed && first != firsts[0]) continue;
+            const std::uint32_t c1 = std::uint32_t(n) * 3u + 1u,
+                                c2 = 0xFFFF0000u + std::uint32_t(n);
+            const std::uint32_t block = std::uint32_t(seed) & 3u;
+            std::vector<float> out[4];
+            for (auto& o : out) o.assign(1 + n + kGuard, kUntouched);
+            float* u[4];
+            for (int w = 0; w < 4; ++w) u[w] = out[w].data() + 1;  // odd offsets
+            if (listed)
+              var.listed(seed, ids, c1, c2, block, n, u[0], u[1], u[2], u[3]);
+            else
+              var.consecutive(seed, first, c1, c2, block, n, u[0], u[1], u[2], u[3]);
+            for (std::size_t i = 0; i < n; ++i) {
+              const std::uint32_t c0 = listed ? ids[i] : first + std::uint32_t(i);
+              const Philox4x32::Block b = Philox4x32::generate(
+                  c0, c1, c2, block, std::uint32_t(seed), std::uint32_t(seed >> 32));
+              for (int w = 0; w < 4; ++w)
+                ASSERT_EQ(floatBits(u[w][i]), floatBits(uniformFloat(b.v[w])))
+                    << var.name << (listed ? " listed ids" : " consecutive ids") << ", seed "
+                    << seed << ", first " << first << ", n " << n << ", i " << i << ", word " << w;
+            }
+            for (int w = 0; w < 4; ++w) {
+              EXPECT_EQ(out[w][0], kUntouched) << var.name << ", n " << n;
+              for (std::size_t g = 0; g < kGuard; ++g)
+                EXPECT_EQ(u[w][n + g], kUntouched) << var.name << ", n " << n;
+            }
+            ++checked;
+          }
+  }
+  EXPECT_GT(checked, 0u);
 }

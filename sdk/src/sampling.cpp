@@ -5,6 +5,11 @@
 #include <algorithm>
 #include <type_traits>
 
+#if defined(__SSE2__)
+#include <immintrin.h>
+#define FLURRY_PHILOX_LANES
+#endif
+
 namespace flurry::detail {
 inline namespace FLURRY_ISA_NAMESPACE {
 
@@ -189,21 +194,216 @@ void sampleBatch(const Fuzzy& f, const float* const* u, std::size_t n, float* ou
   }
 }
 
-// Philox dominates emission; wider vectors multiply more 32-bit lanes at once, so the loop
-// is built for AVX-512, AVX2 and the baseline and picked at load time.
-__attribute__((target_clones("avx512f", "avx2", "default"))) void uniformBatch(
-    std::uint64_t seed, std::uint32_t firstId, std::uint32_t c1, std::uint32_t c2,
-    std::uint32_t block, std::size_t n, float* __restrict u0, float* __restrict u1,
-    float* __restrict u2, float* __restrict u3) {
-  const std::uint32_t k0 = std::uint32_t(seed), k1 = std::uint32_t(seed >> 32);
+namespace {
+
+// Philox4x32-10 on W counters at once, for this translation unit's instruction set (it is
+// compiled once per set, sdk/CMakeLists.txt): the same function as Philox4x32::generate, bit
+// for bit. GCC vectorises the scalar loop but packs the 32x32->64-bit products with
+// cross-lane shuffles. Here the even and the odd lanes of a vector run apart, each word in the
+// low half of a 64-bit slot: an unsigned 32-bit multiply (which reads only the low halves)
+// then gives the full product, its low half is the next round's word as it stands and its
+// high half one shift away; the halves are blended back into 32-bit lanes once, at the end.
+// Only the first counter word varies across lanes (the particle id).
+#if defined(__AVX512F__)
+// GCC 12 takes the undefined pass-through operand of its AVX-512 intrinsics for an
+// uninitialised read (GCC bug 105593).
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+struct Lanes {
+  using V = __m512i;
+  static constexpr std::size_t kWidth = 16;
+  static V set1(std::uint32_t x) { return _mm512_set1_epi32(int(x)); }
+  static V iota(std::uint32_t first) {
+    return _mm512_add_epi32(
+        set1(first), _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
+  }
+  static V load(const std::uint32_t* p) { return _mm512_loadu_si512(p); }
+  static V xor2(V a, V b) { return _mm512_xor_si512(a, b); }
+  static V xor3(V a, V b, V c) { return _mm512_ternarylogic_epi32(a, b, c, 0x96); }
+  static constexpr int kInFlight = 2;  // 32 registers
+  static V mul(V a, V b) { return _mm512_mul_epu32(a, b); }
+  static V high(V a) { return _mm512_srli_epi64(a, 32); }
+  static V pack(V even, V odd) {
+    return _mm512_mask_blend_epi32(0xAAAA, even, _mm512_slli_epi64(odd, 32));
+  }
+  // uniformFloat: w >> 8 < 2^24 converts exactly as a signed int.
+  static void storeUniform(float* p, V w) {
+    _mm512_storeu_ps(p, _mm512_mul_ps(_mm512_cvtepi32_ps(_mm512_srli_epi32(w, 8)),
+                                      _mm512_set1_ps(1.0f / 16777216.0f)));
+  }
+};
+#elif defined(__AVX2__)
+struct Lanes {
+  using V = __m256i;
+  static constexpr std::size_t kWidth = 8;
+  static V set1(std::uint32_t x) { return _mm256_set1_epi32(int(x)); }
+  static V iota(std::uint32_t first) {
+    return _mm256_add_epi32(set1(first), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+  }
+  static V load(const std::uint32_t* p) {
+    return _mm256_loadu_si256(reinterpret_cast<const V*>(p));
+  }
+  static V xor2(V a, V b) { return _mm256_xor_si256(a, b); }
+  static V xor3(V a, V b, V c) { return xor2(xor2(a, b), c); }
+  static constexpr int kInFlight = 1;  // 16 registers
+  static V mul(V a, V b) { return _mm256_mul_epu32(a, b); }
+  static V high(V a) { return _mm256_srli_epi64(a, 32); }
+  static V pack(V even, V odd) {
+    return _mm256_blend_epi32(even, _mm256_slli_epi64(odd, 32), 0xAA);
+  }
+  static void storeUniform(float* p, V w) {
+    _mm256_storeu_ps(p, _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_srli_epi32(w, 8)),
+                                      _mm256_set1_ps(1.0f / 16777216.0f)));
+  }
+};
+#elif defined(__SSE2__)
+struct Lanes {
+  using V = __m128i;
+  static constexpr std::size_t kWidth = 4;
+  static V set1(std::uint32_t x) { return _mm_set1_epi32(int(x)); }
+  static V iota(std::uint32_t first) {
+    return _mm_add_epi32(set1(first), _mm_setr_epi32(0, 1, 2, 3));
+  }
+  static V load(const std::uint32_t* p) { return _mm_loadu_si128(reinterpret_cast<const V*>(p)); }
+  static V xor2(V a, V b) { return _mm_xor_si128(a, b); }
+  static V xor3(V a, V b, V c) { return xor2(xor2(a, b), c); }
+  static constexpr int kInFlight = 1;
+  static V mul(V a, V b) { return _mm_mul_epu32(a, b); }
+  static V high(V a) { return _mm_srli_epi64(a, 32); }
+  static V pack(V even, V odd) {  // no blend before SSE4.1
+    return _mm_or_si128(_mm_and_si128(even, _mm_set1_epi64x(0xFFFFFFFF)), _mm_slli_epi64(odd, 32));
+  }
+  static void storeUniform(float* p, V w) {
+    _mm_storeu_ps(
+        p, _mm_mul_ps(_mm_cvtepi32_ps(_mm_srli_epi32(w, 8)), _mm_set1_ps(1.0f / 16777216.0f)));
+  }
+};
+#endif
+
+constexpr std::uint32_t kM0 = 0xD2511F53u, kM1 = 0xCD9E8D57u;
+constexpr std::uint32_t kW0 = 0x9E3779B9u, kW1 = 0xBB67AE85u;
+
+// Counter word 0 of particle i: firstId + i, or id[i].
+struct Consecutive {
+  std::uint32_t first;
+  std::uint32_t operator[](std::size_t i) const { return first + std::uint32_t(i); }
+#ifdef FLURRY_PHILOX_LANES
+  Lanes::V lanes(std::size_t i) const {
+    return Lanes::iota(first + std::uint32_t(i));
+  }
+#endif
+};
+struct Listed {
+  const std::uint32_t* __restrict id;
+  std::uint32_t operator[](std::size_t i) const { return id[i]; }
+#ifdef FLURRY_PHILOX_LANES
+  Lanes::V lanes(std::size_t i) const {
+    return Lanes::load(id + i);
+  }
+#endif
+};
+
+#ifdef FLURRY_PHILOX_LANES
+// Blocks (ids[i], c1, c2, c3) for i < n as uniforms. A round is a dependent chain (multiply,
+// shift, xor): the even and odd halves of kInFlight vectors run side by side to hide it.
+template <class Ids>
+void philoxUniforms(Ids ids, std::uint32_t c1, std::uint32_t c2, std::uint32_t c3, std::uint32_t k0,
+                    std::uint32_t k1, std::size_t n, float* __restrict u0, float* __restrict u1,
+                    float* __restrict u2, float* __restrict u3) {
+  using L = Lanes;
+  using V = L::V;
+  constexpr std::size_t W = L::kWidth;
+  constexpr int U = L::kInFlight;
+  // Round 1's product of c2 is the same for every lane: its results are broadcast.
+  const std::uint64_t p1 = std::uint64_t(kM1) * c2;
+  const V r1c0 = L::set1(std::uint32_t(p1 >> 32) ^ c1 ^ k0), r1c1 = L::set1(std::uint32_t(p1));
+  const V c3k1 = L::set1(c3 ^ k1);
+  const V m0 = L::set1(kM0), m1 = L::set1(kM1);
+  V key0[10], key1[10];
+  for (int r = 0; r < 10; ++r) {
+    key0[r] = L::set1(k0 + std::uint32_t(r) * kW0);
+    key1[r] = L::set1(k1 + std::uint32_t(r) * kW1);
+  }
+  auto blocks = [&](auto lanesOf, float* o0, float* o1, float* o2, float* o3, auto count) {
+    constexpr int N = 2 * decltype(count)::value;  // halves: 2v even lanes, 2v + 1 odd lanes
+    V x0[N], x1[N], x2[N], x3[N];
+    for (int h = 0; h < N; ++h) {
+      const V c0 = h % 2 ? L::high(lanesOf(h / 2)) : lanesOf(h / 2);
+      const V p0 = L::mul(c0, m0);
+      x0[h] = r1c0;
+      x1[h] = r1c1;
+      x2[h] = L::xor2(L::high(p0), c3k1);
+      x3[h] = p0;
+    }
+    for (int r = 1; r < 10; ++r)
+      for (int h = 0; h < N; ++h) {
+        const V p0 = L::mul(x0[h], m0), p1 = L::mul(x2[h], m1);
+        x0[h] = L::xor3(L::high(p1), x1[h], key0[r]);
+        x1[h] = p1;
+        x2[h] = L::xor3(L::high(p0), x3[h], key1[r]);
+        x3[h] = p0;
+      }
+    for (int v = 0; v < N / 2; ++v) {
+      L::storeUniform(o0 + v * W, L::pack(x0[2 * v], x0[2 * v + 1]));
+      L::storeUniform(o1 + v * W, L::pack(x1[2 * v], x1[2 * v + 1]));
+      L::storeUniform(o2 + v * W, L::pack(x2[2 * v], x2[2 * v + 1]));
+      L::storeUniform(o3 + v * W, L::pack(x3[2 * v], x3[2 * v + 1]));
+    }
+  };
+  std::size_t i = 0;
+  for (; i + U * W <= n; i += U * W)
+    blocks([&](int v) { return ids.lanes(i + v * W); }, u0 + i, u1 + i, u2 + i, u3 + i,
+           std::integral_constant<int, U>{});
+  // The rest, fewer than U * W, a vector at a time; the last partial one through a buffer.
+  for (; i < n; i += W) {
+    const std::size_t m = std::min(W, n - i);
+    if (m == W) {
+      blocks([&](int) { return ids.lanes(i); }, u0 + i, u1 + i, u2 + i, u3 + i,
+             std::integral_constant<int, 1>{});
+    } else {
+      alignas(64) std::uint32_t id[W] = {};
+      alignas(64) float o[4][W];
+      for (std::size_t j = 0; j < m; ++j) id[j] = ids[i + j];
+      blocks([&](int) { return L::load(id); }, o[0], o[1], o[2], o[3],
+             std::integral_constant<int, 1>{});
+      for (std::size_t j = 0; j < m; ++j) {
+        u0[i + j] = o[0][j];
+        u1[i + j] = o[1][j];
+        u2[i + j] = o[2][j];
+        u3[i + j] = o[3][j];
+      }
+    }
+  }
+}
+#else
+template <class Ids>
+void philoxUniforms(Ids ids, std::uint32_t c1, std::uint32_t c2, std::uint32_t c3, std::uint32_t k0,
+                    std::uint32_t k1, std::size_t n, float* __restrict u0, float* __restrict u1,
+                    float* __restrict u2, float* __restrict u3) {
   for (std::size_t i = 0; i < n; ++i) {
-    const Philox4x32::Block b =
-        Philox4x32::generate(firstId + std::uint32_t(i), c1, c2, block, k0, k1);
+    const Philox4x32::Block b = Philox4x32::generate(ids[i], c1, c2, c3, k0, k1);
     u0[i] = uniformFloat(b.v[0]);
     u1[i] = uniformFloat(b.v[1]);
     u2[i] = uniformFloat(b.v[2]);
     u3[i] = uniformFloat(b.v[3]);
   }
+}
+#endif
+
+}  // namespace
+
+void uniformBatch(std::uint64_t seed, std::uint32_t firstId, std::uint32_t c1, std::uint32_t c2,
+                  std::uint32_t block, std::size_t n, float* u0, float* u1, float* u2, float* u3) {
+  philoxUniforms(Consecutive{firstId}, c1, c2, block, std::uint32_t(seed),
+                 std::uint32_t(seed >> 32), n, u0, u1, u2, u3);
+}
+
+void uniformBatchOfIds(std::uint64_t seed, const std::uint32_t* id, std::uint32_t c1,
+                       std::uint32_t c2, std::uint32_t block, std::size_t n, float* u0, float* u1,
+                       float* u2, float* u3) {
+  philoxUniforms(Listed{id}, c1, c2, block, std::uint32_t(seed), std::uint32_t(seed >> 32), n, u0,
+                 u1, u2, u3);
 }
 
 }  // namespace FLURRY_ISA_NAMESPACE

@@ -40,6 +40,10 @@ void sampleBatch(const Fuzzy& f, const float* const* u, std::size_t n, float* ou
 /// for i < n, and converts them to uniforms in [0, 1).
 void uniformBatch(std::uint64_t seed, std::uint32_t firstId, std::uint32_t c1, std::uint32_t c2,
                   std::uint32_t block, std::size_t n, float* u0, float* u1, float* u2, float* u3);
+/// The same for the streams (seed, id[i], c1, c2): id[i] in place of firstId + i.
+void uniformBatchOfIds(std::uint64_t seed, const std::uint32_t* id, std::uint32_t c1,
+                       std::uint32_t c2, std::uint32_t block, std::size_t n, float* u0, float* u1,
+                       float* u2, float* u3);
 
 }  // namespace FLURRY_ISA_NAMESPACE
 }  // namespace flurry::detail

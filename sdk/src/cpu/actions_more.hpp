@@ -74,20 +74,11 @@ inline Random actionRandom(const BlockContext& c, const Lanes& L, std::size_t i)
 }
 
 // Philox block `block` of every particle's action stream as uniforms: words 0-3 of the block
-// are uniforms 4·block .. 4·block + 3 of actionRandom(c, L, i), as Random draws them. One
-// block per particle per loop, vectorised (the 32×32→64-bit products included).
-inline void actionUniforms(const BlockContext& c, const std::uint32_t* __restrict id,
-                           std::uint32_t block, std::size_t n, float* __restrict u0,
-                           float* __restrict u1, float* __restrict u2, float* __restrict u3) {
-  const std::uint32_t k0 = std::uint32_t(c.seed), k1 = std::uint32_t(c.seed >> 32);
-  const std::uint32_t step = c.step, stream = c.streamBase + c.action;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Philox4x32::Block b = Philox4x32::generate(id[i], step, stream, block, k0, k1);
-    u0[i] = uniformFloat(b.v[0]);
-    u1[i] = uniformFloat(b.v[1]);
-    u2[i] = uniformFloat(b.v[2]);
-    u3[i] = uniformFloat(b.v[3]);
-  }
+// are uniforms 4·block .. 4·block + 3 of actionRandom(c, L, i), as Random draws them
+// (uniformBatchOfIds computes many blocks at once with vector instructions).
+inline void actionUniforms(const BlockContext& c, const std::uint32_t* id, std::uint32_t block,
+                           std::size_t n, float* u0, float* u1, float* u2, float* u3) {
+  uniformBatchOfIds(c.seed, id, c.step, c.streamBase + c.action, block, n, u0, u1, u2, u3);
 }
 
 constexpr std::size_t kDrawBatch = 256;  // particles sampled at once (the rows live on the stack)
