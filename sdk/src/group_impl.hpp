@@ -196,6 +196,9 @@ struct GroupImpl {
   std::vector<std::uint8_t> deadCode;      ///< 1 + index of the action that killed
   std::vector<std::uint32_t> deadCount;    ///< per block
   std::vector<std::uint32_t> culledCount;  ///< per block: actions the fused pass skipped
+  /// Per block, the dead each action killed and, last, the non-finite ones: counted while
+  /// the block is in cache, by its own thread, and summed after the pass.
+  std::vector<std::uint32_t> blockKills;
   std::vector<std::uint32_t> holes;        ///< sorted dead indices of this step
   /// This step's newborns, written before the act pass: [bornFirst, bornFirst + bornCount),
   /// each with the part of the step it still has to live (seconds, bornRemaining[r]), which

@@ -391,6 +391,15 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
   g.deadCode.resize(n);
   g.deadCount.assign(blocks, 0);
   g.culledCount.assign(blocks, 0);
+  const std::size_t killSlots = acts.size() + 1;  // the last: non-finite
+  g.blockKills.assign(blocks * killSlots, 0);
+  // Tallies a block's dead by cause (codes: 1 + action, or kNonFiniteCode).
+  auto tally = [&](std::size_t b, std::uint32_t k) {
+    std::uint32_t* kills = g.blockKills.data() + b * killSlots;
+    const std::uint8_t* code = g.deadCode.data() + b * B;
+    for (std::uint32_t j = 0; j < k; ++j)
+      ++kills[code[j] == kNonFiniteCode ? killSlots - 1 : code[j] - 1u];
+  };
   const Lanes lanes = g.lanePointers();
   Plan plan{planActions(g), substepCount(g, sp, *sp.pool)};
   if (plan.list.guarded) {
@@ -475,6 +484,7 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
         }
         guardFinite(blockLanes, m, dead.data(), plan.list.guardVelocity);
         g.deadCount[b] = collectDead(g, first, m, dead.data());
+        tally(b, g.deadCount[b]);
         store.clean = true;
       }
     });
@@ -501,25 +511,24 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
       const std::size_t first = b * B, m = std::min(B, n - first);
       guardFinite(lanes.offset(first), m, g.deadFlags.data() + first, plan.list.guardVelocity);
       g.deadCount[b] = collectDead(g, first, m, g.deadFlags.data() + first);
+      tally(b, g.deadCount[b]);
     });
   }
 
   for (std::size_t b = 0; b < blocks; ++b) {
     g.stats.blockActionsCulled += g.culledCount[b];
     const std::uint32_t* idx = g.deadIndex.data() + b * B;
-    const std::uint8_t* code = g.deadCode.data() + b * B;
-    for (std::uint32_t j = 0; j < g.deadCount[b]; ++j) {
-      g.holes.push_back(idx[j]);
-      if (code[j] == kNonFiniteCode) {
-        ++g.stats.killedNonFinite;
-        continue;
-      }
-      const std::size_t k = code[j] - 1u;
-      ++g.stats.killedByAction[k];
-      if (std::holds_alternative<KillOld>(acts[k]))
-        ++g.stats.killedByAge;
-      else
-        ++g.stats.absorbed;
+    g.holes.insert(g.holes.end(), idx, idx + g.deadCount[b]);  // within the capacity
+  }
+  for (std::size_t a = 0; a < killSlots; ++a) {
+    std::uint64_t killed = 0;
+    for (std::size_t b = 0; b < blocks; ++b) killed += g.blockKills[b * killSlots + a];
+    if (killed == 0) continue;
+    if (a == killSlots - 1)
+      g.stats.killedNonFinite += killed;
+    else {
+      g.stats.killedByAction[a] += killed;
+      (std::holds_alternative<KillOld>(acts[a]) ? g.stats.killedByAge : g.stats.absorbed) += killed;
     }
   }
 }
