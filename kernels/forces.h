@@ -240,6 +240,23 @@ FL_INLINE void fl_clamp_speed(float minS, float maxS, float* vx, float* vy, floa
   *vz = take ? z * k : z;
 }
 
+/* ---- Constrain2D ------------------------------------------------------------------------- */
+
+/* Constrain2D: the position onto the plane through o with unit normal n, p - n ((p - o)·n),
+ * and the velocity onto its directions, v - n (v·n). */
+FL_INLINE void fl_constrain_2d(float ox, float oy, float oz, float nx, float ny, float nz,
+                               float* px, float* py, float* pz, float* vx, float* vy, float* vz) {
+  const float x = *px, y = *py, z = *pz, u = *vx, v = *vy, w = *vz;
+  const float d = (x - ox) * nx + (y - oy) * ny + (z - oz) * nz;
+  const float e = u * nx + v * ny + w * nz;
+  *px = x - nx * d;
+  *py = y - ny * d;
+  *pz = z - nz * d;
+  *vx = u - nx * e;
+  *vy = v - ny * e;
+  *vz = w - nz * e;
+}
+
 /* ---- Curves over life --------------------------------------------------------------------- */
 
 /* Where a particle is in its life, 0 to 1 (1 for one without a lifetime). */

@@ -284,19 +284,11 @@ FL_INLINE void fl_avoid(__global const FlActionParams* a, uint kind, float dt, f
   *vz = r.z;
 }
 
-/* actions_more.hpp apply(Constrain2D). f[0..2] point, f[3..5] unit normal. */
+/* forces.h fl_constrain_2d. f[0..2] point, f[3..5] unit normal. */
 FL_INLINE void fl_constrain2d(__global const FlActionParams* a, float* px, float* py, float* pz,
                               float* vx, float* vy, float* vz) {
-  const float3 p = (float3)(*px, *py, *pz), v = (float3)(*vx, *vy, *vz);
-  const float3 point = fl_v3(a->f), nrm = fl_v3(a->f + 3);
-  const float3 q = p - nrm * fl_dotv(p - point, nrm);
-  const float3 w = v - nrm * fl_dotv(v, nrm);
-  *px = q.x;
-  *py = q.y;
-  *pz = q.z;
-  *vx = w.x;
-  *vy = w.y;
-  *vz = w.z;
+  __global const float* f = a->f;
+  fl_constrain_2d(f[0], f[1], f[2], f[3], f[4], f[5], px, py, pz, vx, vy, vz);
 }
 
 /* ---- Neighbours: the particles as they were at the start of the step (FL_SNAP) ----------- */

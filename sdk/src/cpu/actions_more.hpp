@@ -554,11 +554,17 @@ inline void apply(const SizeOverLife& a, const Lanes& L, std::size_t n, const Bl
 // ---- Bookkeeping -------------------------------------------------------------------------
 
 inline void apply(const Constrain2D& a, const Lanes& L, std::size_t n, const BlockContext&) {
-  const Vec3 nrm = glm::normalize(a.normal);
+  const Vec3 nrm = glm::normalize(a.normal), o = a.point;
+  float* __restrict px = L.p[0];
+  float* __restrict py = L.p[1];
+  float* __restrict pz = L.p[2];
+  float* __restrict vx = L.v[0];
+  float* __restrict vy = L.v[1];
+  float* __restrict vz = L.v[2];
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 p = at(L.p, i), v = at(L.v, i);
-    put(L.p, i, p - nrm * glm::dot(p - a.point, nrm));
-    put(L.v, i, v - nrm * glm::dot(v, nrm));
+    float x = px[i], y = py[i], z = pz[i], u = vx[i], v = vy[i], w = vz[i];
+    kernel::fl_constrain_2d(o.x, o.y, o.z, nrm.x, nrm.y, nrm.z, &x, &y, &z, &u, &v, &w);
+    px[i] = x, py[i] = y, pz[i] = z, vx[i] = u, vy[i] = v, vz[i] = w;
   }
 }
 
