@@ -257,6 +257,40 @@ FL_INLINE void fl_constrain_2d(float ox, float oy, float oz, float nx, float ny,
   *vz = w - nz * e;
 }
 
+/* ---- Restore ------------------------------------------------------------------------------ */
+
+/* Restore steers once `time` has reached `start` (a nanosecond early counts: the host's and
+ * the step's sums of dt differ in the last bits). */
+FL_INLINE int fl_restore_started(fl_real start, fl_real time) {
+  return !(time + (fl_real)1e-9 < start);
+}
+
+/* The seconds left until the arrival at `end` (start + duration). */
+FL_INLINE float fl_restore_left(fl_real end, fl_real time) {
+  return (float)(end - time);
+}
+
+/* Towards home h: the velocity that arrives in `left` seconds, or in the last step exactly;
+ * a particle with dt = 0 (a newborn born at the step's very end) keeps its velocity. Once
+ * left <= 0 it is home, at rest. */
+FL_INLINE void fl_restore_step(float left, float dt, float hx, float hy, float hz, float* px,
+                               float* py, float* pz, float* vx, float* vy, float* vz) {
+  const float by = left > dt ? left : dt;
+  if (dt > 0.0f) {
+    *vx = (hx - *px) / by;
+    *vy = (hy - *py) / by;
+    *vz = (hz - *pz) / by;
+  }
+  if (left <= 0.0f) {
+    *px = hx;
+    *py = hy;
+    *pz = hz;
+    *vx = 0.0f;
+    *vy = 0.0f;
+    *vz = 0.0f;
+  }
+}
+
 /* ---- Curves over life --------------------------------------------------------------------- */
 
 /* Where a particle is in its life, 0 to 1 (1 for one without a lifetime). */

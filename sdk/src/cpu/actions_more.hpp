@@ -574,17 +574,13 @@ inline void apply(const CopyVertexB& a, const Lanes& L, std::size_t n, const Blo
 }
 
 inline void apply(const Restore& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  if (c.time + 1e-9 < a.start) return;
-  const float left = float(double(a.start) + a.duration - c.time);  // seconds to arrival
+  if (!kernel::fl_restore_started(a.start, c.time)) return;
+  const float left = kernel::fl_restore_left(double(a.start) + a.duration, c.time);
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 p = at(L.p, i), home = at(L.posB, i);
-    // The velocity that arrives on time; in the last step, exactly. A newborn born at the
-    // step's very end (dt = 0) keeps its velocity.
-    if (c.dt > 0.0f) put(L.v, i, left > c.dt ? (home - p) / left : (home - p) / c.dt);
-    if (left <= 0.0f) {
-      put(L.p, i, home);
-      put(L.v, i, Vec3(0.0f));
-    }
+    float x = L.p[0][i], y = L.p[1][i], z = L.p[2][i], u = L.v[0][i], v = L.v[1][i], w = L.v[2][i];
+    kernel::fl_restore_step(left, c.dt, L.posB[0][i], L.posB[1][i], L.posB[2][i], &x, &y, &z, &u,
+                            &v, &w);
+    L.p[0][i] = x, L.p[1][i] = y, L.p[2][i] = z, L.v[0][i] = u, L.v[1][i] = v, L.v[2][i] = w;
   }
 }
 
