@@ -45,6 +45,9 @@ inline kernel::FlVortex flVortex(const Vortex& a) {
   return {a.center.x,    a.center.y,   a.center.z,  k.x,       k.y,       k.z,
           a.aroundSpeed, a.coreRadius, a.tightness, a.inSpeed, a.upSpeed, a.maxRadius};
 }
+inline kernel::FlTurbulence flTurbulence(const Turbulence& a) {
+  return {a.amplitude, a.frequency, a.drift.x, a.drift.y, a.drift.z, kernel::uint(a.octaves)};
+}
 // Calls f(&x, &y, &z) on locals holding lane particle i's vector and stores them back: the
 // shared kernels' pointers into the arrays would hide their __restrict from the vectoriser.
 template <class F>
@@ -359,11 +362,15 @@ inline void apply(const RandomRotVelocity& a, const Lanes& L, std::size_t n,
 }
 
 inline void apply(const Turbulence& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const Vec3 shift = a.drift * float(c.time);
+  const kernel::FlTurbulence turbulence = flTurbulence(a);
+  const float t = float(c.time);
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 p = at(L.p, i);
-    const Vec3 acc = curlNoise((p - shift) * a.frequency, a.octaves) * a.amplitude;
-    put(L.v, i, at(L.v, i) + acc * (c.dtAt(i) * falloffWeight(a.falloff, p)));
+    const float px = L.p[0][i], py = L.p[1][i], pz = L.p[2][i];
+    const Vec3 acc = kernel::fl_turbulence_field(turbulence, t, px, py, pz);
+    const float k = c.dtAt(i) * falloffWeight(a.falloff, Vec3(px, py, pz));
+    onLocals(L.v, i, [&](float* x, float* y, float* z) {
+      kernel::fl_add_scaled(acc.x, acc.y, acc.z, k, x, y, z);
+    });
   }
 }
 
