@@ -240,6 +240,13 @@ FL_INLINE void fl_clamp_speed(float minS, float maxS, float* vx, float* vy, floa
   *vz = take ? z * k : z;
 }
 
+/* ---- Avoid -------------------------------------------------------------------------------- */
+
+/* Avoid's push away from an obstacle at distance dist, per second: v += away push dt. */
+FL_INLINE float fl_avoid_push(float magnitude, float eps, float dist) {
+  return magnitude / (dist * dist + eps);
+}
+
 /* ---- Constrain2D ------------------------------------------------------------------------- */
 
 /* Constrain2D: the position onto the plane through o with unit normal n, p - n ((p - o)·n),

@@ -162,12 +162,10 @@ inline void apply(const Sink& a, const Lanes& L, std::size_t n, const BlockConte
   } else {  // Hit: the coming Move crosses the plane piece
     for (std::size_t i = 0; i < n; ++i) {
       const Vec3 p = at(L.p, i), v = at(L.v, i);
-      const Vec3 q = p + v * c.dtAt(i);
-      const Vec3 nrm = a.region.normal(p);
-      const Vec3 origin = a.region.closestPoint(p);
-      const float d0 = glm::dot(p - origin, nrm), d1 = glm::dot(q - origin, nrm);
-      if (!((d0 >= 0.0f) != (d1 >= 0.0f))) continue;
-      const Vec3 h = p + (q - p) * (d0 / (d0 - d1));
+      Vec3 h;
+      if (!kernel::fl_path_crosses(p, p + v * c.dtAt(i), a.region.closestPoint(p),
+                                   a.region.normal(p), &h))
+        continue;
       if (a.region.distance(h) <= 1e-5f * (1.0f + glm::length(h))) kill(c, i);
     }
   }
@@ -425,12 +423,10 @@ inline void apply(const Avoid& a, const Lanes& L, std::size_t n, const BlockCont
     const Vec3 ahead = p + v * a.lookAhead;
     bool threat;
     if (planar) {
-      const Vec3 nrm = a.obstacle.normal(p);
-      const Vec3 o = a.obstacle.closestPoint(p);
-      const float d0 = glm::dot(p - o, nrm), d1 = glm::dot(ahead - o, nrm);
+      Vec3 h;
       threat =
-          (d0 >= 0.0f) != (d1 >= 0.0f) &&
-          a.obstacle.distance(p + (ahead - p) * (d0 / (d0 - d1))) < 1e-4f * (1.0f + glm::length(p));
+          kernel::fl_path_crosses(p, ahead, a.obstacle.closestPoint(p), a.obstacle.normal(p), &h) &&
+          a.obstacle.distance(h) < 1e-4f * (1.0f + glm::length(p));
     } else {
       threat = !a.obstacle.contains(p) && a.obstacle.contains(ahead);
     }
@@ -438,7 +434,11 @@ inline void apply(const Avoid& a, const Lanes& L, std::size_t n, const BlockCont
     const float dist = a.obstacle.distance(p);
     Vec3 away = a.obstacle.normal(p);
     if (planar && glm::dot(p - a.obstacle.closestPoint(p), away) < 0.0f) away = -away;
-    put(L.v, i, v + away * (a.magnitude / (dist * dist + a.epsilon) * c.dtAt(i)));
+    onLocals(L.v, i, [&](float* x, float* y, float* z) {
+      kernel::fl_add_scaled(away.x, away.y, away.z,
+                            kernel::fl_avoid_push(a.magnitude, a.epsilon, dist) * c.dtAt(i), x, y,
+                            z);
+    });
   }
 }
 
