@@ -37,30 +37,14 @@ FL_INLINE fl_real fl_real_from_words(uint lo, uint hi) {
   return fl_real_from_bits(((ulong)hi << 32) | (ulong)lo);
 }
 
-/* Restore (actions_more.hpp apply(Restore)): steer to PositionB so as to arrive on time.
- * u[0..1]: start, u[2..3]: start + duration, as doubles. dt: the particle's sub-step. */
+/* Restore (forces.h fl_restore_step). u[0..1]: start, u[2..3]: start + duration, as doubles.
+ * dt: the particle's sub-step. */
 FL_INLINE void fl_restore(__global const FlActionParams* a, float dt, fl_real time, float* px,
                           float* py, float* pz, float* vx, float* vy, float* vz, float hx,
                           float hy, float hz) {
-  const fl_real start = fl_real_from_words(a->u[0], a->u[1]);
-  if (time + (fl_real)1e-9 < start) return;
-  const float left = (float)(fl_real_from_words(a->u[2], a->u[3]) - time);
-  const float dx = hx - *px, dy = hy - *py, dz = hz - *pz;
-  /* A newborn born at the step's very end has h = 0: its velocity is left as it is. */
-  if (dt > 0.0f) {
-    const float by = left > dt ? left : dt;
-    *vx = dx / by;
-    *vy = dy / by;
-    *vz = dz / by;
-  }
-  if (left <= 0.0f) {
-    *px = hx;
-    *py = hy;
-    *pz = hz;
-    *vx = 0.0f;
-    *vy = 0.0f;
-    *vz = 0.0f;
-  }
+  if (!fl_restore_started(fl_real_from_words(a->u[0], a->u[1]), time)) return;
+  const float left = fl_restore_left(fl_real_from_words(a->u[2], a->u[3]), time);
+  fl_restore_step(left, dt, hx, hy, hz, px, py, pz, vx, vy, vz);
 }
 
 /* ---- Spatial culling per work-group (fused_pass.cpp Culler) ------------------------------ */

@@ -206,6 +206,17 @@ FL_INLINE float3 fl_blob_at(float3 c, float sd, float u0, float u1, float u2, fl
                      c.z + sd * fl_normal_from(u4, u5));
 }
 
+/* ---- Crossing a planar piece's plane (Sink's Hit, Avoid) ----------------------------------- */
+
+/* Whether the straight path p -> q crosses the plane through o with normal n (a side
+ * includes the plane: d >= 0), and then where, *h. */
+FL_INLINE int fl_path_crosses(float3 p, float3 q, float3 o, float3 n, float3* h) {
+  const float d0 = fl_dotv(p - o, n), d1 = fl_dotv(q - o, n);
+  if (!((d0 >= 0.0f) != (d1 >= 0.0f))) return 0;
+  *h = p + (q - p) * (d0 / (d0 - d1));
+  return 1;
+}
+
 /* ---- Containment (branch-free: the CPU's Sink and regions test whole blocks) --------------- */
 
 FL_INLINE int fl_inside_plane(float3 point, float3 normal, float3 p) {

@@ -243,31 +243,21 @@ FL_INLINE void fl_random_set(__global const FlActionParams* a, uint kind, float*
 /* ---- Turbulence: curl noise (noise.h), f[0] amplitude, [1] frequency,
  * [2..4] drift, u[0] octaves; falloff ----------------------------------------------------- */
 
-/* The turbulence's acceleration without the falloff, at p and time t. */
-FL_INLINE float3 fl_turbulence_field(__global const FlActionParams* a, float t, float px, float py,
-                                     float pz) {
-  const float f = a->f[1], amp = a->f[0];
-  const float sx = a->f[2] * t, sy = a->f[3] * t, sz = a->f[4] * t;
-  const float3 c = fl_curl_noise((px - sx) * f, (py - sy) * f, (pz - sz) * f, a->u[0]);
-  return (float3)(c.x * amp, c.y * amp, c.z * amp);
+FL_INLINE FlTurbulence fl_turbulence_params(__global const FlActionParams* a) {
+  const FlTurbulence t = {a->f[0], a->f[1], a->f[2], a->f[3], a->f[4], a->u[0]};
+  return t;
 }
 
 FL_INLINE void fl_turbulence(__global const FlActionParams* a, float dt, fl_real time, float px,
                              float py, float pz, float* vx, float* vy, float* vz) {
-  const float3 acc = fl_turbulence_field(a, (float)time, px, py, pz);
-  const float k = dt * fl_force_falloff(a, px, py, pz);
-  *vx = *vx + acc.x * k;
-  *vy = *vy + acc.y * k;
-  *vz = *vz + acc.z * k;
+  const float3 acc = fl_turbulence_field(fl_turbulence_params(a), (float)time, px, py, pz);
+  fl_add_scaled(acc.x, acc.y, acc.z, dt * fl_force_falloff(a, px, py, pz), vx, vy, vz);
 }
 
 FL_INLINE void fl_turbulence_acc(__global const FlActionParams* a, fl_real t, float px, float py,
                                  float pz, float* ax, float* ay, float* az) {
-  const float3 acc = fl_turbulence_field(a, (float)t, px, py, pz);
-  const float w = fl_force_falloff(a, px, py, pz);
-  *ax += acc.x * w;
-  *ay += acc.y * w;
-  *az += acc.z * w;
+  fl_turbulence_accel(fl_turbulence_params(a), (float)t, fl_force_falloff(a, px, py, pz), px, py,
+                      pz, ax, ay, az);
 }
 
 /* ---- ElectricField: f[0..2] field; falloff ------------------------------------------- */

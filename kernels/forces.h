@@ -240,6 +240,64 @@ FL_INLINE void fl_clamp_speed(float minS, float maxS, float* vx, float* vy, floa
   *vz = take ? z * k : z;
 }
 
+/* ---- Avoid -------------------------------------------------------------------------------- */
+
+/* Avoid's push away from an obstacle at distance dist, per second: v += away push dt. */
+FL_INLINE float fl_avoid_push(float magnitude, float eps, float dist) {
+  return magnitude / (dist * dist + eps);
+}
+
+/* ---- Constrain2D ------------------------------------------------------------------------- */
+
+/* Constrain2D: the position onto the plane through o with unit normal n, p - n ((p - o)·n),
+ * and the velocity onto its directions, v - n (v·n). */
+FL_INLINE void fl_constrain_2d(float ox, float oy, float oz, float nx, float ny, float nz,
+                               float* px, float* py, float* pz, float* vx, float* vy, float* vz) {
+  const float x = *px, y = *py, z = *pz, u = *vx, v = *vy, w = *vz;
+  const float d = (x - ox) * nx + (y - oy) * ny + (z - oz) * nz;
+  const float e = u * nx + v * ny + w * nz;
+  *px = x - nx * d;
+  *py = y - ny * d;
+  *pz = z - nz * d;
+  *vx = u - nx * e;
+  *vy = v - ny * e;
+  *vz = w - nz * e;
+}
+
+/* ---- Restore ------------------------------------------------------------------------------ */
+
+/* Restore steers once `time` has reached `start` (a nanosecond early counts: the host's and
+ * the step's sums of dt differ in the last bits). */
+FL_INLINE int fl_restore_started(fl_real start, fl_real time) {
+  return !(time + (fl_real)1e-9 < start);
+}
+
+/* The seconds left until the arrival at `end` (start + duration). */
+FL_INLINE float fl_restore_left(fl_real end, fl_real time) {
+  return (float)(end - time);
+}
+
+/* Towards home h: the velocity that arrives in `left` seconds, or in the last step exactly;
+ * a particle with dt = 0 (a newborn born at the step's very end) keeps its velocity. Once
+ * left <= 0 it is home, at rest. */
+FL_INLINE void fl_restore_step(float left, float dt, float hx, float hy, float hz, float* px,
+                               float* py, float* pz, float* vx, float* vy, float* vz) {
+  const float by = left > dt ? left : dt;
+  if (dt > 0.0f) {
+    *vx = (hx - *px) / by;
+    *vy = (hy - *py) / by;
+    *vz = (hz - *pz) / by;
+  }
+  if (left <= 0.0f) {
+    *px = hx;
+    *py = hy;
+    *pz = hz;
+    *vx = 0.0f;
+    *vy = 0.0f;
+    *vz = 0.0f;
+  }
+}
+
 /* ---- Curves over life --------------------------------------------------------------------- */
 
 /* Where a particle is in its life, 0 to 1 (1 for one without a lifetime). */

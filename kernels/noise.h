@@ -100,4 +100,29 @@ FL_INLINE float3 fl_curl_noise(float px, float py, float pz, uint octaves) {
   return make_float3(cx, cy, cz);
 }
 
+/* ---- Turbulence ----------------------------------------------------------------------------- */
+
+typedef struct FlTurbulence {
+  float amplitude, frequency, driftX, driftY, driftZ;
+  uint octaves;
+} FlTurbulence;
+
+/* Turbulence's acceleration without its falloff, at p and time t: the amplitude times the
+ * curl noise at (p - drift t) frequency. */
+FL_INLINE float3 fl_turbulence_field(FlTurbulence a, float t, float px, float py, float pz) {
+  const float sx = a.driftX * t, sy = a.driftY * t, sz = a.driftZ * t;
+  const float3 c = fl_curl_noise((px - sx) * a.frequency, (py - sy) * a.frequency,
+                                 (pz - sz) * a.frequency, a.octaves);
+  return make_float3(c.x * a.amplitude, c.y * a.amplitude, c.z * a.amplitude);
+}
+
+/* As a force (the integrators): adds the field times the falloff's weight w to *a. */
+FL_INLINE void fl_turbulence_accel(FlTurbulence a, float t, float w, float px, float py, float pz,
+                                   float* ax, float* ay, float* az) {
+  const float3 f = fl_turbulence_field(a, t, px, py, pz);
+  *ax += f.x * w;
+  *ay += f.y * w;
+  *az += f.z * w;
+}
+
 #endif /* FLURRY_KERNELS_NOISE_H */

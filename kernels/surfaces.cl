@@ -226,12 +226,10 @@ FL_INLINE void fl_sink_hit(__global const FlActionParams* a, uint kind, float dt
                            __global const float* shapes) {
   __global const float* d = a->domain.v;
   const float3 p = (float3)(x, y, z), v = (float3)(vx, vy, vz);
-  const float3 q = p + v * dt;
-  const float3 nrm = fl_normal_leaf(d, kind, p, shapes);
-  const float3 origin = fl_closest(d, kind, p, shapes);
-  const float d0 = fl_dotv(p - origin, nrm), d1 = fl_dotv(q - origin, nrm);
-  if (!((d0 >= 0.0f) != (d1 >= 0.0f))) return;
-  const float3 h = p + (q - p) * (d0 / (d0 - d1));
+  float3 h;
+  if (!fl_path_crosses(p, p + v * dt, fl_closest(d, kind, p, shapes),
+                       fl_normal_leaf(d, kind, p, shapes), &h))
+    return;
   if (fl_surf_distance(a, kind, h, shapes) <= 1e-5f * (1.0f + fl_lengthv(h))) fl_kill(code, dead);
 }
 
@@ -264,12 +262,10 @@ FL_INLINE void fl_avoid(__global const FlActionParams* a, uint kind, float dt, f
   const float3 ahead = p + v * a->f[2];
   int threat;
   if (planar) {
-    const float3 nrm = fl_normal_any(d, kind, p, shapes);
-    const float3 o = fl_closest_any(d, kind, p, shapes);
-    const float d0 = fl_dotv(p - o, nrm), d1 = fl_dotv(ahead - o, nrm);
-    threat = (d0 >= 0.0f) != (d1 >= 0.0f) &&
-             fl_surf_distance(a, kind, p + (ahead - p) * (d0 / (d0 - d1)), shapes) <
-                 1e-4f * (1.0f + fl_lengthv(p));
+    float3 h;
+    threat = fl_path_crosses(p, ahead, fl_closest_any(d, kind, p, shapes),
+                             fl_normal_any(d, kind, p, shapes), &h) &&
+             fl_surf_distance(a, kind, h, shapes) < 1e-4f * (1.0f + fl_lengthv(p));
   } else {
     threat = !fl_inside_any(d, kind, p.x, p.y, p.z, shapes) &&
              fl_inside_any(d, kind, ahead.x, ahead.y, ahead.z, shapes);
@@ -278,25 +274,14 @@ FL_INLINE void fl_avoid(__global const FlActionParams* a, uint kind, float dt, f
   const float dist = fl_surf_distance(a, kind, p, shapes);
   float3 away = fl_normal_any(d, kind, p, shapes);
   if (planar && fl_dotv(p - fl_closest_any(d, kind, p, shapes), away) < 0.0f) away = -away;
-  const float3 r = v + away * (a->f[0] / (dist * dist + a->f[1]) * dt);
-  *vx = r.x;
-  *vy = r.y;
-  *vz = r.z;
+  fl_add_scaled(away.x, away.y, away.z, fl_avoid_push(a->f[0], a->f[1], dist) * dt, vx, vy, vz);
 }
 
-/* actions_more.hpp apply(Constrain2D). f[0..2] point, f[3..5] unit normal. */
+/* forces.h fl_constrain_2d. f[0..2] point, f[3..5] unit normal. */
 FL_INLINE void fl_constrain2d(__global const FlActionParams* a, float* px, float* py, float* pz,
                               float* vx, float* vy, float* vz) {
-  const float3 p = (float3)(*px, *py, *pz), v = (float3)(*vx, *vy, *vz);
-  const float3 point = fl_v3(a->f), nrm = fl_v3(a->f + 3);
-  const float3 q = p - nrm * fl_dotv(p - point, nrm);
-  const float3 w = v - nrm * fl_dotv(v, nrm);
-  *px = q.x;
-  *py = q.y;
-  *pz = q.z;
-  *vx = w.x;
-  *vy = w.y;
-  *vz = w.z;
+  __global const float* f = a->f;
+  fl_constrain_2d(f[0], f[1], f[2], f[3], f[4], f[5], px, py, pz, vx, vy, vz);
 }
 
 /* ---- Neighbours: the particles as they were at the start of the step (FL_SNAP) ----------- */

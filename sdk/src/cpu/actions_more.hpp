@@ -45,6 +45,9 @@ inline kernel::FlVortex flVortex(const Vortex& a) {
   return {a.center.x,    a.center.y,   a.center.z,  k.x,       k.y,       k.z,
           a.aroundSpeed, a.coreRadius, a.tightness, a.inSpeed, a.upSpeed, a.maxRadius};
 }
+inline kernel::FlTurbulence flTurbulence(const Turbulence& a) {
+  return {a.amplitude, a.frequency, a.drift.x, a.drift.y, a.drift.z, kernel::uint(a.octaves)};
+}
 // Calls f(&x, &y, &z) on locals holding lane particle i's vector and stores them back: the
 // shared kernels' pointers into the arrays would hide their __restrict from the vectoriser.
 template <class F>
@@ -159,12 +162,10 @@ inline void apply(const Sink& a, const Lanes& L, std::size_t n, const BlockConte
   } else {  // Hit: the coming Move crosses the plane piece
     for (std::size_t i = 0; i < n; ++i) {
       const Vec3 p = at(L.p, i), v = at(L.v, i);
-      const Vec3 q = p + v * c.dtAt(i);
-      const Vec3 nrm = a.region.normal(p);
-      const Vec3 origin = a.region.closestPoint(p);
-      const float d0 = glm::dot(p - origin, nrm), d1 = glm::dot(q - origin, nrm);
-      if (!((d0 >= 0.0f) != (d1 >= 0.0f))) continue;
-      const Vec3 h = p + (q - p) * (d0 / (d0 - d1));
+      Vec3 h;
+      if (!kernel::fl_path_crosses(p, p + v * c.dtAt(i), a.region.closestPoint(p),
+                                   a.region.normal(p), &h))
+        continue;
       if (a.region.distance(h) <= 1e-5f * (1.0f + glm::length(h))) kill(c, i);
     }
   }
@@ -359,11 +360,15 @@ inline void apply(const RandomRotVelocity& a, const Lanes& L, std::size_t n,
 }
 
 inline void apply(const Turbulence& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const Vec3 shift = a.drift * float(c.time);
+  const kernel::FlTurbulence turbulence = flTurbulence(a);
+  const float t = float(c.time);
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 p = at(L.p, i);
-    const Vec3 acc = curlNoise((p - shift) * a.frequency, a.octaves) * a.amplitude;
-    put(L.v, i, at(L.v, i) + acc * (c.dtAt(i) * falloffWeight(a.falloff, p)));
+    const float px = L.p[0][i], py = L.p[1][i], pz = L.p[2][i];
+    const Vec3 acc = kernel::fl_turbulence_field(turbulence, t, px, py, pz);
+    const float k = c.dtAt(i) * falloffWeight(a.falloff, Vec3(px, py, pz));
+    onLocals(L.v, i, [&](float* x, float* y, float* z) {
+      kernel::fl_add_scaled(acc.x, acc.y, acc.z, k, x, y, z);
+    });
   }
 }
 
@@ -418,12 +423,10 @@ inline void apply(const Avoid& a, const Lanes& L, std::size_t n, const BlockCont
     const Vec3 ahead = p + v * a.lookAhead;
     bool threat;
     if (planar) {
-      const Vec3 nrm = a.obstacle.normal(p);
-      const Vec3 o = a.obstacle.closestPoint(p);
-      const float d0 = glm::dot(p - o, nrm), d1 = glm::dot(ahead - o, nrm);
+      Vec3 h;
       threat =
-          (d0 >= 0.0f) != (d1 >= 0.0f) &&
-          a.obstacle.distance(p + (ahead - p) * (d0 / (d0 - d1))) < 1e-4f * (1.0f + glm::length(p));
+          kernel::fl_path_crosses(p, ahead, a.obstacle.closestPoint(p), a.obstacle.normal(p), &h) &&
+          a.obstacle.distance(h) < 1e-4f * (1.0f + glm::length(p));
     } else {
       threat = !a.obstacle.contains(p) && a.obstacle.contains(ahead);
     }
@@ -431,7 +434,11 @@ inline void apply(const Avoid& a, const Lanes& L, std::size_t n, const BlockCont
     const float dist = a.obstacle.distance(p);
     Vec3 away = a.obstacle.normal(p);
     if (planar && glm::dot(p - a.obstacle.closestPoint(p), away) < 0.0f) away = -away;
-    put(L.v, i, v + away * (a.magnitude / (dist * dist + a.epsilon) * c.dtAt(i)));
+    onLocals(L.v, i, [&](float* x, float* y, float* z) {
+      kernel::fl_add_scaled(away.x, away.y, away.z,
+                            kernel::fl_avoid_push(a.magnitude, a.epsilon, dist) * c.dtAt(i), x, y,
+                            z);
+    });
   }
 }
 
@@ -554,11 +561,17 @@ inline void apply(const SizeOverLife& a, const Lanes& L, std::size_t n, const Bl
 // ---- Bookkeeping -------------------------------------------------------------------------
 
 inline void apply(const Constrain2D& a, const Lanes& L, std::size_t n, const BlockContext&) {
-  const Vec3 nrm = glm::normalize(a.normal);
+  const Vec3 nrm = glm::normalize(a.normal), o = a.point;
+  float* __restrict px = L.p[0];
+  float* __restrict py = L.p[1];
+  float* __restrict pz = L.p[2];
+  float* __restrict vx = L.v[0];
+  float* __restrict vy = L.v[1];
+  float* __restrict vz = L.v[2];
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 p = at(L.p, i), v = at(L.v, i);
-    put(L.p, i, p - nrm * glm::dot(p - a.point, nrm));
-    put(L.v, i, v - nrm * glm::dot(v, nrm));
+    float x = px[i], y = py[i], z = pz[i], u = vx[i], v = vy[i], w = vz[i];
+    kernel::fl_constrain_2d(o.x, o.y, o.z, nrm.x, nrm.y, nrm.z, &x, &y, &z, &u, &v, &w);
+    px[i] = x, py[i] = y, pz[i] = z, vx[i] = u, vy[i] = v, vz[i] = w;
   }
 }
 
@@ -568,17 +581,13 @@ inline void apply(const CopyVertexB& a, const Lanes& L, std::size_t n, const Blo
 }
 
 inline void apply(const Restore& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  if (c.time + 1e-9 < a.start) return;
-  const float left = float(double(a.start) + a.duration - c.time);  // seconds to arrival
+  if (!kernel::fl_restore_started(a.start, c.time)) return;
+  const float left = kernel::fl_restore_left(double(a.start) + a.duration, c.time);
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 p = at(L.p, i), home = at(L.posB, i);
-    // The velocity that arrives on time; in the last step, exactly. A newborn born at the
-    // step's very end (dt = 0) keeps its velocity.
-    if (c.dt > 0.0f) put(L.v, i, left > c.dt ? (home - p) / left : (home - p) / c.dt);
-    if (left <= 0.0f) {
-      put(L.p, i, home);
-      put(L.v, i, Vec3(0.0f));
-    }
+    float x = L.p[0][i], y = L.p[1][i], z = L.p[2][i], u = L.v[0][i], v = L.v[1][i], w = L.v[2][i];
+    kernel::fl_restore_step(left, c.dt, L.posB[0][i], L.posB[1][i], L.posB[2][i], &x, &y, &z, &u,
+                            &v, &w);
+    L.p[0][i] = x, L.p[1][i] = y, L.p[2][i] = z, L.v[0][i] = u, L.v[1][i] = v, L.v[2][i] = w;
   }
 }
 

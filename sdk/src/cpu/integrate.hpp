@@ -81,8 +81,8 @@ inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std
             Random rng = actionRandom(c, L, i);
             acc = a.acceleration.sample(rng) * falloffWeight(a.falloff, p);
           } else if constexpr (std::is_same_v<A, Turbulence>) {
-            acc = curlNoise((p - a.drift * float(t)) * a.frequency, a.octaves) * a.amplitude *
-                  falloffWeight(a.falloff, p);
+            kernel::fl_turbulence_accel(flTurbulence(a), float(t), falloffWeight(a.falloff, p), p.x,
+                                        p.y, p.z, &acc.x, &acc.y, &acc.z);
           } else if constexpr (std::is_same_v<A, ElectricField>) {
             acc = a.field * chargePerMass(L, i) * falloffWeight(a.falloff, p);
           } else if constexpr (std::is_same_v<A, MagneticField>) {
