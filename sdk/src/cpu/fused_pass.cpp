@@ -202,7 +202,10 @@ void runActions(const std::vector<Action>& acts, const Plan& plan, std::size_t f
     if (plan.list.integrator != Integrator::SemiImplicitEuler &&
         std::holds_alternative<Move>(acts[k])) {
       cpu::IntegratorScratch& scratch = scratchStore;
-      cpu::integrate(plan.list.integrator, acts, plan.list.forcesOf[k], lanes, n, ctx, scratch);
+      cpu::withDt(ctx, [&](auto dt) {
+        cpu::integrate(plan.list.integrator, acts, plan.list.forcesOf[k], lanes, n, ctx, scratch,
+                       dt);
+      });
       if (!plan.list.guardsOf[k].empty()) {
         const float* start[3];
         for (int c = 0; c < 3; ++c) start[c] = plan.start[c] + ctx.base;
@@ -225,14 +228,27 @@ void runActions(const std::vector<Action>& acts, const Plan& plan, std::size_t f
   }
 }
 
-// Whether an action runs over a batch of newborns, each with its own step length
-// (BlockContext::ownDt), in one call like a block. What depends on the time itself (not
-// only on the step's length), and the integrators' Move, runs per newborn instead.
-bool takesOwnDt(const Action& act, bool eulerMove) {
-  if (std::holds_alternative<Move>(act)) return eulerMove;
-  if (const auto* t = std::get_if<Turbulence>(&act)) return t->drift == Vec3(0.0f);
-  return !std::holds_alternative<Explosion>(act) && !std::holds_alternative<Restore>(act) &&
-         !std::holds_alternative<Callback>(act);
+// Whether an action reads the time itself, not only the step's length.
+bool readsTime(const Action& act) {
+  if (const auto* t = std::get_if<Turbulence>(&act)) return t->drift != Vec3(0.0f);
+  return std::holds_alternative<Explosion>(act) || std::holds_alternative<Restore>(act) ||
+         std::holds_alternative<Callback>(act);
+}
+
+// Whether action k runs over a batch of newborns, each with its own step length
+// (BlockContext::ownDt), in one call like a block. What reads the time itself runs per
+// newborn instead, at its own time: an action, or the forces an integrating Move (or a
+// bounce on its curved path) evaluates at its stages.
+bool takesOwnDt(const std::vector<Action>& acts, const ActionPlan& list, std::size_t k) {
+  const auto forcesReadTime = [&](std::size_t move) {
+    for (std::uint32_t f : list.forcesOf[move])
+      if (readsTime(acts[f])) return true;
+    return false;
+  };
+  if (list.curvedBy[k]) return !forcesReadTime(list.curvedBy[k] - 1);
+  if (std::holds_alternative<Move>(acts[k]))
+    return list.integrator == Integrator::SemiImplicitEuler || !forcesReadTime(k);
+  return !readsTime(acts[k]);
 }
 
 // Actions [first, last) of the list over a block's newborns, [0, count) of `lanes`: each
@@ -249,7 +265,6 @@ void runNewborns(const std::vector<Action>& acts, const Plan& plan, std::size_t 
   if (own.size() < count) own.resize(std::max<std::size_t>(count, 1024));
   for (std::size_t i = 0; i < count; ++i)
     own[i] = float(double(remaining[i]) / double(plan.substeps));
-  const bool euler = plan.list.integrator == Integrator::SemiImplicitEuler;
   cpu::BlockContext batch = ctx;
   batch.ownDt = own.data();
   for (std::size_t k = first; k < last; ++k) {
@@ -258,7 +273,7 @@ void runNewborns(const std::vector<Action>& acts, const Plan& plan, std::size_t 
       runActions(acts, plan, k, k + 1, lanes, count, ctx);
       continue;
     }
-    if (!plan.list.curvedBy[k] && takesOwnDt(acts[k], euler)) {
+    if (takesOwnDt(acts, plan.list, k)) {
       runActions(acts, plan, k, k + 1, lanes, count, batch);
       continue;
     }

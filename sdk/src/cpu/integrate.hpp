@@ -133,11 +133,15 @@ inline void startAcceleration(const std::vector<Action>& acts,
 }
 
 /// Move with an integrator other than semi-implicit Euler: `forces` are the indices of the
-/// force actions gathered for this Move.
+/// force actions gathered for this Move. `dt` is the block's sub-step (UniformDt) or each
+/// newborn's own (OwnDt); with OwnDt the forces must not depend on the time (the stages are
+/// evaluated at c.time), which the fused pass checks (fused_pass.cpp runNewborns).
+template <class Dt>
 inline void integrate(Integrator integrator, const std::vector<Action>& acts,
                       const std::vector<std::uint32_t>& forces, const Lanes& L, std::size_t n,
-                      const BlockContext& c, IntegratorScratch& scratch) {
-  const float dt = c.dt;
+                      const BlockContext& c, IntegratorScratch& scratch, Dt dt) {
+  // A stage's time, for the forces that read it: with OwnDt none does.
+  const float h0 = dt[0];
   const double t = c.time;
   scratch.reset(n, 24);
   auto arrays3 = [&](float** out) {
@@ -161,8 +165,8 @@ inline void integrate(Integrator integrator, const std::vector<Action>& acts,
       evaluate(L.p, L.v, a0, t);
       for (int d = 0; d < 3; ++d)
         for (std::size_t i = 0; i < n; ++i) {
-          L.p[d][i] += L.v[d][i] * dt;  // with the velocity at the start of the step
-          L.v[d][i] += a0[d][i] * dt;
+          L.p[d][i] += L.v[d][i] * dt[i];  // with the velocity at the start of the step
+          L.v[d][i] += a0[d][i] * dt[i];
         }
       break;
     }
@@ -174,14 +178,14 @@ inline void integrate(Integrator integrator, const std::vector<Action>& acts,
       evaluate(L.p, L.v, a0, t);
       for (int d = 0; d < 3; ++d)
         for (std::size_t i = 0; i < n; ++i) {
-          p1[d][i] = L.p[d][i] + L.v[d][i] * dt + 0.5f * a0[d][i] * dt * dt;
-          v1[d][i] = L.v[d][i] + a0[d][i] * dt;  // predicted, for velocity-dependent forces
+          p1[d][i] = L.p[d][i] + L.v[d][i] * dt[i] + 0.5f * a0[d][i] * dt[i] * dt[i];
+          v1[d][i] = L.v[d][i] + a0[d][i] * dt[i];  // predicted, for velocity-dependent forces
         }
-      evaluate(p1, v1, a1, t + dt);
+      evaluate(p1, v1, a1, t + h0);
       for (int d = 0; d < 3; ++d)
         for (std::size_t i = 0; i < n; ++i) {
           L.p[d][i] = p1[d][i];
-          L.v[d][i] += 0.5f * (a0[d][i] + a1[d][i]) * dt;
+          L.v[d][i] += 0.5f * (a0[d][i] + a1[d][i]) * dt[i];
         }
       break;
     }
@@ -201,21 +205,22 @@ inline void integrate(Integrator integrator, const std::vector<Action>& acts,
       }
       const float h[4] = {0.0f, 0.5f, 0.5f, 1.0f}, w[4] = {1.0f, 2.0f, 2.0f, 1.0f};
       for (int k = 0; k < 4; ++k) {
-        evaluate(ps, vs, a1, t + h[k] * dt);
-        const float next = k < 3 ? h[k + 1] * dt : 0.0f;
+        evaluate(ps, vs, a1, t + h[k] * h0);
+        const float hn = k < 3 ? h[k + 1] : 0.0f;
         for (int d = 0; d < 3; ++d)
           for (std::size_t i = 0; i < n; ++i) {
             const float kp = vs[d][i], kv = a1[d][i];
             sp[d][i] += w[k] * kp;
             sv[d][i] += w[k] * kv;
+            const float next = hn * dt[i];     // 0 after the last stage, as h·dt was
             ps[d][i] = L.p[d][i] + kp * next;  // the next stage's state
             vs[d][i] = L.v[d][i] + kv * next;
           }
       }
       for (int d = 0; d < 3; ++d)
         for (std::size_t i = 0; i < n; ++i) {
-          L.p[d][i] += sp[d][i] * (dt / 6.0f);
-          L.v[d][i] += sv[d][i] * (dt / 6.0f);
+          L.p[d][i] += sp[d][i] * (dt[i] / 6.0f);
+          L.v[d][i] += sv[d][i] * (dt[i] / 6.0f);
         }
       break;
     }
@@ -239,14 +244,14 @@ inline void integrate(Integrator integrator, const std::vector<Action>& acts,
       }
       for (int d = 0; d < 3; ++d)
         for (std::size_t i = 0; i < n; ++i) {
-          const float g = a0[d][i], k = a1[d][i], v0 = L.v[d][i];
+          const float g = a0[d][i], k = a1[d][i], v0 = L.v[d][i], h = dt[i];
           if (k > 0.0f) {
-            const float e = std::exp(-k * dt), term = g / k;
-            L.p[d][i] += term * dt + (v0 - term) * (1.0f - e) / k;
+            const float e = std::exp(-k * h), term = g / k;
+            L.p[d][i] += term * h + (v0 - term) * (1.0f - e) / k;
             L.v[d][i] = term + (v0 - term) * e;
           } else {
-            L.p[d][i] += v0 * dt + 0.5f * g * dt * dt;
-            L.v[d][i] = v0 + g * dt;
+            L.p[d][i] += v0 * h + 0.5f * g * h * h;
+            L.v[d][i] = v0 + g * h;
           }
         }
       break;
@@ -254,7 +259,7 @@ inline void integrate(Integrator integrator, const std::vector<Action>& acts,
     case Integrator::SemiImplicitEuler:
       break;  // not used: the forces ran as their own updates
   }
-  if (L.age) ageLoop(L.age, n, UniformDt{dt});
+  if (L.age) ageLoop(L.age, n, dt);
 }
 
 }  // namespace FLURRY_ISA_NAMESPACE

@@ -312,6 +312,7 @@ inline void bouncePlanarLoop(float* __restrict px, float* __restrict py, float* 
                              std::size_t n, Dt dts, Vec3 P, Vec3 N, OnPiece onPiece,
                              const Bounce& b) {
   constexpr std::size_t kChunk = 256;
+  constexpr std::size_t kPad = 16;  // floats in the widest vector (AVX-512)
   const Reflect reflect{b.restitution, 1.0f - b.friction, b.cutoff * b.cutoff};
   alignas(32) std::uint8_t reaches[kChunk];
   // A floor, a wall: a normal along an axis makes the test read two lanes, not six.
@@ -321,8 +322,8 @@ inline void bouncePlanarLoop(float* __restrict px, float* __restrict py, float* 
                                                 : -1;
   const float Pk = axis == 0 ? P.x : axis == 1 ? P.y : P.z;
   const float Nk = axis == 0 ? N.x : axis == 1 ? N.y : N.z;
-  alignas(32) float g[7][kChunk];  // the packed candidates: x, y, z, vx, vy, vz, dt
-  std::uint8_t idx[kChunk + 8];    // (eight are stored at once)
+  alignas(64) float g[7][kChunk];  // the packed candidates: x, y, z, vx, vy, vz, dt
+  std::uint8_t idx[kChunk + 8];    // (eight are stored at once; padding stays below m/4 + 16)
   for (std::size_t c0 = 0; c0 < n; c0 += kChunk) {
     const std::size_t m = std::min(kChunk, n - c0);
     float *x = px + c0, *y = py + c0, *z = pz + c0, *vx = vxs + c0, *vy = vys + c0, *vz = vzs + c0;
@@ -357,13 +358,18 @@ inline void bouncePlanarLoop(float* __restrict px, float* __restrict py, float* 
       bouncePlanarAll(x, y, z, vx, vy, vz, m, OffsetDt<Dt>{dts, c0}, P, N, onPiece, reflect);
       continue;
     }
-    for (std::size_t j = 0; j < k; ++j) {
+    // Padded with copies of the first candidate to whole vectors: the batch runs in the
+    // vector loop alone, with no scalar remainder (the copies are computed, never stored).
+    const std::size_t padded = (k + kPad - 1) / kPad * kPad;
+    for (std::size_t j = k; j < padded; ++j) idx[j] = idx[0];
+    for (std::size_t j = 0; j < padded; ++j) {
       const std::size_t s = idx[j];
       g[0][j] = x[s], g[1][j] = y[s], g[2][j] = z[s];
       g[3][j] = vx[s], g[4][j] = vy[s], g[5][j] = vz[s];
       g[6][j] = dts[c0 + s];
     }
-    bouncePlanarAll(g[0], g[1], g[2], g[3], g[4], g[5], k, OwnDt{g[6]}, P, N, onPiece, reflect);
+    bouncePlanarAll(g[0], g[1], g[2], g[3], g[4], g[5], padded, OwnDt{g[6]}, P, N, onPiece,
+                    reflect);
     for (std::size_t j = 0; j < k; ++j) {
       const std::size_t s = idx[j];
       x[s] = g[0][j], y[s] = g[1][j], z[s] = g[2][j];
@@ -379,16 +385,16 @@ inline void bouncePlanarLoop(float* __restrict px, float* __restrict py, float* 
 /// impact, v + a·tau, is reflected. The start-of-step state is then set so that the
 /// integrator's p + v·dt + ½a·dt² runs the reflected parabola after the impact. With the
 /// straight path instead, the impact velocity would be off by a·(dt − tau): first order.
-template <class OnPiece>
+template <class OnPiece, class Dt>
 inline void bouncePlanarAccelLoop(float* __restrict px, float* __restrict py, float* __restrict pz,
                                   float* __restrict vxs, float* __restrict vys,
                                   float* __restrict vzs, const float* __restrict axs,
                                   const float* __restrict ays, const float* __restrict azs,
-                                  std::size_t n, float dt, Vec3 P, Vec3 N, OnPiece onPiece,
+                                  std::size_t n, Dt dts, Vec3 P, Vec3 N, OnPiece onPiece,
                                   const Bounce& b) {
   const Reflect reflect{b.restitution, 1.0f - b.friction, b.cutoff * b.cutoff};
-  const float hdt2 = 0.5f * dt * dt;
   for (std::size_t i = 0; i < n; ++i) {
+    const float dt = dts[i], hdt2 = 0.5f * dt * dt;
     const float x = px[i], y = py[i], z = pz[i];
     const float vx = vxs[i], vy = vys[i], vz = vzs[i];
     const float ax = axs[i], ay = ays[i], az = azs[i];
@@ -576,8 +582,10 @@ inline void apply(const Bounce& a, const Lanes& L, std::size_t n, const BlockCon
 inline void applyAccelerated(const Bounce& a, const Lanes& L, std::size_t n, const BlockContext& c,
                              const float* const* acc) {
   const bool planar = withPlanarPiece(a, [&](Vec3 P, Vec3 N, auto onPiece) {
-    bouncePlanarAccelLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], acc[0], acc[1], acc[2], n,
-                          c.dt, P, N, onPiece, a);
+    withDt(c, [&](auto dt) {
+      bouncePlanarAccelLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], acc[0], acc[1], acc[2],
+                            n, dt, P, N, onPiece, a);
+    });
   });
   if (!planar) apply(a, L, n, c);
 }
