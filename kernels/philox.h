@@ -5,8 +5,9 @@
 #define FLURRY_KERNELS_PHILOX_H
 
 FL_INLINE uint4 fl_philox(uint4 c, uint k0, uint k1) {
-  const uint M0 = 0xD2511F53u, M1 = 0xCD9E8D57u;
-  const uint W0 = 0x9E3779B9u, W1 = 0xBB67AE85u;
+  /* Defined by the generated source from flurry::Philox4x32 (codegen.cpp). */
+  const uint M0 = FL_PHILOX_M0, M1 = FL_PHILOX_M1;
+  const uint W0 = FL_PHILOX_W0, W1 = FL_PHILOX_W1;
   uint c0 = c.x, c1 = c.y, c2 = c.z, c3 = c.w;
   /* 64-bit products rather than mul_hi: PoCL's mul_hi made this ~10x slower. */
 #pragma unroll

@@ -281,8 +281,8 @@ struct Lanes {
 };
 #endif
 
-constexpr std::uint32_t kM0 = 0xD2511F53u, kM1 = 0xCD9E8D57u;
-constexpr std::uint32_t kW0 = 0x9E3779B9u, kW1 = 0xBB67AE85u;
+constexpr std::uint32_t kM0 = Philox4x32::kM0, kM1 = Philox4x32::kM1;
+constexpr std::uint32_t kW0 = Philox4x32::kW0, kW1 = Philox4x32::kW1;
 
 // Counter word 0 of particle i: firstId + i, or id[i].
 struct Consecutive {

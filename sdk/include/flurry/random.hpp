@@ -12,24 +12,27 @@ namespace flurry {
 
 /// One Philox4x32-10 block: 4 random 32-bit words for a 128-bit counter and 64-bit key.
 struct Philox4x32 {
+  /// The round multipliers and the key's increments (a Weyl sequence), the generator's one
+  /// definition: the CPU's vectorised batches use these, and the OpenCL programs are given
+  /// them as macros (FL_PHILOX_M0 ...) when their source is generated.
+  static constexpr std::uint32_t kM0 = 0xD2511F53u, kM1 = 0xCD9E8D57u;
+  static constexpr std::uint32_t kW0 = 0x9E3779B9u, kW1 = 0xBB67AE85u;
   struct Block {
     std::uint32_t v[4];
   };
   static inline Block generate(std::uint32_t c0, std::uint32_t c1, std::uint32_t c2,
                                std::uint32_t c3, std::uint32_t k0, std::uint32_t k1) noexcept {
-    constexpr std::uint32_t M0 = 0xD2511F53u, M1 = 0xCD9E8D57u;
-    constexpr std::uint32_t W0 = 0x9E3779B9u, W1 = 0xBB67AE85u;
     for (int r = 0; r < 10; ++r) {
-      const std::uint64_t p0 = std::uint64_t(M0) * c0;
-      const std::uint64_t p1 = std::uint64_t(M1) * c2;
+      const std::uint64_t p0 = std::uint64_t(kM0) * c0;
+      const std::uint64_t p1 = std::uint64_t(kM1) * c2;
       const std::uint32_t hi0 = std::uint32_t(p0 >> 32), lo0 = std::uint32_t(p0);
       const std::uint32_t hi1 = std::uint32_t(p1 >> 32), lo1 = std::uint32_t(p1);
       c0 = hi1 ^ c1 ^ k0;
       c1 = lo1;
       c2 = hi0 ^ c3 ^ k1;
       c3 = lo0;
-      k0 += W0;
-      k1 += W1;
+      k0 += kW0;
+      k1 += kW1;
     }
     return {{c0, c1, c2, c3}};
   }

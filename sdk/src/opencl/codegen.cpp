@@ -10,6 +10,7 @@
 #include "../action_traits.hpp"
 #include "../shape_math.hpp"
 #include "flurry/error.hpp"
+#include "flurry/random.hpp"
 
 namespace flurry::detail::ocl {
 
@@ -697,6 +698,9 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   s << " } while (0)\n#define FL_LANE_ARGS ";
   for (std::size_t k = 0; k < all.size(); ++k) s << (k ? ", " : "") << "l_" << all[k].name;
   s << "\n";
+  s << "#define FL_PHILOX_M0 " << Philox4x32::kM0 << "u\n#define FL_PHILOX_M1 " << Philox4x32::kM1
+    << "u\n#define FL_PHILOX_W0 " << Philox4x32::kW0 << "u\n#define FL_PHILOX_W1 "
+    << Philox4x32::kW1 << "u\n";
   for (const char* f : {"compat_opencl.h", "math.h", "params.h", "philox.h", "noise.h", "deflect.h",
                         "domain.h", "domain.cl", "forces.h", "absorb.h", "actions.cl", "forces.cl",
                         "surfaces.cl", "compact.cl", "emit.cl"})
