@@ -65,11 +65,57 @@ std::uint32_t substepCount(GroupImpl& g, const StepParams& sp, ThreadPool& pool)
 // After an integrating Move, a particle that its curved step (or its bounce) left on the
 // wrong side of a deflector, compared with where it was when the step began, is put back on
 // its side and reflected: no particle ends behind a deflector.
+//
+// A planar piece is one plane: a vectorised test first drops the particles that are clearly
+// on their starting side at both ends of the step, by far more than the rounding of the exact
+// test below (which gives the same answer for them); the few left (near the plane, or across
+// it) take the exact test, so the result is bitwise what testing everyone would give.
 void guard(const Bounce& b, const Lanes& L, const float* const* start, std::size_t n) {
   const Domain& d = b.surface;
   const auto* seg = std::get_if<LineDomain>(&d.shape());
   const bool planar = d.isPlanar() || seg;
-  for (std::size_t i = 0; i < n; ++i) {
+  thread_local std::vector<std::uint32_t> nearStore, flagStore;
+  std::vector<std::uint32_t>& near = nearStore;
+  std::size_t count = n;
+  if (planar && n > 0) {
+    const Vec3 p00(start[0][0], start[1][0], start[2][0]);
+    const Vec3 N =
+        seg ? glm::normalize(glm::cross(seg->p1 - seg->p0, b.planeNormal)) : d.normal(p00);
+    const Vec3 P = seg ? seg->p0 : d.closestPoint(p00);
+    // How far the exact test's own point on the piece (its closest point) may lie from P.
+    float extent = 0.0f;
+    if (const auto* x = std::get_if<DiscDomain>(&d.shape())) extent = x->outerRadius;
+    if (const auto* x = std::get_if<RectangleDomain>(&d.shape()))
+      extent = glm::length(x->u) + glm::length(x->v);
+    if (const auto* x = std::get_if<TriangleDomain>(&d.shape()))
+      extent = glm::length(x->p1 - x->p0) + glm::length(x->p2 - x->p0);
+    if (seg) extent = glm::length(seg->p1 - seg->p0);
+    const float reach = std::abs(P.x) + std::abs(P.y) + std::abs(P.z) + extent + 1.0f;
+    std::vector<std::uint32_t>& flags = flagStore;
+    if (near.size() < n) near.resize(std::max<std::size_t>(n, 1024));
+    if (flags.size() < n) flags.resize(near.size());
+    std::uint32_t* __restrict flag = flags.data();
+    const float *x0 = start[0], *y0 = start[1], *z0 = start[2];
+    const float *x1 = L.p[0], *y1 = L.p[1], *z1 = L.p[2];
+    for (std::size_t i = 0; i < n; ++i) {
+      const float s0 = (x0[i] - P.x) * N.x + (y0[i] - P.y) * N.y + (z0[i] - P.z) * N.z;
+      const float s1 = (x1[i] - P.x) * N.x + (y1[i] - P.y) * N.y + (z1[i] - P.z) * N.z;
+      const float size = reach + std::abs(x0[i]) + std::abs(y0[i]) + std::abs(z0[i]) +
+                         std::abs(x1[i]) + std::abs(y1[i]) + std::abs(z1[i]);
+      const float slack = 1e-3f * size;
+      // Clearly off the plane at the start, and still on that side by as much at the end
+      // (NaN: a candidate).
+      const bool clear = std::abs(s0) > slack && (s0 > 0.0f ? s1 : -s1) > slack;
+      flag[i] = clear ? 0u : 1u;
+    }
+    count = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      near[count] = std::uint32_t(i);
+      count += flag[i];
+    }
+  }
+  for (std::size_t k = 0; k < count; ++k) {
+    const std::size_t i = planar ? near[k] : k;
     const Vec3 p0(start[0][i], start[1][i], start[2][i]);
     Vec3 p1(L.p[0][i], L.p[1][i], L.p[2][i]);
     Vec3 nrm, back;
