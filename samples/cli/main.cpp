@@ -37,6 +37,7 @@ struct RunOptions {
   std::optional<double> dt;
   unsigned threads = 0;
   std::size_t capacity = 0;
+  double spawnScale = 1.0;
   bool quiet = false;
   std::string backend = "cpu";
   std::string device;
@@ -227,8 +228,9 @@ void printStats(const flurry::Group& g, int frame, double time) {
 }
 
 int run(const RunOptions& o, std::vector<std::unique_ptr<flurry::cli::Plugin>>& plugins) {
-  const flurry::Effect fx = flurry::cli::loadEffectForCli(o.effect);
+  flurry::Effect fx = flurry::cli::loadEffectForCli(o.effect);
   printWarnings(fx, o.effect);
+  if (o.spawnScale != 1.0) fx.scaleSpawning(o.spawnScale);
   const int frames = o.frames.value_or(fx.frames);
   if (!o.out.empty()) {
     std::error_code ec;
@@ -377,6 +379,10 @@ int main(int argc, char** argv) {
   runCmd->add_option("--threads", o.threads, "worker threads (0: all cores)");
   runCmd->add_option("--capacity", o.capacity, "cap every group's capacity (0: the effect's)")
       ->check(CLI::Range(std::size_t(0), std::size_t(1) << 31));
+  runCmd
+      ->add_option("--spawn-scale", o.spawnScale,
+                   "scale every emitter's rate and bursts, and the capacities (a quality knob)")
+      ->check(CLI::Range(1e-6, 1e6));
   runCmd->add_flag("--quiet", o.quiet, "print only errors, warnings and a one-line summary");
   runCmd->add_option("--backend", o.backend, "cpu, opencl or auto")
       ->check(CLI::IsMember({"cpu", "opencl", "auto"}));

@@ -29,6 +29,8 @@ struct Look {
   std::vector<float> target;  // x, y, z
   float fov = 45.0f;
   CLI::Option* fovOption = nullptr;
+  float exposure = 1.0f;
+  CLI::Option* exposureOption = nullptr;
 };
 
 bool parseSize(const std::string& s, int& w, int& h) {
@@ -57,6 +59,11 @@ void addLookOptions(CLI::App& cmd, Look& look) {
       ->delimiter(',');
   look.fovOption = cmd.add_option("--fov", look.fov, "vertical field of view, degrees")
                        ->check(CLI::Range(1.0, 170.0));
+  // An additive effect run with --spawn-scale N is N times as bright: --exposure 1/N.
+  look.exposureOption =
+      cmd.add_option("--exposure", look.exposure,
+                     "scale the colour before the tone map (additive glow: 1/spawn scale)")
+          ->check(CLI::Range(1e-6, 100.0));
 }
 
 // The effect's `render` object, then the command line's overrides.
@@ -104,6 +111,7 @@ RenderSettings settingsFrom(const std::string& render, const fs::path& effectFil
   if (look.target.size() == 3)
     s.camera.target = Vec3(look.target[0], look.target[1], look.target[2]);
   if (look.fovOption && look.fovOption->count() > 0) s.camera.fovY = look.fov;
+  if (look.exposureOption && look.exposureOption->count() > 0) s.exposure = look.exposure;
   return s;
 }
 

@@ -92,6 +92,11 @@ elseif(MODE STREQUAL "run")
     ARGS run ${SRC}/tests/effect/data/nonfinite.json --frames 10 --quiet)
   flurry_expect(RC 0 OUT "blowup: 10 steps.*non-finite 300"
     ARGS run ${SRC}/tests/effect/data/nonfinite.json --frames 10)
+  # --spawn-scale: twice the births (Effect::scaleSpawning); none or a negative is refused.
+  flurry_expect(RC 0 OUT "nonfinite: 10 steps in [0-9.]+ s; emitted 600 = "
+    ARGS run ${SRC}/tests/effect/data/nonfinite.json --frames 10 --quiet --spawn-scale 2)
+  flurry_expect(RC 105 ERR "--spawn-scale: Value 0 not in range"
+    ARGS run fountain --frames 1 --spawn-scale 0)
   # A warning does not stop a run.
   flurry_expect(RC 0 OUT "no_move: 3 steps" ERR "flurry: warning: [^\n]*no_move.json: groups\\[0\\]\\.actions: has no Move"
     ARGS run ${SRC}/tests/effect/data/no_move.json --frames 3 --quiet)

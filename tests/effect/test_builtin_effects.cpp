@@ -254,3 +254,54 @@ TEST(BuiltinEffects, BuildFountainMatchesTheEffectFile) {
   const auto xa = ga.lane(Attribute::Position, 1), xb = gb.lane(Attribute::Position, 1);
   for (std::size_t i = 0; i < ga.size(); ++i) ASSERT_EQ(xa[i], xb[i]) << i;
 }
+
+// A quality knob (Niagara's spawn count scale): rates, bursts, births by distance, the
+// emitters prime emitters spawn (every level) and capacities scale; the particles made scale
+// with them.
+TEST(Effect, ScaleSpawningScalesWhatIsBornAndTheRoom) {
+  const samples::Sample* galaxy = samples::findSample("galaxy");
+  const samples::Sample* fireworks = samples::findSample("fireworks");
+  ASSERT_TRUE(galaxy && galaxy->effect && fireworks && fireworks->effect);
+
+  Effect fx = *galaxy->effect;
+  fx.scaleSpawning(3.0);
+  for (std::size_t g = 0; g < fx.groups.size(); ++g) {
+    const EffectGroup &a = galaxy->effect->groups[g], &b = fx.groups[g];
+    EXPECT_EQ(b.capacity, a.capacity * 3);
+    for (std::size_t e = 0; e < a.emitters.size(); ++e) {
+      EXPECT_DOUBLE_EQ(b.emitters[e].rate, a.emitters[e].rate * 3.0);
+      for (std::size_t k = 0; k < a.emitters[e].bursts.size(); ++k)
+        EXPECT_EQ(b.emitters[e].bursts[k].count, a.emitters[e].bursts[k].count * 3);
+    }
+  }
+  // Three times the stars, within the randomness of their lifetimes.
+  auto alive = [](const Effect& e, int steps) {
+    Context ctx(e.contextOptions());
+    e.build(ctx);
+    ctx.run(steps);
+    std::size_t n = 0;
+    for (const Group* g : ctx.groups()) n += g->size();
+    return double(n);
+  };
+  EXPECT_NEAR(alive(fx, 60) / alive(*galaxy->effect, 60), 3.0, 0.15);
+
+  // The showers' own bursts scale at every level of the chain; the original is untouched.
+  Effect fw = *fireworks->effect;
+  fw.scaleSpawning(0.5);
+  const EmitterSpec* before = &fireworks->effect->groups[0].primeEmitters[0].child;
+  const EmitterSpec* after = &fw.groups[0].primeEmitters[0].child;
+  int levels = 0;
+  for (; before && after; before = before->next.get(), after = after->next.get(), ++levels) {
+    EXPECT_DOUBLE_EQ(after->emitter.rate, before->emitter.rate * 0.5);
+    EXPECT_FLOAT_EQ(after->emitter.spacing, before->emitter.spacing * 2.0f);
+    if (before->deathBurst > 0)
+      EXPECT_EQ(after->deathBurst,
+                std::max(1u, std::uint32_t(std::round(before->deathBurst * 0.5))));
+  }
+  EXPECT_GE(levels, 2);
+  EXPECT_NE(fireworks->effect->groups[0].primeEmitters[0].child.next.get(),
+            fw.groups[0].primeEmitters[0].child.next.get());
+
+  for (double bad : {0.0, -1.0, std::nan(""), double(INFINITY)})
+    EXPECT_THROW(fx.scaleSpawning(bad), InvalidArgument) << bad;
+}

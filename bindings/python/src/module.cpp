@@ -476,6 +476,9 @@ NB_MODULE(_flurry, m) {
                      for (const auto& w : e.warnings) out.push_back(w.message());
                      return out;
                    })
+      .def("scale_spawning", &flurry::Effect::scaleSpawning, "factor"_a,
+           "Scales every emitter's rate, bursts and births by distance, the showers of prime "
+           "emitters, and the capacities, by `factor` (> 0): a quality knob.")
       .def(
           "build",
           [](const flurry::Effect& e, nb::handle context, std::size_t maxCapacity) {

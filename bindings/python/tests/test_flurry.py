@@ -336,3 +336,17 @@ def test_the_benchmark_knobs_are_not_public():
         with pytest.raises(TypeError):
             flurry.Context(threads=1, **{knob: 0})
     assert flurry.Context(threads=1, cull=False).threads == 1
+
+
+def test_scale_spawning_is_a_quality_knob():
+    fx = flurry.load("fountain")
+    counts = []
+    for factor in (1.0, 2.0):
+        scaled = flurry.load("fountain")
+        scaled.scale_spawning(factor)
+        ctx = flurry.simulate(scaled)
+        ctx.step(30)  # one second: 2000 births at the file's rate
+        counts.append(ctx.group("fountain").stats.emitted)
+    assert counts[1] == 2 * counts[0]
+    with pytest.raises(flurry.InvalidArgument, match="factor"):
+        fx.scale_spawning(0.0)

@@ -93,6 +93,13 @@ struct Effect {
   /// build() as an instance a game places, moves and prewarms: see EffectInstance.
   EffectInstance instantiate(Context& ctx, std::string_view instance,
                              std::size_t maxCapacity = 0) const;
+  /// Scales how many particles the effect makes, as a quality setting does (Niagara's spawn
+  /// count scale): every emitter's rate, burst counts and births by distance, the emitters
+  /// a prime emitter spawns (theirs, and their death bursts, at every level), and every
+  /// group's capacity, by `factor` (finite, > 0). Counts are rounded; a burst keeps at
+  /// least one particle. How many emitters a prime emitter spawns is left as it is.
+  /// InvalidArgument("factor") otherwise.
+  void scaleSpawning(double factor);
 };
 
 /// One effect built into a Context (Effect::instantiate): its groups, placed together. A

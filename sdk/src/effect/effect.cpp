@@ -1001,6 +1001,39 @@ Effect readEffect(const json& j, const Loader& L, const std::string& defaultName
 
 }  // namespace
 
+namespace {
+std::uint32_t scaledCount(std::uint32_t n, double f) {
+  if (n == 0) return 0;
+  return std::uint32_t(std::clamp(std::round(double(n) * f), 1.0, 4294967295.0));
+}
+void scaleEmitter(Emitter& e, double f) {
+  e.rate *= f;
+  if (e.spacing > 0.0f) e.spacing = float(double(e.spacing) / f);
+  for (Burst& b : e.bursts) b.count = scaledCount(b.count, f);
+}
+void scaleSpec(EmitterSpec& spec, double f, int depth) {
+  if (depth > 1000) throw InvalidArgument("child.next", "more than 1000 levels: a cycle");
+  scaleEmitter(spec.emitter, f);
+  spec.deathBurst = scaledCount(spec.deathBurst, f);
+  if (spec.next) {
+    auto next = std::make_shared<EmitterSpec>(*spec.next);  // shared with other copies
+    scaleSpec(*next, f, depth + 1);
+    spec.next = std::move(next);
+  }
+}
+}  // namespace
+
+void Effect::scaleSpawning(double factor) {
+  if (!(factor > 0.0) || !std::isfinite(factor))
+    throw InvalidArgument("factor", "must be finite and > 0");
+  for (EffectGroup& g : groups) {
+    g.capacity = std::size_t(
+        std::clamp(std::round(double(g.capacity) * factor), 1.0, double(std::uint32_t(~0u))));
+    for (Emitter& e : g.emitters) scaleEmitter(e, factor);
+    for (PrimeEmitter& p : g.primeEmitters) scaleSpec(p.child, factor, 0);
+  }
+}
+
 ContextOptions Effect::contextOptions() const {
   ContextOptions o;
   o.seed = seed;
