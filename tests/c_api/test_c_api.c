@@ -260,6 +260,20 @@ static void test_effects(const char* fountain) {
   FAILS(flurry_effect_render_json(NULL, &text), FLURRY_ERROR_NULL_ARGUMENT, "effect");
   FAILS(flurry_effect_build(NULL, ctx, 0), FLURRY_ERROR_NULL_ARGUMENT, "effect");
   FAILS(flurry_effect_build(fx, NULL, 0), FLURRY_ERROR_NULL_ARGUMENT, "ctx");
+  /* Twice the particles and the room: its burst of 4 gives 8. */
+  {
+    flurry_context* twice = NULL;
+    OK(flurry_effect_scale_spawning(fx, 2.0));
+    OK(flurry_context_create(&o, &twice));
+    OK(flurry_effect_build(fx, twice, 0));
+    OK(flurry_context_step(twice));
+    OK(flurry_context_group(twice, "g", &g));
+    OK(flurry_group_size(g, &size));
+    CHECK(size == 8);
+    OK(flurry_context_destroy(twice));
+    FAILS(flurry_effect_scale_spawning(fx, 0.0), FLURRY_ERROR_INVALID_ARGUMENT, "factor");
+    FAILS(flurry_effect_scale_spawning(NULL, 2.0), FLURRY_ERROR_NULL_ARGUMENT, "effect");
+  }
   OK(flurry_context_destroy(ctx));
   OK(flurry_effect_destroy(fx));
 

@@ -174,6 +174,10 @@ FLURRY_C_EXPORT flurry_status flurry_effect_warning(const flurry_effect* effect,
 /** The `render` object as JSON text ("{}" when absent). */
 FLURRY_C_EXPORT flurry_status flurry_effect_render_json(const flurry_effect* effect,
                                                         const char** json);
+/** Scales how many particles the effect makes, a quality knob (Effect::scaleSpawning): every
+ * emitter's rate, bursts and births by distance, the showers of prime emitters, and the
+ * groups' capacities, by `factor` (finite, > 0: else FLURRY_ERROR_INVALID_ARGUMENT). */
+FLURRY_C_EXPORT flurry_status flurry_effect_scale_spawning(flurry_effect* effect, double factor);
 /** Creates the effect's groups in `ctx`; max_capacity > 0 caps each group's capacity. */
 FLURRY_C_EXPORT flurry_status flurry_effect_build(const flurry_effect* effect, flurry_context* ctx,
                                                   size_t max_capacity);

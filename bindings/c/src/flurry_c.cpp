@@ -553,6 +553,12 @@ flurry_status flurry_effect_frames(const flurry_effect* effect, int* frames) {
     *frames = effect->fx.frames;
   });
 }
+flurry_status flurry_effect_scale_spawning(flurry_effect* effect, double factor) {
+  return guard([&] {
+    need(effect, "effect");
+    effect->fx.scaleSpawning(factor);
+  });
+}
 flurry_status flurry_effect_context_options(const flurry_effect* effect,
                                             flurry_context_options* options) {
   return guard([&] {
