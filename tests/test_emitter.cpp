@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "emission_plan.hpp"
 #include "flurry/flurry.hpp"
 #include "pass_options.hpp"
 
@@ -97,6 +98,51 @@ TEST(Emitter, PathKeyframesAreInterpolated) {
   EXPECT_EQ(e.positionAt(0.5), Vec3(5, 0, 0));
   EXPECT_EQ(e.positionAt(2.0), Vec3(10, 10, 0));
   EXPECT_EQ(e.positionAt(9.0), Vec3(10, 20, 0));
+}
+
+// Births look their emitter's place up on its path starting from the key the last birth
+// found (a step's births are close in time): whatever key it starts from, the place is the
+// one a search from scratch finds, bit for bit, for times that go forward in small and large
+// jumps, go back, loop, and fall before and after the path.
+TEST(Emitter, PathLookupFromAnyKeyIsTheSearchFromScratch) {
+  Emitter e;
+  Random rng(3, 0, 0, 0);
+  double t = 0.0;
+  for (int k = 0; k < 500; ++k) {
+    t += 0.001 + rng.uniform();
+    e.path.push_back({t, Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * 100.0f});
+  }
+  const double end = e.path.back().time;
+  for (bool loop : {false, true}) {
+    e.pathLoop = loop;
+    std::size_t key = 0;
+    // Linear search: the key later than t, as the definition says.
+    const auto expected = [&](double x) {
+      if (loop && x > end)
+        x = e.path.front().time + std::fmod(x - e.path.front().time, end - e.path.front().time);
+      if (x <= e.path.front().time) return e.path.front().position;
+      if (x >= end) return e.path.back().position;
+      std::size_t b = 1;
+      while (!(x < e.path[b].time)) ++b;
+      const Keyframe& a = e.path[b - 1];
+      const double w = (x - a.time) / (e.path[b].time - a.time);
+      return a.position + (e.path[b].position - a.position) * float(w);
+    };
+    std::vector<double> times;
+    for (double x = -1.0; x < end + 3.0; x += 0.037) times.push_back(x);       // small steps
+    for (double x = 0.0; x < 2.5 * end; x += 7.9) times.push_back(x);          // long jumps
+    for (double x = end + 1.0; x > -2.0; x -= 3.3) times.push_back(x);         // backwards
+    for (int k = 0; k < 300; ++k) times.push_back(3.0 * end * rng.uniform());  // anywhere
+    for (const double x : times) {
+      const Vec3 walked = detail::pathPositionAt(e, x, key);
+      ASSERT_EQ(walked, expected(x)) << "t " << x << " loop " << loop;
+      ASSERT_EQ(walked, e.positionAt(x)) << "t " << x << " loop " << loop;
+      if (x > e.path.front().time && x < end) {
+        ASSERT_GE(key, 1u);
+        ASSERT_LT(key, e.path.size());
+      }
+    }
+  }
 }
 
 // A looping path starts again from its first key after its last: births at rate 10 along

@@ -33,6 +33,17 @@ struct BirthRun {
 /// bursts' `repeat`, rates and spacings.
 std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, std::vector<BirthRun>& runs);
 
+/// Where an emitter (or a prime emitter) is at time t: Emitter::positionAt's definition, with
+/// the search for the path's keys starting from `key`, the one found by the last call (0:
+/// none), and updated. A step's births come in increasing time, close together, so along a
+/// path of many keys each costs a step of a walk instead of a binary search. Bitwise the same
+/// position whatever `key` is.
+Vec3 pathPositionAt(Vec3 position, Vec3 velocity, double start, const std::vector<Keyframe>& path,
+                    bool loop, double t, std::size_t& key);
+inline Vec3 pathPositionAt(const Emitter& e, double t, std::size_t& key) {
+  return pathPositionAt(e.position, e.velocity, e.start, e.path, e.pathLoop, t, key);
+}
+
 /// Drops the live emitters that died by t1 (after their last births are written).
 void retireDead(GroupImpl& g, double t1);
 

@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "emission_plan.hpp"
 #include "flurry/emitter.hpp"
 #include "flurry/error.hpp"
 
@@ -12,21 +13,42 @@ bool finite(Vec3 v) {
 }
 }  // namespace
 
-Vec3 Emitter::positionAt(double t) const {
+namespace detail {
+Vec3 pathPositionAt(Vec3 position, Vec3 velocity, double start, const std::vector<Keyframe>& path,
+                    bool loop, double t, std::size_t& key) {
   if (path.empty()) return position + velocity * float(t - start);
-  if (pathLoop && t > path.back().time) {
+  if (loop && t > path.back().time) {
     // fmod is exact, so the device (kernels/emit.cl fl_emitter_at) wraps to the same time.
     const double t0 = path.front().time;
     t = t0 + std::fmod(t - t0, path.back().time - t0);
   }
   if (t <= path.front().time) return path.front().position;
   if (t >= path.back().time) return path.back().position;
-  const auto it = std::upper_bound(path.begin(), path.end(), t,
-                                   [](double x, const Keyframe& k) { return x < k.time; });
-  const Keyframe& b = *it;
-  const Keyframe& a = *(it - 1);
-  const double w = (t - a.time) / (b.time - a.time);
-  return a.position + (b.position - a.position) * float(w);
+  // The first key later than t (1 <= key < size, as t is inside the path): a short walk on
+  // from the last one found when t is not before it, else a binary search. Times increase,
+  // so both find the same key.
+  const auto later = [](double x, const Keyframe& k) { return x < k.time; };
+  std::size_t b = key;
+  if (b == 0 || b >= path.size() || t < path[b - 1].time) {
+    b = std::size_t(std::upper_bound(path.begin(), path.end(), t, later) - path.begin());
+  } else {
+    for (int walked = 0; !(t < path[b].time); ++b)
+      if (++walked > 8) {
+        b = std::size_t(std::upper_bound(path.begin() + std::ptrdiff_t(b), path.end(), t, later) -
+                        path.begin());
+        break;
+      }
+  }
+  key = b;
+  const Keyframe& a = path[b - 1];
+  const double w = (t - a.time) / (path[b].time - a.time);
+  return a.position + (path[b].position - a.position) * float(w);
+}
+}  // namespace detail
+
+Vec3 Emitter::positionAt(double t) const {
+  std::size_t key = 0;  // no hint: a binary search
+  return detail::pathPositionAt(position, velocity, start, path, pathLoop, t, key);
 }
 
 void Emitter::validate(const std::string& where) const {
@@ -88,13 +110,8 @@ void EmitterSpec::validate(const std::string& where) const {
 }
 
 Vec3 PrimeEmitter::positionAt(double t) const {
-  Emitter e;
-  e.position = position;
-  e.velocity = velocity;
-  e.path = path;
-  e.pathLoop = pathLoop;
-  e.start = start;
-  return e.positionAt(t);
+  std::size_t key = 0;
+  return detail::pathPositionAt(position, velocity, start, path, pathLoop, t, key);
 }
 
 void PrimeEmitter::validate(const std::string& where) const {

@@ -170,11 +170,12 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
   float* const px = attr[3];
   float* const py = attr[4];
   float* const pz = attr[5];
+  std::size_t key = 0;  // the path's key the last birth found
   for (std::size_t k = 0; k < m; ++k) {
     const double tb = birthTime(run, em, q0 + k);
     nc.remaining[i0 + k] = nc.left(tb);
-    const Vec3 e =
-        em.path.empty() ? em.position + em.velocity * float(tb - em.start) : em.positionAt(tb);
+    const Vec3 e = em.path.empty() ? em.position + em.velocity * float(tb - em.start)
+                                   : pathPositionAt(em, tb, key);
     px[k] += e.x;
     py[k] += e.y;
     pz[k] += e.z;
@@ -216,6 +217,7 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
 void emitOneByOne(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
                   std::uint64_t q0, std::size_t i0, std::size_t m) {
   const Lanes& L = nc.L;
+  std::size_t key = 0;  // the path's key the last birth found
   for (std::size_t k = 0; k < m; ++k) {
     const std::uint32_t id = nc.firstId + std::uint32_t(i0 + k);
     Random rng(nc.sp.seed, id, nc.g.index, stream::kEmission);
@@ -227,7 +229,7 @@ void emitOneByOne(const NewbornContext& nc, const BirthRun& run, const Emitter& 
     const Vec3 local = em.shape.sample(rng);
     if (!(em.normalSpeed.constant() && em.normalSpeed.center == 0.0f))
       b.vel += em.shape.normal(local) * em.normalSpeed.sample(rng);
-    b.pos = local + em.positionAt(tb);
+    b.pos = local + pathPositionAt(em, tb, key);
     if (L.lifetime) b.lifetime = type.lifetime.sample(rng);
     if (L.color[0]) {
       const Vec3 rgb = type.color.sample(rng);
