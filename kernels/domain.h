@@ -6,8 +6,8 @@
  * domain.cpp). Meshes and unions keep their loops on each side (the data differs); the
  * per-triangle math they run is here.
  *
- * With FP_CONTRACT off and correctly rounded division and sqrt both backends agree to the bit,
- * except in Box-Muller's log and cos (normal fuzzy values, blobs). glm's order is kept where
+ * With FP_CONTRACT off and correctly rounded division and sqrt both backends agree to the bit
+ * (Box-Muller's log and cos included: fl_logf and fl_sincos_2pi, not libm's). glm's order is kept where
  * the CPU used it: dot is (x x' + y y') + z z', normalize v * (1 / sqrt(dot(v, v))). The
  * samplers and containment tests are branch-free where the CPU's loops call them per
  * particle, so those loops still vectorise. */
@@ -88,6 +88,25 @@ FL_INLINE void fl_sincos_2pi(float u, float* s, float* c) {
   *c = as_float(((cb & ~swap) | (sb & swap)) ^ cSign);
 }
 
+/* ln(x) for a positive normal float x, with no libm or device builtin (Box-Muller's log, so
+ * that a normal draw has the same bits everywhere): FreeBSD's e_logf.c (as musl's logf),
+ * within 1 ulp (tests/test_random.cpp checks every input a uniform draw gives).
+ * x = m·2^k with m in [sqrt(2)/2, sqrt(2)); ln(m) = 2·atanh(s), s = (m - 1)/(m + 1), by a
+ * polynomial in s²; ln 2 in two parts so that k·ln 2 adds no rounding. */
+FL_INLINE float fl_logf(float x) {
+  uint ix = as_uint(x) + (0x3f800000u - 0x3f3504f3u);
+  const int k = (int)(ix >> 23) - 0x7f;
+  ix = (ix & 0x007fffffu) + 0x3f3504f3u;
+  const float f = as_float(ix) - 1.0f;
+  const float s = f / (2.0f + f);
+  const float z = s * s, w = z * z;
+  const float t1 = w * (0x1.999c26p-2f + w * 0x1.f13c4cp-3f);
+  const float t2 = z * (0x1.555554p-1f + w * 0x1.23d3dcp-2f);
+  const float hfsq = 0.5f * f * f;
+  const float dk = (float)k;
+  return s * (hfsq + (t2 + t1)) + dk * 0x1.2fefa2p-17f - hfsq + f + dk * 0x1.62e3p-1f;
+}
+
 /* Cube root of x >= 0 to about 1 ulp: an exponent-bits guess refined by Newton's method. */
 FL_INLINE float fl_cbrt_nonneg(float x) {
   const uint i = as_uint(x);
@@ -96,10 +115,12 @@ FL_INLINE float fl_cbrt_nonneg(float x) {
   return x > 0.0f ? y : 0.0f;
 }
 
-/* Box-Muller, as Random::normal(): the one place with libm calls (log, cos), where the
- * device's builtins may differ from glibc by an ulp or two. */
+/* A standard normal from two uniforms in [0, 1) by Box-Muller (Random::normal() calls it):
+ * its log and cos are the ones above, so both backends give the same bits. */
 FL_INLINE float fl_normal_from(float ua, float ub) {
-  return sqrt(-2.0f * log(1.0f - ua)) * cos(6.28318530718f * ub);
+  float s, c;
+  fl_sincos_2pi(ub, &s, &c);
+  return sqrt(-2.0f * fl_logf(1.0f - ua)) * c;
 }
 
 /* Uniforms a domain of kind FL_DOMAIN_* draws per sample; a union's depend on its parts

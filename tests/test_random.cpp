@@ -1,8 +1,14 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 #include "flurry/random.hpp"
+#include "sampling.hpp"
+#include "shape_math.hpp"  // kernels/math.h and domain.h on the CPU
 
 using flurry::Philox4x32;
 
@@ -60,4 +66,84 @@ TEST(Random, UniformAndNormalMoments) {
   EXPECT_NEAR(s2 / n - (s / n) * (s / n), 1.0 / 12, 0.002);
   EXPECT_NEAR(m / n, 0.0, 5 / std::sqrt(double(n)));
   EXPECT_NEAR(m2 / n, 1.0, 0.02);
+}
+
+// Box-Muller's log and cos (kernels/domain.h) are float arithmetic alone, so that a normal
+// draw has the same bits on every instruction set, libm and device: checked here against
+// double precision on every value a uniform draw can give (multiples of 2^-24 in [0, 1)).
+namespace {
+// The error of `got` against `exact` in units of the float spacing at `exact`.
+double ulps(float got, double exact) {
+  const float e = float(exact);
+  const double spacing = double(std::nextafter(std::fabs(e), INFINITY)) - double(std::fabs(e));
+  return std::fabs(double(got) - exact) / spacing;
+}
+}  // namespace
+
+TEST(Random, BoxMullersLogIsWithinAnUlpOnEveryUniform) {
+  namespace k = flurry::detail::kernel;
+  double worst = 0.0;
+  for (std::uint32_t b = 0; b < (1u << 24); ++b) {
+    const float x = 1.0f - flurry::uniformFloat(b << 8);  // what fl_normal_from takes the log of
+    worst = std::max(worst, ulps(k::fl_logf(x), std::log(double(x))));
+  }
+  EXPECT_LT(worst, 1.0);
+  // Any positive normal float, not only those (the function says so).
+  flurry::Random r(5, 0, 0, 0);
+  for (int i = 0; i < 1000000; ++i) {
+    const float x = std::bit_cast<float>(0x00800000u + r.bits() % (0x7f800000u - 0x00800000u));
+    ASSERT_LT(ulps(k::fl_logf(x), std::log(double(x))), 1.0) << x;
+  }
+  EXPECT_EQ(k::fl_logf(1.0f), 0.0f);  // a draw of 0 gives a radius of exactly 0
+}
+
+TEST(Random, BoxMullersCosIsWithin3e7OnEveryUniform) {
+  namespace k = flurry::detail::kernel;
+  double worst = 0.0;
+  for (std::uint32_t b = 0; b < (1u << 24); ++b) {
+    const float u = flurry::uniformFloat(b << 8);
+    float s, c;
+    k::fl_sincos_2pi(u, &s, &c);
+    const double turn = 2.0 * 3.14159265358979323846 * double(u);
+    ASSERT_LE(std::fabs(c), 1.0f) << u;
+    worst = std::max(
+        {worst, std::fabs(double(c) - std::cos(turn)), std::fabs(double(s) - std::sin(turn))});
+  }
+  EXPECT_LT(worst, 3e-7);  // as kernels/domain.h says
+}
+
+TEST(Random, NormalIsTheKernelsBoxMuller) {
+  flurry::Random a(9, 1, 2, 3), b(9, 1, 2, 3);
+  for (int i = 0; i < 1000; ++i) {
+    const float ua = b.uniform(), ub = b.uniform();
+    ASSERT_EQ(std::bit_cast<std::uint32_t>(a.normal()),
+              std::bit_cast<std::uint32_t>(flurry::detail::kernel::fl_normal_from(ua, ub)));
+  }
+}
+
+// The emitters' batches (vectorised) give each blob point and each normal fuzzy value the
+// bits of the scalar function, whatever the batch's length.
+TEST(Random, NormalBatchesAreTheScalarBoxMullerBitForBit) {
+  namespace k = flurry::detail::kernel;
+  constexpr std::size_t n = 1003;
+  std::vector<float> u[6];
+  flurry::Random r(11, 0, 0, 0);
+  for (auto& row : u)
+    for (std::size_t i = 0; i < n; ++i) row.push_back(r.uniform());
+  const float* rows[6] = {u[0].data(), u[1].data(), u[2].data(),
+                          u[3].data(), u[4].data(), u[5].data()};
+  const flurry::Vec3 c(1.0f, -2.0f, 3.0f);
+  std::vector<float> x(n), y(n), z(n), g(n);
+  flurry::detail::sampleBatch(flurry::Domain::blob(c, 0.5f), rows, n, x.data(), y.data(), z.data());
+  const flurry::Fuzzy f(2.0f, 0.25f, flurry::Fuzzy::Distribution::Normal);
+  flurry::detail::sampleBatch(f, rows, n, g.data());
+  for (std::size_t i = 0; i < n; ++i) {
+    const flurry::Vec3 p =
+        k::fl_blob_at(c, 0.5f, u[0][i], u[1][i], u[2][i], u[3][i], u[4][i], u[5][i]);
+    ASSERT_EQ(std::bit_cast<std::uint32_t>(x[i]), std::bit_cast<std::uint32_t>(p.x)) << i;
+    ASSERT_EQ(std::bit_cast<std::uint32_t>(y[i]), std::bit_cast<std::uint32_t>(p.y)) << i;
+    ASSERT_EQ(std::bit_cast<std::uint32_t>(z[i]), std::bit_cast<std::uint32_t>(p.z)) << i;
+    const float e = 2.0f + 0.25f * k::fl_normal_from(u[0][i], u[1][i]);
+    ASSERT_EQ(std::bit_cast<std::uint32_t>(g[i]), std::bit_cast<std::uint32_t>(e)) << i;
+  }
 }

@@ -412,6 +412,10 @@ bool inside(const UnionDomain& d, Vec3 p) {
 
 }  // namespace detail
 
+float detail::standardNormal(float ua, float ub) noexcept {
+  return kern::fl_normal_from(ua, ub);
+}
+
 Vec3 Domain::sample(Random& rng) const {
   // A batch of one through the emitters' batch samplers: the same formulas either way.
   float u[detail::kMaxDomainDraws];

@@ -82,6 +82,17 @@ FL_LOOP void cone(C u0, C u1, C u2, F x, F y, F z, std::size_t n, Vec3 apex, Vec
   }
 }
 
+// Box-Muller in float arithmetic alone (kernels/math.h): no libm call, so this vectorises.
+FL_LOOP void blob(C u0, C u1, C u2, C u3, C u4, C u5, F x, F y, F z, std::size_t n, Vec3 c,
+                  float sd) {
+  for (std::size_t i = 0; i < n; ++i)
+    store(x, y, z, i, k::fl_blob_at(c, sd, u0[i], u1[i], u2[i], u3[i], u4[i], u5[i]));
+}
+
+FL_LOOP void normal(C u0, C u1, F out, std::size_t n, float center, float spread) {
+  for (std::size_t i = 0; i < n; ++i) out[i] = center + spread * k::fl_normal_from(u0[i], u1[i]);
+}
+
 #undef FL_LOOP
 
 }  // namespace
@@ -173,10 +184,7 @@ void sampleBatch(const Domain& d, const float* const* u, std::size_t n, float* x
             sampleBatch(un.parts[k], rest, 1, x + i, y + i, z + i);
           }
         } else if constexpr (std::is_same_v<S, BlobDomain>) {
-          for (std::size_t i = 0; i < n; ++i)
-            store(x, y, z, i,
-                  k::fl_blob_at(s.center, s.stddev, u[0][i], u[1][i], u[2][i], u[3][i], u[4][i],
-                                u[5][i]));
+          blob(u[0], u[1], u[2], u[3], u[4], u[5], x, y, z, n, s.center, s.stddev);
         }
       },
       d.shape());
@@ -186,8 +194,7 @@ void sampleBatch(const Fuzzy& f, const float* const* u, std::size_t n, float* ou
   if (f.spread == 0.0f) {
     std::fill_n(out, n, f.center);
   } else if (f.distribution == Fuzzy::Distribution::Normal) {
-    for (std::size_t i = 0; i < n; ++i)
-      out[i] = f.center + f.spread * kernel::fl_normal_from(u[0][i], u[1][i]);
+    normal(u[0], u[1], out, n, f.center, f.spread);
   } else {
     const float* __restrict a = u[0];
     for (std::size_t i = 0; i < n; ++i) out[i] = f.center + f.spread * (2.0f * a[i] - 1.0f);

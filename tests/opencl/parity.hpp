@@ -3,9 +3,10 @@
 //
 // Tolerance. The device runs the CPU's float operations in the CPU's order, with
 // contraction off and correctly rounded division and sqrt, and the emitters' sampling is
-// libm-free on both sides, so nearly everything agrees to the bit. Two things may not:
-//  - Box-Muller (normal fuzzy values, blob domains) calls log and cos, whose OpenCL
-//    builtins may differ from glibc's by an ulp or two;
+// libm-free on both sides (Box-Muller's log and cos too), so nearly everything agrees to
+// the bit. Two things may not:
+//  - forces and damping that call exp, pow, sin or cos, whose OpenCL builtins may differ
+//    from glibc's by an ulp or two;
 //  - an ulp of difference, carried through 200 steps of gravity and bounces, grows.
 // So attributes are compared with |cpu - cl| <= kAbs + kRel * |cpu|, kAbs = kRel = 1e-4
 // (positions are O(1..10) here: a few hundred float ulps), and the test reports the largest

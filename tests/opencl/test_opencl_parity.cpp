@@ -2,6 +2,8 @@
 // and the OpenCL backend from the same seed; the same particles (matched by id: a device
 // compacts in another order), the same counts, the same attributes.
 //
+#include <bit>
+
 #include "builtin.hpp"
 #include "parity.hpp"
 
@@ -132,6 +134,42 @@ TEST(OpenCLParity, EmissionFromEveryDomain) {
           return g;
         },
         60);
+  }
+}
+
+// Box-Muller is float arithmetic alone on both backends (kernels/domain.h fl_logf,
+// fl_sincos_2pi), so normal draws have the same bits: a blob's velocities and normal fuzzy
+// sizes and lifetimes of newborns that nothing moves, compared bit for bit by id.
+TEST(OpenCLParity, NormalDrawsAreBitwiseTheSame) {
+  const Build build = [](Context& ctx) -> Group& {
+    Group& g = ctx.createGroup("normal", 5000);
+    Emitter e;
+    e.shape = Domain::point(Vec3(0.0f));
+    e.rate = 3000;
+    ParticleType t;
+    t.velocity = Domain::blob(Vec3(0.5f, 2.0f, -1.0f), 0.7f);
+    t.size = Fuzzy(0.05f, 0.02f, Fuzzy::Distribution::Normal);
+    t.lifetime = Fuzzy(10.0f, 0.3f, Fuzzy::Distribution::Normal);
+    e.types = {t};
+    g.addEmitter(e);
+    g.setActions({KillOld{}});
+    g.require({Attribute::Size});
+    return g;
+  };
+  FLURRY_REQUIRE_OPENCL();
+  const RunResult cpu = runEffect(Backend::Cpu, build, 5);
+  const RunResult cl = runEffect(Backend::OpenCL, build, 5);
+  ASSERT_GT(cpu.size, 400u);
+  ASSERT_EQ(cpu.size, cl.size);
+  const auto bits = [](float f) { return std::bit_cast<std::uint32_t>(f); };
+  for (const auto& [id, p] : cpu.byId) {
+    const auto it = cl.byId.find(id);
+    ASSERT_NE(it, cl.byId.end()) << id;
+    const Particle& q = it->second;
+    for (int c = 0; c < 3; ++c)
+      ASSERT_EQ(bits(p.velocity[c]), bits(q.velocity[c])) << "velocity of " << id;
+    ASSERT_EQ(bits(p.size), bits(q.size)) << "size of " << id;
+    ASSERT_EQ(bits(p.lifetime), bits(q.lifetime)) << "lifetime of " << id;
   }
 }
 

@@ -43,6 +43,12 @@ inline float uniformFloat(std::uint32_t bits) noexcept {
   return float(bits >> 8) * (1.0f / 16777216.0f);
 }
 
+namespace detail {
+/// A standard normal from two uniforms in [0, 1) (kernels/domain.h fl_normal_from, the
+/// emitters' batches and the device run the same function).
+float standardNormal(float ua, float ub) noexcept;
+}  // namespace detail
+
 /// A stream of random numbers for one particle (or one emitter event), drawn four at a time.
 /// Streams with different (id, step, stream) never overlap.
 class Random {
@@ -65,11 +71,11 @@ class Random {
   float uniform() noexcept { return uniformFloat(bits()); }
   /// Uniform in [lo, hi).
   float uniform(float lo, float hi) noexcept { return lo + (hi - lo) * uniform(); }
-  /// Standard normal (Box-Muller; the log's argument is kept in (0, 1]).
+  /// Standard normal, by Box-Muller from two uniforms, in float arithmetic alone (no libm):
+  /// the same bits on every CPU and on the device.
   float normal() noexcept {
-    const float u1 = 1.0f - uniform();
-    const float u2 = uniform();
-    return std::sqrt(-2.0f * std::log(u1)) * std::cos(6.28318530718f * u2);
+    const float ua = uniform();
+    return detail::standardNormal(ua, uniform());
   }
 
  private:
