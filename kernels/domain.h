@@ -7,10 +7,10 @@
  * per-triangle math they run is here.
  *
  * With FP_CONTRACT off and correctly rounded division and sqrt both backends agree to the bit
- * (Box-Muller's log and cos included: fl_logf and fl_sincos_2pi, not libm's). glm's order is kept where
- * the CPU used it: dot is (x x' + y y') + z z', normalize v * (1 / sqrt(dot(v, v))). The
- * samplers and containment tests are branch-free where the CPU's loops call them per
- * particle, so those loops still vectorise. */
+ * (Box-Muller's log and cos included: fl_logf and fl_sincos_2pi, not libm's). glm's order is
+ * kept where the CPU used it: dot is (x x' + y y') + z z', normalize v * (1 / sqrt(dot(v,
+ * v))). The samplers and containment tests are branch-free where the CPU's loops call them
+ * per particle, so those loops still vectorise. */
 #ifndef FLURRY_KERNELS_DOMAIN_H
 #define FLURRY_KERNELS_DOMAIN_H
 
