@@ -162,6 +162,10 @@ void GroupImpl::move(std::size_t from, std::size_t to) {
 }
 
 void GroupImpl::ensureStorage() {
+  if (actionAttributesVersion != actionsVersion) {
+    actionAttributes = actions.attributes();
+    actionAttributesVersion = actionsVersion;
+  }
   // While particles exist, lanes are kept even when no action reads them any more: they hold
   // state (a rest pose, a charge) that a later action list may read again.
   const AttributeSet want = size > 0 ? wanted() | stored : wanted();

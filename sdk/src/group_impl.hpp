@@ -199,7 +199,7 @@ struct GroupImpl {
   /// Per block, the dead each action killed and, last, the non-finite ones: counted while
   /// the block is in cache, by its own thread, and summed after the pass.
   std::vector<std::uint32_t> blockKills;
-  std::vector<std::uint32_t> holes;        ///< sorted dead indices of this step
+  std::vector<std::uint32_t> holes;  ///< sorted dead indices of this step
   /// This step's newborns, written before the act pass: [bornFirst, bornFirst + bornCount),
   /// each with the part of the step it still has to live (seconds, bornRemaining[r]), which
   /// the pass runs it through the action list for.
@@ -239,8 +239,15 @@ struct GroupImpl {
   /// first; no-op without a frame).
   void placeEmitters();
 
-  /// The attributes the group must store now.
-  AttributeSet wanted() const { return required | actions.attributes(); }
+  /// The attributes the group must store now. The action list's share is kept for its
+  /// actionsVersion by ensureStorage: every step asks, and an idle group's step is little
+  /// more than that question.
+  AttributeSet wanted() const {
+    return required |
+           (actionAttributesVersion == actionsVersion ? actionAttributes : actions.attributes());
+  }
+  AttributeSet actionAttributes;
+  std::uint64_t actionAttributesVersion = ~std::uint64_t(0);
   /// Allocates the lanes of wanted() not yet stored (existing particles get defaults) and
   /// frees lanes nobody uses any more.
   void ensureStorage();
