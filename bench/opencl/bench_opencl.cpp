@@ -157,8 +157,8 @@ void SmallStep(benchmark::State& state, Backend backend) {
   timedSteps(state, ctx, g, 200);
 }
 
-// Skip what a scene doesn't need (issue #17), on both backends: 1M particles bouncing on
-// floors of which each reaches one, with 32 floors in the list against 2
+// Skip what a scene doesn't need (issue #17), on both backends: 1M particles bouncing on a
+// floor in 32 pieces, of which each particle reaches one, against the same floor in 2
 // (bench/common/scenes.hpp; the CPU backend culls per block of particles, the OpenCL backend
 // per work-group)...
 void Deflectors(benchmark::State& state, Backend backend) {
@@ -298,7 +298,7 @@ class SummaryReporter : public benchmark::ConsoleReporter {
       const double d32 = ms_["Deflectors/" + B + "/deflectors:32"];
       const double d2 = ms_["Deflectors/" + B + "/deflectors:2"];
       if (d32 > 0 && d2 > 0)
-        std::printf("  %-6s 1M particles, 32 floors in the list / 2: %.2fx the time (aim <= 1.3)\n",
+        std::printf("  %-6s 1M particles, a floor in 32 pieces / in 2: %.2fx the time (aim <= 1.3)\n",
                     b, d32 / d2);
       const double i100 = usPerStep_["IdleGroups/" + B + "/groups:100/alive:10"];
       const double i10 = usPerStep_["IdleGroups/" + B + "/groups:10/alive:10"];
