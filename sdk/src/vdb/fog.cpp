@@ -66,36 +66,75 @@ void splat(const Blob& b, float voxelSize, float minKernel, bool vel, bool color
     hi[a] = int(std::floor(x[a] + h));
   }
   const double invH = 1.0 / h;
-  auto weight = [&](int i, int j, int k) {
-    const double dx = i - x[0], dy = j - x[1], dz = k - x[2];
-    return kernel(std::sqrt(dx * dx + dy * dy + dz * dz) * invH);
+  auto weight = [&](int i, double dyz2) {
+    const double dx = i - x[0];
+    return kernel(std::sqrt(dx * dx + dyz2) * invH);
+  };
+  // The voxels of row (j, k) that may lie inside the kernel's sphere: [i0, i1], a voxel wider
+  // than the sphere's chord on each side (the weight decides; a voxel outside it weighs 0,
+  // and adding 0 changes no sum), empty where the row misses the sphere. Half of the box's
+  // voxels are outside, and each would cost a square root.
+  auto row = [&](int j, int k, int& i0, int& i1, double& dyz2) {
+    const double dy = j - x[1], dz = k - x[2];
+    dyz2 = dy * dy + dz * dz;
+    const double c2 = h * h - dyz2;
+    if (c2 < 0.0) return false;
+    const double c = std::sqrt(c2);
+    i0 = std::max(lo[0], int(std::ceil(x[0] - c)) - 1);
+    i1 = std::min(hi[0], int(std::floor(x[0] + c)) + 1);
+    return i0 <= i1;
   };
   // Normalise over the voxel centres actually covered, so the deposit sums to the mass
   // exactly wherever the particle sits against the grid.
   double sum = 0.0;
   for (int k = lo[2]; k <= hi[2]; ++k)
-    for (int j = lo[1]; j <= hi[1]; ++j)
-      for (int i = lo[0]; i <= hi[0]; ++i) sum += weight(i, j, k);
+    for (int j = lo[1]; j <= hi[1]; ++j) {
+      int i0, i1;
+      double dyz2;
+      if (!row(j, k, i0, i1, dyz2)) continue;
+      for (int i = i0; i <= i1; ++i) sum += weight(i, dyz2);
+    }
   const double perVoxel = b.mass / (double(voxelSize) * voxelSize * voxelSize);
   const openvdb::Vec3s v(b.v.x, b.v.y, b.v.z), c(b.c.x, b.c.y, b.c.z);
-  auto deposit = [&](const openvdb::Coord& ijk, double w) {
-    const float d = float(perVoxel * w);
+  if (!(sum > 0.0)) {  // a kernel narrower than the voxel spacing: all to the nearest voxel
+    const openvdb::Coord ijk(int(std::lround(x[0])), int(std::lround(x[1])),
+                             int(std::lround(x[2])));
+    const float d = float(perVoxel);
     da.setValue(ijk, da.getValue(ijk) + d);
     if (vel) va.setValue(ijk, va.getValue(ijk) + v * d);
     if (color) ca.setValue(ijk, ca.getValue(ijk) + c * d);
-  };
-  if (!(sum > 0.0)) {  // a kernel narrower than the voxel spacing: all to the nearest voxel
-    deposit(openvdb::Coord(int(std::lround(x[0])), int(std::lround(x[1])), int(std::lround(x[2]))),
-            1.0);
     return;
   }
+  // Deposits straight into the leaves (8 voxels along x each), found once per leaf a row
+  // crosses rather than through the accessors per voxel and grid.
+  using DensityLeaf = openvdb::FloatGrid::TreeType::LeafNodeType;
+  using VectorLeaf = openvdb::Vec3SGrid::TreeType::LeafNodeType;
   const double norm = 1.0 / sum;
   for (int k = lo[2]; k <= hi[2]; ++k)
-    for (int j = lo[1]; j <= hi[1]; ++j)
-      for (int i = lo[0]; i <= hi[0]; ++i) {
-        const double w = weight(i, j, k);
-        if (w > 0.0) deposit(openvdb::Coord(i, j, k), w * norm);
+    for (int j = lo[1]; j <= hi[1]; ++j) {
+      int i0, i1;
+      double dyz2;
+      if (!row(j, k, i0, i1, dyz2)) continue;
+      DensityLeaf* dl = nullptr;
+      VectorLeaf *vl = nullptr, *cl = nullptr;
+      int leafX = 0;
+      for (int i = i0; i <= i1; ++i) {
+        const double w = weight(i, dyz2);
+        if (!(w > 0.0)) continue;
+        const openvdb::Coord ijk(i, j, k);
+        if (!dl || (i & ~7) != leafX) {
+          leafX = i & ~7;
+          dl = da.touchLeaf(ijk);
+          if (vel) vl = va.touchLeaf(ijk);
+          if (color) cl = ca.touchLeaf(ijk);
+        }
+        const openvdb::Index n = DensityLeaf::coordToOffset(ijk);
+        const float d = float(perVoxel * (w * norm));
+        dl->setValueOn(n, dl->getValue(n) + d);
+        if (vel) vl->setValueOn(n, vl->getValue(n) + v * d);
+        if (color) cl->setValueOn(n, cl->getValue(n) + c * d);
       }
+    }
 }
 
 /// Strands as beads: each segment cut into pieces no longer than half the thinner kernel
