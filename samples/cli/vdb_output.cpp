@@ -1,4 +1,4 @@
-// `flurry run ... --vdb DIR`: one OpenVDB file per frame (fog volume and points), written on
+// `flurry run ... --vdb DIR`: an OpenVDB file per due frame (fog volume and points), written on
 // a background thread while the simulation goes on, with a progress bar and a cost report.
 // An effect of hair alone is static: a frame is written only when strands were added.
 #include <unistd.h>
@@ -26,8 +26,11 @@ class VdbPlugin final : public Plugin {
                    "vel, Cd and the point grid 'points'; hair also as curves, the point grid "
                    "'strands' whose strand_id and strand_vertex rebuild them (docs/vdb-export.md); "
                    "static hair is written once, not every frame");
-    run.add_option("--vdb-every", every_, "write a VDB file every N frames (and the last)")
+    run.add_option("--vdb-every", every_,
+                   "write a VDB file every N frames, and the last (default: --every's N, as PNG "
+                   "and PLY; 1 for a whole sequence)")
         ->check(CLI::Range(1, 1000000));
+    run_ = &run;
     run.add_flag("--vdb-fog", fogOnly_, "write only the fog volume (density, vel, Cd)");
     run.add_flag("--vdb-points", pointsOnly_, "write only the points (PointDataGrid 'points')");
     run.add_option("--voxel-size", options_.fogVoxelSize,
@@ -46,6 +49,14 @@ class VdbPlugin final : public Plugin {
 
   void begin(Context& ctx, const RunInfo& info) override {
     info_ = info;
+    // Every output follows --every unless told otherwise: a file per frame of a 300-frame
+    // effect is gigabytes and minutes of export, so a whole sequence is asked for by name.
+    if (every_ == 0) {
+      every_ = 10;
+      if (const CLI::Option* o = run_->get_option_no_throw("--every")) {
+        if (o->count() > 0 || !o->as<std::string>().empty()) every_ = o->as<int>();
+      }
+    }
     if (fogOnly_ || pointsOnly_) {
       options_.fog = fogOnly_;
       options_.points = pointsOnly_;
@@ -176,7 +187,8 @@ class VdbPlugin final : public Plugin {
   }
 
   std::string folder_;
-  int every_ = 1;
+  int every_ = 0;  ///< 0: --every's
+  CLI::App* run_ = nullptr;
   bool fogOnly_ = false, pointsOnly_ = false;
   vdb::ExportOptions options_;
   RunInfo info_;
