@@ -6,7 +6,7 @@
 # with Debian's ffmpeg (installed by `scripts/setup.sh --gallery` when missing: only the
 # gallery needs it). No display needed (the renderer starts its own Xvfb). A few minutes on
 # 2 cores. `bash scripts/gallery.sh NAME...` renders only those (docs/gallery.md is
-# rewritten whole).
+# rewritten whole, but for its "Run times" section: `bash scripts/sample-times.sh --gallery`).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if ! command -v ffmpeg >/dev/null; then bash scripts/setup.sh --gallery; fi
@@ -16,6 +16,8 @@ flurry=build/release/bin/flurry
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 mkdir -p docs/gallery
+# The page's last section, "Run times", is scripts/sample-times.sh's table: kept as it is.
+sed -n '/^## Run times$/,$p' docs/gallery.md >"$tmp/times.md" 2>/dev/null || true
 # name:frame — the frame each still is taken at (a moment where the effect reads best).
 shots="fountain:90 fireworks:100 galaxy:120 magnetic:30 pinball2d:150 smoke:200 hair:5
        tornado:200 snow:150 shockwave:40 campfire:150 comet:120 waterfall:150
@@ -101,3 +103,4 @@ for shot in $shots; do
     } >>docs/gallery.md
   fi
 done
+cat "$tmp/times.md" >>docs/gallery.md
