@@ -318,6 +318,85 @@ FL_INLINE void fl_planar_bounce(FlReflect rf, int hit, float side, float tau, fl
   *vzs = ovz;
 }
 
+/* The same piece when the following Move integrates with an acceleration (ax, ay, az) taken
+ * as constant over the step (Exact with gravity and electric fields; Verlet and RK4 with their
+ * first stage's): the particle runs the parabola p + v·t + ½a·t², so the impact is found on
+ * it, and the velocity it has there, v + a·tau, is the one reflected (with the straight path
+ * that velocity would be off by a·(dt − tau): first order). Where the path meets the plane
+ * (*tau, *h), the side it starts on, and whether it hits: crossing within the step or ending
+ * within a few ulps of the plane, approaching at the impact, not born on it. The caller adds
+ * whether h is on the piece. */
+FL_INLINE int fl_planar_accel_hit(float x, float y, float z, float vx, float vy, float vz, float ax,
+                                  float ay, float az, float dt, float Px, float Py, float Pz,
+                                  float Nx, float Ny, float Nz, float* side, float* tau, float* hx,
+                                  float* hy, float* hz) {
+  const float hdt2 = 0.5f * dt * dt;
+  const float d0 = (x - Px) * Nx + (y - Py) * Ny + (z - Pz) * Nz;
+  const float vn = vx * Nx + vy * Ny + vz * Nz;
+  const float an = ax * Nx + ay * Ny + az * Nz;
+  *side = d0 >= 0.0f ? 1.0f : -1.0f;
+  /* Towards the side it is on: s(t) = s0 + u·t + ½w·t², s0 > 0 (0 when on the plane). */
+  const float s0 = *side * d0, u = *side * vn, w = *side * an;
+  const float s1 = s0 + u * dt + w * hdt2;
+  const float reach =
+      1.2e-7f * (fabs(Nx) * (fabs(x) + fabs(Px) + 2.0f * (fabs(vx * dt) + fabs(ax * hdt2))) +
+                 fabs(Ny) * (fabs(y) + fabs(Py) + 2.0f * (fabs(vy * dt) + fabs(ay * hdt2))) +
+                 fabs(Nz) * (fabs(z) + fabs(Pz) + 2.0f * (fabs(vz * dt) + fabs(az * hdt2)))) +
+      1e-30f;
+  /* The first root of s(t) = 0 in the forms without cancellation: approaching (u < 0)
+   * 2·s0 / (√D − u); receding but pulled back (u ≥ 0, w < 0) (u + √D) / −w. D < 0: the path
+   * turns before it reaches the plane. */
+  const float D = u * u - 2.0f * w * s0;
+  const float sq = sqrt(fl_maxf(D, 0.0f));
+  const float root = u < 0.0f ? 2.0f * s0 / (sq - u) : (u + sq) / -w;
+  const int crossing = (D >= 0.0f) & (root >= 0.0f) & (root <= dt);
+  /* Or ending within a few ulps of the plane: an arrival at the end of the step. */
+  *tau = crossing ? root : dt;
+  *hx = x + (vx + 0.5f * ax * *tau) * *tau;
+  *hy = y + (vy + 0.5f * ay * *tau) * *tau;
+  *hz = z + (vz + 0.5f * az * *tau) * *tau;
+  return (crossing | (s1 <= reach)) & (u + w * *tau < 0.0f) & (d0 != 0.0f);
+}
+
+/* The bounce of a particle that fl_planar_accel_hit found hitting the piece at h after tau:
+ * the velocity at the impact reflected, then the start of a parabola through h at tau with
+ * that velocity (v_start = v' − a·tau, p_start = h − v'·tau + ½a·tau²), so that the
+ * integrator's p + v·dt + ½a·dt² runs the reflected parabola after the impact; pushed out if
+ * rounding would leave that end on or behind the plane (the reflected parabola may also come
+ * back through the plane within the step, a slow bounce: then it ends just in front). */
+FL_INLINE void fl_planar_accel_bounce(FlReflect rf, float side, float tau, float hx, float hy,
+                                      float hz, float dt, float ax, float ay, float az, float Px,
+                                      float Py, float Pz, float Nx, float Ny, float Nz, float* px,
+                                      float* py, float* pz, float* vxs, float* vys, float* vzs) {
+  const float hdt2 = 0.5f * dt * dt;
+  float nx = *px, ny = *py, nz = *pz;
+  float nvx = *vxs + ax * tau, nvy = *vys + ay * tau, nvz = *vzs + az * tau;
+  fl_reflect(rf, &nx, &ny, &nz, &nvx, &nvy, &nvz, hx, hy, hz, Nx, Ny, Nz, tau);
+  const float htau2 = 0.5f * tau * tau;
+  nx += ax * htau2;
+  ny += ay * htau2;
+  nz += az * htau2;
+  nvx -= ax * tau;
+  nvy -= ay * tau;
+  nvz -= az * tau;
+  const float sx = nvx * dt + 0.5f * ax * dt * dt, sy = nvy * dt + 0.5f * ay * dt * dt,
+              sz = nvz * dt + 0.5f * az * dt * dt;
+  const float qx = nx + sx, qy = ny + sy, qz = nz + sz;
+  const float qd = side * ((qx - Px) * Nx + (qy - Py) * Ny + (qz - Pz) * Nz);
+  const float margin =
+      1.2e-7f * (fabs(Nx) * (fabs(qx) + fabs(Px) + fabs(nvx * dt) + fabs(ax * hdt2)) +
+                 fabs(Ny) * (fabs(qy) + fabs(Py) + fabs(nvy * dt) + fabs(ay * hdt2)) +
+                 fabs(Nz) * (fabs(qz) + fabs(Pz) + fabs(nvz * dt) + fabs(az * hdt2))) +
+      1e-30f;
+  const float push = fl_maxf(margin - qd, 0.0f) * side;
+  *px = nx + push * Nx;
+  *py = ny + push * Ny;
+  *pz = nz + push * Nz;
+  *vxs = nvx;
+  *vys = nvy;
+  *vzs = nvz;
+}
+
 /* A rectangle: (s, t) = (w·du, w·dv) in [0, 1]² (du, dv: the dual vectors of its edges,
  * which also serve a rhombus). */
 FL_INLINE int fl_on_rectangle(float wx, float wy, float wz, float dux, float duy, float duz,

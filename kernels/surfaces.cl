@@ -70,64 +70,19 @@ FL_INLINE void fl_bounce_planar(__global const FlActionParams* a, int piece, flo
 }
 
 /* The same deflector when the following Move integrates with the acceleration (ax, ay, az)
- * taken as constant over the step: the impact on the parabola, the velocity at the impact
- * reflected, and the start state the integrator carries along the reflected parabola
- * (kernels.hpp bouncePlanarAccelLoop, operation by operation). */
+ * taken as constant over the step (kernels/deflect.h, as on the CPU). */
 FL_INLINE void fl_bounce_planar_accel(__global const FlActionParams* a, int piece, float dt,
-                                      float ax, float ay, float az, float* px, float* py,
-                                      float* pz, float* vxs, float* vys, float* vzs) {
+                                      float ax, float ay, float az, float* px, float* py, float* pz,
+                                      float* vxs, float* vys, float* vzs) {
   const float Px = a->f[0], Py = a->f[1], Pz = a->f[2];
   const float Nx = a->f[3], Ny = a->f[4], Nz = a->f[5];
-  const float hdt2 = 0.5f * dt * dt;
-  const float x = *px, y = *py, z = *pz, vx = *vxs, vy = *vys, vz = *vzs;
-  const float d0 = (x - Px) * Nx + (y - Py) * Ny + (z - Pz) * Nz;
-  const float vn = vx * Nx + vy * Ny + vz * Nz;
-  const float an = ax * Nx + ay * Ny + az * Nz;
-  const float side = d0 >= 0.0f ? 1.0f : -1.0f;
-  const float s0 = side * d0, u = side * vn, w = side * an;
-  const float s1 = s0 + u * dt + w * hdt2;
-  const float reach =
-      1.2e-7f * (fabs(Nx) * (fabs(x) + fabs(Px) + 2.0f * (fabs(vx * dt) + fabs(ax * hdt2))) +
-                 fabs(Ny) * (fabs(y) + fabs(Py) + 2.0f * (fabs(vy * dt) + fabs(ay * hdt2))) +
-                 fabs(Nz) * (fabs(z) + fabs(Pz) + 2.0f * (fabs(vz * dt) + fabs(az * hdt2)))) +
-      1e-30f;
-  /* The first root of s0 + u t + w t^2 / 2, without cancellation. */
-  const float D = u * u - 2.0f * w * s0;
-  const float sq = sqrt(fl_maxf(D, 0.0f));
-  const float root = u < 0.0f ? 2.0f * s0 / (sq - u) : (u + sq) / -w;
-  const int crossing = (D >= 0.0f) & (root >= 0.0f) & (root <= dt);
-  const float tau = crossing ? root : dt;
-  const float hx = x + (vx + 0.5f * ax * tau) * tau, hy = y + (vy + 0.5f * ay * tau) * tau,
-              hz = z + (vz + 0.5f * az * tau) * tau;
-  const int hit = (crossing | (s1 <= reach)) & (u + w * tau < 0.0f) & (d0 != 0.0f) &
+  float side, tau, hx, hy, hz;
+  const int hit = fl_planar_accel_hit(*px, *py, *pz, *vxs, *vys, *vzs, ax, ay, az, dt, Px, Py, Pz,
+                                      Nx, Ny, Nz, &side, &tau, &hx, &hy, &hz) &
                   fl_on_piece(a, piece, hx, hy, hz);
   if (!hit) return;
-  float nx = x, ny = y, nz = z;
-  float nvx = vx + ax * tau, nvy = vy + ay * tau, nvz = vz + az * tau;
-  fl_reflect(fl_reflect_of(a), &nx, &ny, &nz, &nvx, &nvy, &nvz, hx, hy, hz, Nx, Ny, Nz, tau);
-  const float htau2 = 0.5f * tau * tau;
-  nx += ax * htau2;
-  ny += ay * htau2;
-  nz += az * htau2;
-  nvx -= ax * tau;
-  nvy -= ay * tau;
-  nvz -= az * tau;
-  const float sx = nvx * dt + 0.5f * ax * dt * dt, sy = nvy * dt + 0.5f * ay * dt * dt,
-              sz = nvz * dt + 0.5f * az * dt * dt;
-  const float qx = nx + sx, qy = ny + sy, qz = nz + sz;
-  const float qd = side * ((qx - Px) * Nx + (qy - Py) * Ny + (qz - Pz) * Nz);
-  const float margin =
-      1.2e-7f * (fabs(Nx) * (fabs(qx) + fabs(Px) + fabs(nvx * dt) + fabs(ax * hdt2)) +
-                 fabs(Ny) * (fabs(qy) + fabs(Py) + fabs(nvy * dt) + fabs(ay * hdt2)) +
-                 fabs(Nz) * (fabs(qz) + fabs(Pz) + fabs(nvz * dt) + fabs(az * hdt2))) +
-      1e-30f;
-  const float push = fl_maxf(margin - qd, 0.0f) * side;
-  *px = nx + push * Nx;
-  *py = ny + push * Ny;
-  *pz = nz + push * Nz;
-  *vxs = nvx;
-  *vys = nvy;
-  *vzs = nvz;
+  fl_planar_accel_bounce(fl_reflect_of(a), side, tau, hx, hy, hz, dt, ax, ay, az, Px, Py, Pz, Nx,
+                         Ny, Nz, px, py, pz, vxs, vys, vzs);
 }
 
 /* A sphere deflecting from outside (inside == 0) or keeping particles in: kernels/deflect.h,
@@ -138,8 +93,8 @@ FL_INLINE void fl_bounce_sphere(__global const FlActionParams* a, int inside, fl
   fl_bounce_sphere_once(rf, a->f[0], a->f[1], a->f[2], a->f[10], a->f[11], a->f[12], a->f[9],
                         inside, dt, px, py, pz, vxs, vys, vzs);
   if (inside)
-    fl_bounce_sphere_again(rf, a->f[0], a->f[1], a->f[2], a->f[10], a->f[11], dt, px, py, pz,
-                           vxs, vys, vzs);
+    fl_bounce_sphere_again(rf, a->f[0], a->f[1], a->f[2], a->f[10], a->f[11], dt, px, py, pz, vxs,
+                           vys, vzs);
 }
 
 /* A box keeping particles in (inside == 1) or deflecting them from outside: kernels/deflect.h.
@@ -215,8 +170,7 @@ FL_INLINE void fl_sink_motion(__global const FlActionParams* a, uint kind, int e
                               float x, float y, float z, float vx, float vy, float vz, uint code,
                               uint* dead, __global const float* shapes) {
   const int now = fl_inside_any(a->domain.v, kind, x, y, z, shapes);
-  const int next =
-      fl_inside_any(a->domain.v, kind, x + vx * dt, y + vy * dt, z + vz * dt, shapes);
+  const int next = fl_inside_any(a->domain.v, kind, x + vx * dt, y + vy * dt, z + vz * dt, shapes);
   *dead = fl_dead_sink_motion(now, next, enter, code, *dead);
 }
 

@@ -379,12 +379,8 @@ inline void bouncePlanarLoop(float* __restrict px, float* __restrict py, float* 
 }
 
 /// The same deflector when the following Move integrates each particle with an acceleration
-/// a (per particle: ax, ay, az) taken as constant over the step (Exact with gravity and
-/// electric fields; Verlet and RK4 with their first stage's): the particle moves on the
-/// parabola p + v·t + ½a·t², so the impact is found on it and the velocity it has at the
-/// impact, v + a·tau, is reflected. The start-of-step state is then set so that the
-/// integrator's p + v·dt + ½a·dt² runs the reflected parabola after the impact. With the
-/// straight path instead, the impact velocity would be off by a·(dt − tau): first order.
+/// a (per particle: ax, ay, az) taken as constant over the step: the impact found on the
+/// parabola and the velocity there reflected (kernels/deflect.h, shared with the device).
 template <class OnPiece, class Dt>
 inline void bouncePlanarAccelLoop(float* __restrict px, float* __restrict py, float* __restrict pz,
                                   float* __restrict vxs, float* __restrict vys,
@@ -392,77 +388,17 @@ inline void bouncePlanarAccelLoop(float* __restrict px, float* __restrict py, fl
                                   const float* __restrict ays, const float* __restrict azs,
                                   std::size_t n, Dt dts, Vec3 P, Vec3 N, OnPiece onPiece,
                                   const Bounce& b) {
-  const Reflect reflect{b.restitution, 1.0f - b.friction, b.cutoff * b.cutoff};
+  const kernel::FlReflect rf{b.restitution, 1.0f - b.friction, b.cutoff * b.cutoff};
   for (std::size_t i = 0; i < n; ++i) {
-    const float dt = dts[i], hdt2 = 0.5f * dt * dt;
-    const float x = px[i], y = py[i], z = pz[i];
-    const float vx = vxs[i], vy = vys[i], vz = vzs[i];
-    const float ax = axs[i], ay = ays[i], az = azs[i];
-    const float d0 = (x - P.x) * N.x + (y - P.y) * N.y + (z - P.z) * N.z;
-    const float vn = vx * N.x + vy * N.y + vz * N.z;
-    const float an = ax * N.x + ay * N.y + az * N.z;
-    const float side = d0 >= 0.0f ? 1.0f : -1.0f;
-    // Towards the side it is on: s(t) = s0 + u·t + ½w·t², s0 > 0 (0 when on the plane).
-    const float s0 = side * d0, u = side * vn, w = side * an;
-    const float s1 = s0 + u * dt + w * hdt2;
-    const float reach =
-        1.2e-7f *
-            (std::abs(N.x) *
-                 (std::abs(x) + std::abs(P.x) + 2.0f * (std::abs(vx * dt) + std::abs(ax * hdt2))) +
-             std::abs(N.y) *
-                 (std::abs(y) + std::abs(P.y) + 2.0f * (std::abs(vy * dt) + std::abs(ay * hdt2))) +
-             std::abs(N.z) *
-                 (std::abs(z) + std::abs(P.z) + 2.0f * (std::abs(vz * dt) + std::abs(az * hdt2)))) +
-        1e-30f;
-    // The first root of s(t) = 0, in the forms without cancellation: approaching (u < 0)
-    // 2·s0 / (√D − u); receding but pulled back (u ≥ 0, w < 0) (u + √D) / −w. D < 0: the
-    // path turns before it reaches the plane.
-    const float D = u * u - 2.0f * w * s0;
-    const float sq = std::sqrt(std::max(D, 0.0f));
-    const float root = u < 0.0f ? 2.0f * s0 / (sq - u) : (u + sq) / -w;
-    const bool crossing = (D >= 0.0f) & (root >= 0.0f) & (root <= dt);
-    // Or ending within a few ulps of the plane: an arrival at the end of the step.
-    const float tau = crossing ? root : dt;
-    const float hx = x + (vx + 0.5f * ax * tau) * tau, hy = y + (vy + 0.5f * ay * tau) * tau,
-                hz = z + (vz + 0.5f * az * tau) * tau;
-    // Approaching at the impact; one born or placed exactly on the plane leaves it freely.
-    const bool hit =
-        (crossing | (s1 <= reach)) & (u + w * tau < 0.0f) & (d0 != 0.0f) & onPiece(hx, hy, hz);
+    const float dt = dts[i], ax = axs[i], ay = ays[i], az = azs[i];
+    float side, tau, hx, hy, hz;
+    const int hit =
+        kernel::fl_planar_accel_hit(px[i], py[i], pz[i], vxs[i], vys[i], vzs[i], ax, ay, az, dt,
+                                    P.x, P.y, P.z, N.x, N.y, N.z, &side, &tau, &hx, &hy, &hz) &
+        int(onPiece(hx, hy, hz));
     if (!hit) continue;
-    // The velocity at the impact, reflected; then the start of a parabola through h at tau
-    // with that velocity: v_start = v' − a·tau, p_start = h − v'·tau + ½a·tau².
-    float nx = x, ny = y, nz = z;
-    float nvx = vx + ax * tau, nvy = vy + ay * tau, nvz = vz + az * tau;
-    reflect(nx, ny, nz, nvx, nvy, nvz, hx, hy, hz, N.x, N.y, N.z, tau);
-    const float htau2 = 0.5f * tau * tau;
-    nx += ax * htau2;
-    ny += ay * htau2;
-    nz += az * htau2;
-    nvx -= ax * tau;
-    nvy -= ay * tau;
-    nvz -= az * tau;
-    // Where the integrator will put it (as Exact computes it); pushed out if rounding left
-    // it on or behind the plane. The reflected parabola may also come back through the
-    // plane within the step (a slow bounce): then it ends just in front of it.
-    const float sx = nvx * dt + 0.5f * ax * dt * dt, sy = nvy * dt + 0.5f * ay * dt * dt,
-                sz = nvz * dt + 0.5f * az * dt * dt;
-    const float qx = nx + sx, qy = ny + sy, qz = nz + sz;
-    const float qd = side * ((qx - P.x) * N.x + (qy - P.y) * N.y + (qz - P.z) * N.z);
-    const float margin =
-        1.2e-7f * (std::abs(N.x) *
-                       (std::abs(qx) + std::abs(P.x) + std::abs(nvx * dt) + std::abs(ax * hdt2)) +
-                   std::abs(N.y) *
-                       (std::abs(qy) + std::abs(P.y) + std::abs(nvy * dt) + std::abs(ay * hdt2)) +
-                   std::abs(N.z) *
-                       (std::abs(qz) + std::abs(P.z) + std::abs(nvz * dt) + std::abs(az * hdt2))) +
-        1e-30f;
-    const float push = std::max(margin - qd, 0.0f) * side;
-    px[i] = nx + push * N.x;
-    py[i] = ny + push * N.y;
-    pz[i] = nz + push * N.z;
-    vxs[i] = nvx;
-    vys[i] = nvy;
-    vzs[i] = nvz;
+    kernel::fl_planar_accel_bounce(rf, side, tau, hx, hy, hz, dt, ax, ay, az, P.x, P.y, P.z, N.x,
+                                   N.y, N.z, &px[i], &py[i], &pz[i], &vxs[i], &vys[i], &vzs[i]);
   }
 }
 
