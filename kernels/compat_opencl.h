@@ -10,5 +10,7 @@
  * call. */
 #define FL_INLINE inline __attribute__((always_inline))
 #define make_float3(x, y, z) ((float3)((x), (y), (z)))
+/* A pointer into a buffer the host wrote (a group's lanes, its start-of-step snapshot). */
+#define FL_GLOBAL __global
 
 #endif /* FLURRY_KERNELS_COMPAT_OPENCL_H */

@@ -30,6 +30,33 @@ FL_INLINE float fl_approach(float rate, float dt) {
   return 1.0f - exp(-rate * dt);
 }
 
+/* MatchVelocity and MatchRotVelocity: the mean of a field (fx, fy, fz) over the particles of
+ * the step's start (n of them, at sx, sy, sz) within r2max (a squared radius) of p, `self`
+ * left out, and the value (vx, vy, vz) carried towards it by k; left as it is with no
+ * neighbour. */
+FL_INLINE void fl_match_mean(const FL_GLOBAL float* sx, const FL_GLOBAL float* sy,
+                             const FL_GLOBAL float* sz, const FL_GLOBAL float* fx,
+                             const FL_GLOBAL float* fy, const FL_GLOBAL float* fz, uint n,
+                             uint self, float r2max, float px, float py, float pz, float k,
+                             float* vx, float* vy, float* vz) {
+  float sumx = 0.0f, sumy = 0.0f, sumz = 0.0f;
+  int count = 0;
+  for (uint j = 0; j < n; ++j) {
+    if (j == self) continue;
+    const float dx = sx[j] - px, dy = sy[j] - py, dz = sz[j] - pz;
+    if (dx * dx + dy * dy + dz * dz > r2max) continue;
+    sumx += fx[j];
+    sumy += fy[j];
+    sumz += fz[j];
+    ++count;
+  }
+  if (count == 0) return;
+  const float c = (float)count;
+  *vx = *vx + (sumx / c - *vx) * k;
+  *vy = *vy + (sumy / c - *vy) * k;
+  *vz = *vz + (sumz / c - *vz) * k;
+}
+
 /* Charge over mass: a particle of zero (or negative) mass feels no field. */
 FL_INLINE float fl_charge_per_mass(float charge, float mass) {
   return mass > 0.0f ? charge / mass : 0.0f;

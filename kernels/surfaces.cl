@@ -281,25 +281,11 @@ FL_INLINE void fl_add_accel(float3 acc, float dt, float* vx, float* vy, float* v
 /* actions_more.hpp matchMean: towards the mean of the neighbours' field (snapshot attribute
  * `field`: 1 velocity, 2 angular velocity) within maxR. f[0] rate, f[1] the dt f[3] was
  * computed for, f[2] maxR^2, f[3] 1 - exp(-rate dt); another dt (sub-steps) computes it. */
-FL_INLINE void fl_match_mean(__global const FlActionParams* a, __global const float* snap,
-                             uint snapStride, uint snapN, uint self, uint field, float dt, float px,
-                             float py, float pz, float* ox, float* oy, float* oz) {
+FL_INLINE void fl_match_toward_mean(__global const FlActionParams* a, __global const float* snap,
+                                    uint snapStride, uint snapN, uint self, uint field, float dt,
+                                    float px, float py, float pz, float* ox, float* oy, float* oz) {
   const float k = dt == a->f[1] ? a->f[3] : 1.0f - exp(-a->f[0] * dt);
-  const float r2max = a->f[2];
-  const float3 p = (float3)(px, py, pz);
-  float3 sum = (float3)(0.0f);
-  int count = 0;
-  for (uint j = 0; j < snapN; ++j) {
-    if (j == self) continue;
-    const float3 d = (float3)(FL_SNAP(0, 0, j), FL_SNAP(0, 1, j), FL_SNAP(0, 2, j)) - p;
-    if (fl_dotv(d, d) > r2max) continue;
-    sum += (float3)(FL_SNAP(field, 0, j), FL_SNAP(field, 1, j), FL_SNAP(field, 2, j));
-    ++count;
-  }
-  if (count == 0) return;
-  const float3 v = (float3)(*ox, *oy, *oz);
-  const float3 r = v + (sum / (float)count - v) * k;
-  *ox = r.x;
-  *oy = r.y;
-  *oz = r.z;
+  fl_match_mean(&FL_SNAP(0, 0, 0), &FL_SNAP(0, 1, 0), &FL_SNAP(0, 2, 0), &FL_SNAP(field, 0, 0),
+                &FL_SNAP(field, 1, 0), &FL_SNAP(field, 2, 0), snapN, self, a->f[2], px, py, pz, k,
+                ox, oy, oz);
 }

@@ -16,6 +16,9 @@
 #ifndef FL_INLINE
 #define FL_INLINE inline
 #endif
+#ifndef FL_GLOBAL
+#define FL_GLOBAL  // the device's __global: one address space here
+#endif
 
 namespace flurry::detail {
 inline namespace FLURRY_ISA_NAMESPACE {

@@ -452,27 +452,18 @@ inline void apply(const Follow& a, const Lanes& L, std::size_t n, const BlockCon
   }
 }
 
-// Towards the mean of the neighbours' values within maxRadius, at `magnitude` per second.
+// Towards the mean of the neighbours' values within maxRadius, at `magnitude` per second
+// (kernels/forces.h, shared with the device).
 inline void matchMean(const Snapshot& s, const float* const* self, const float* const* field,
                       float* const* out, std::size_t n, const BlockContext& c, float rate,
                       float maxR) {
   const float kStep = approach(rate, c.dt);
   const float r2max = maxR * maxR;
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 p = at(self, i);
-    Vec3 sum(0.0f);
-    int count = 0;
-    for (std::size_t j = 0; j < s.size; ++j) {
-      if (j == c.base + i) continue;
-      const Vec3 d = Vec3(s.p[0][j], s.p[1][j], s.p[2][j]) - p;
-      if (glm::dot(d, d) > r2max) continue;
-      sum += Vec3(field[0][j], field[1][j], field[2][j]);
-      ++count;
-    }
-    if (count == 0) continue;
     const float k = c.ownDt ? approach(rate, c.ownDt[i]) : kStep;
-    const Vec3 v = at(out, i);
-    put(out, i, v + (sum / float(count) - v) * k);
+    kernel::fl_match_mean(s.p[0], s.p[1], s.p[2], field[0], field[1], field[2],
+                          std::uint32_t(s.size), std::uint32_t(c.base + i), r2max, self[0][i],
+                          self[1][i], self[2][i], k, &out[0][i], &out[1][i], &out[2][i]);
   }
 }
 inline void apply(const MatchVelocity& a, const Lanes& L, std::size_t n, const BlockContext& c) {

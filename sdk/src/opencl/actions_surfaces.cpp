@@ -194,15 +194,16 @@ bool generateSurfaceAction(const Action& act, ActionSource& s) {
     s.neighbours = true;
     s.reads.insert({Attribute::Position, Attribute::Velocity});
     s.writes.insert(Attribute::Velocity);
-    s.apply = "fl_match_mean(" + ap + ", " + kSnapArgs + ", 1u, dt, px, py, pz, &vx, &vy, &vz);\n";
+    s.apply =
+        "fl_match_toward_mean(" + ap + ", " + kSnapArgs + ", 1u, dt, px, py, pz, &vx, &vy, &vz);\n";
     return true;
   }
   if (std::holds_alternative<MatchRotVelocity>(act)) {
     s.neighbours = true;
     s.reads.insert({Attribute::Position, Attribute::RotVelocity});
     s.writes.insert(Attribute::RotVelocity);
-    s.apply =
-        "fl_match_mean(" + ap + ", " + kSnapArgs + ", 2u, dt, px, py, pz, &rotx, &roty, &rotz);\n";
+    s.apply = "fl_match_toward_mean(" + ap + ", " + kSnapArgs +
+              ", 2u, dt, px, py, pz, &rotx, &roty, &rotz);\n";
     return true;
   }
   return false;
