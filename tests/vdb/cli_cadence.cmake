@@ -4,18 +4,9 @@
 cmake_minimum_required(VERSION 3.25)
 file(REMOVE_RECURSE ${DIR})
 
+include(${CMAKE_CURRENT_LIST_DIR}/cli_run.cmake)
 function(expect_files folder expected)
-  execute_process(COMMAND ${FLURRY} run fountain --frames 12 --vdb ${folder} --vdb-fog
-                          --voxel-size 0.05 --quiet ${ARGN}
-                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "flurry run fountain --vdb ${ARGN} failed (${rc}):\n${out}\n${err}")
-  endif()
-  file(GLOB files RELATIVE ${folder} ${folder}/*)
-  list(SORT files)
-  if(NOT files STREQUAL "${expected}")
-    message(FATAL_ERROR "--vdb ${ARGN}: wrote '${files}', expected '${expected}'")
-  endif()
+  expect_vdb_files(fountain ${folder} "${expected}" --frames 12 --vdb-fog --voxel-size 0.05 ${ARGN})
 endfunction()
 
 expect_files(${DIR}/default "fountain.0010.vdb;fountain.0012.vdb")

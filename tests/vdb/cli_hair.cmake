@@ -5,18 +5,9 @@
 cmake_minimum_required(VERSION 3.25)
 file(REMOVE_RECURSE ${DIR})
 
+include(${CMAKE_CURRENT_LIST_DIR}/cli_run.cmake)
 function(run_hair effect folder expected)
-  execute_process(COMMAND ${FLURRY} run ${effect} --frames 6 --vdb ${folder} --vdb-every 1
-                          --voxel-size 0.05 --quiet
-                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "flurry run ${effect} --vdb failed (${rc}):\n${out}\n${err}")
-  endif()
-  file(GLOB files RELATIVE ${folder} ${folder}/*)
-  list(SORT files)
-  if(NOT files STREQUAL "${expected}")
-    message(FATAL_ERROR "${effect}: wrote '${files}', expected '${expected}':\n${out}")
-  endif()
+  expect_vdb_files(${effect} ${folder} "${expected}" --frames 6 --vdb-every 1 --voxel-size 0.05)
   set(out "${out}" PARENT_SCOPE)
 endfunction()
 
