@@ -17,6 +17,7 @@ for preset in release debug; do
     # and switched off in CMakePresets.json: GCC <= 13's __tls_get_addr interceptor takes a
     # dynamic TLS block that happens to start 16 bytes into a page for glibc 2.19's header
     # and scans a bogus range (google/sanitizers#1322), hence intercept_tls_get_addr=0.
+    # (What PoCL's kernel compiler keeps past exit is suppressed there too: tests/lsan.supp.)
     # Any other tracer crash, and only that, earns the failed tests one rerun.
     if [ "$preset" = debug ] && grep -q "Tracer caught signal" "$log"; then
       echo "== LeakSanitizer's tracer crashed (not a leak report): rerunning the failed tests once"
