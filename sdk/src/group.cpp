@@ -55,6 +55,13 @@ LaneBuffer& LaneBuffer::operator=(LaneBuffer&& o) noexcept {
   return *this;
 }
 
+void assignFill(std::vector<std::uint32_t>& v, std::size_t n, std::uint32_t value) {
+  v.assign(n, value);
+}
+void assignFill(std::vector<float>& v, std::size_t n, float value) {
+  v.assign(n, value);
+}
+
 Lanes Lanes::offset(std::size_t b) const {
   Lanes r = *this;
   auto shift = [b](auto*& ptr) {

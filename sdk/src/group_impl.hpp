@@ -154,6 +154,13 @@ struct Frame {
   std::uint64_t emittersDerived = ~std::uint64_t(0);
 };
 
+/// v = n copies of `value`. Out of line in a baseline translation unit (group.cpp) for the
+/// code built once per instruction set (cpu/fused_pass.cpp): a std::vector member it
+/// instantiated itself would be a weak symbol, compiled with that set's instructions, which
+/// the linker may keep for every build (tests/isa/check_variant_symbols.py).
+void assignFill(std::vector<std::uint32_t>& v, std::size_t n, std::uint32_t value);
+void assignFill(std::vector<float>& v, std::size_t n, float value);
+
 struct GroupImpl;
 /// Brings group.plan up to date with its action list (when actionsVersion changed) and
 /// returns it (cpu/cpu_backend.cpp).

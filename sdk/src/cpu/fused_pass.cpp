@@ -49,7 +49,7 @@ std::uint32_t substepCount(GroupImpl& g, const StepParams& sp, ThreadPool& pool)
     const Lanes L = g.lanePointers();
     const std::size_t chunks = (g.size + 65535) / 65536;
     std::vector<float>& fastest = g.plan.fastest;  // grows, never shrinks
-    fastest.assign(chunks, 0.0f);
+    assignFill(fastest, chunks, 0.0f);
     pool.parallelFor(chunks, [&](std::size_t c) {
       float m = 0.0f;
       for (std::size_t i = c * 65536; i < std::min(g.size, (c + 1) * 65536); ++i)
@@ -449,10 +449,10 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
   const std::size_t tasks = (blocks + blocksPerTask - 1) / blocksPerTask;
   g.deadIndex.resize(n);
   g.deadCode.resize(n);
-  g.deadCount.assign(blocks, 0);
-  g.culledCount.assign(blocks, 0);
+  assignFill(g.deadCount, blocks, 0);
+  assignFill(g.culledCount, blocks, 0);
   const std::size_t killSlots = acts.size() + 1;  // the last: non-finite
-  g.blockKills.assign(blocks * killSlots, 0);
+  assignFill(g.blockKills, blocks * killSlots, 0);
   // Tallies a block's dead by cause (codes: 1 + action, or kNonFiniteCode).
   auto tally = [&](std::size_t b, std::uint32_t k) {
     std::uint32_t* kills = g.blockKills.data() + b * killSlots;
@@ -550,7 +550,7 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
     });
   } else {
     // The unfused baseline: one parallel pass over the whole group per action.
-    g.deadFlags.assign(n, 0u);
+    assignFill(g.deadFlags, n, 0u);
     for (std::uint32_t s = 0; s < plan.substeps; ++s) {
       for (std::size_t k = 0; k < acts.size(); ++k) {
         sp.pool->parallelFor(tasks, [&](std::size_t t) {
