@@ -37,8 +37,18 @@ FL_INLINE float3 fl_emitter_at(__global const FlEmitter* e, __global const FlKey
   }
   if (t <= fl_real_from_bits(k[0].time)) return fl_v3(k[0].position);
   if (t >= fl_real_from_bits(k[last].time)) return fl_v3(k[last].position);
-  uint b = 1; /* the first key later than t */
-  while (!(t < fl_real_from_bits(k[b].time))) ++b;
+  /* The first key later than t (1 <= b <= last, as t is inside the path): a binary search,
+   * as the CPU's std::upper_bound (times increase, so every search finds the same key); a
+   * newborn of a long path (Orbit2's has thousands of keys) no longer walks them all. */
+  uint lo = 1, hi = last;
+  while (lo < hi) {
+    const uint mid = lo + (hi - lo) / 2u;
+    if (t < fl_real_from_bits(k[mid].time))
+      hi = mid;
+    else
+      lo = mid + 1u;
+  }
+  const uint b = lo;
   const fl_real ta = fl_real_from_bits(k[b - 1].time), tb = fl_real_from_bits(k[b].time);
   const fl_real w = (t - ta) / (tb - ta);
   const float3 a = fl_v3(k[b - 1].position);

@@ -1,5 +1,7 @@
 // Parity on the device: Emission on the device: every domain, spacing, normal speed, prime
 // emitters. Each test runs the same build on the CPU and on the device (tests/opencl/parity.hpp).
+#include <cmath>
+
 #include "parity.hpp"
 
 using namespace flurry;
@@ -102,6 +104,30 @@ TEST(OpenCLEmission, LoopingPath) {
     e.rate = 90;
     e.spacing = 0.05f;
     e.shape = Domain::sphere(Vec3(0.0f), 0.1f);
+    e.types = {drawingType(Domain::sphere(Vec3(0.0f), 0.5f))};
+    g.addEmitter(e);
+    g.setActions({Gravity{kDown}, Move{}, KillOld{}});
+    g.require(kAll);
+    return g;
+  });
+}
+
+// A path of many keys (a circle in 240 keys over 8 s, looping): each newborn's key is found by
+// a binary search on the device and by a walk from the last one on the CPU; both must find
+// the same key for every birth, by rate and by distance.
+TEST(OpenCLEmission, LongPath) {
+  checkParity([](Context& ctx) -> Group& {
+    Group& g = ctx.createGroup("orbit", 20000);
+    Emitter e;
+    for (int k = 0; k <= 240; ++k) {
+      const float a = 6.2831853f * float(k) / 240.0f;
+      e.path.push_back({0.2 + 8.0 * double(k) / 240.0,
+                        Vec3(3.0f * std::cos(a), 0.01f * float(k), 3.0f * std::sin(a))});
+    }
+    e.pathLoop = true;
+    e.rate = 300;
+    e.spacing = 0.1f;
+    e.shape = Domain::point(Vec3(0.0f));
     e.types = {drawingType(Domain::sphere(Vec3(0.0f), 0.5f))};
     g.addEmitter(e);
     g.setActions({Gravity{kDown}, Move{}, KillOld{}});
