@@ -26,6 +26,14 @@ struct RunInfo {
   bool progress = false;
 };
 
+/// An output's cadence when its own option (`--png-every`, `--vdb-every`) was not given:
+/// `run --every`'s N (default 10), so that every output writes the same frames.
+inline int everyOfRun(const CLI::App& run) {
+  if (const CLI::Option* o = run.get_option_no_throw("--every"))
+    if (o->count() > 0 || !o->as<std::string>().empty()) return o->as<int>();
+  return 10;
+}
+
 class Plugin {
  public:
   virtual ~Plugin() = default;

@@ -182,12 +182,7 @@ class PngPlugin : public Plugin {
 
   void begin(Context& ctx, const RunInfo& info) override {
     info_ = info;
-    if (every_ == 0) {
-      every_ = 10;
-      if (const CLI::Option* o = run_->get_option_no_throw("--every")) {
-        if (o->count() > 0 || !o->as<std::string>().empty()) every_ = o->as<int>();
-      }
-    }
+    if (every_ == 0) every_ = everyOfRun(*run_);
     std::error_code ec;
     fs::create_directories(dir_, ec);
     if (ec) throw IoError(dir_, "cannot create the --png folder: " + ec.message());

@@ -51,12 +51,7 @@ class VdbPlugin final : public Plugin {
     info_ = info;
     // Every output follows --every unless told otherwise: a file per frame of a 300-frame
     // effect is gigabytes and minutes of export, so a whole sequence is asked for by name.
-    if (every_ == 0) {
-      every_ = 10;
-      if (const CLI::Option* o = run_->get_option_no_throw("--every")) {
-        if (o->count() > 0 || !o->as<std::string>().empty()) every_ = o->as<int>();
-      }
-    }
+    if (every_ == 0) every_ = everyOfRun(*run_);
     if (fogOnly_ || pointsOnly_) {
       options_.fog = fogOnly_;
       options_.points = pointsOnly_;
