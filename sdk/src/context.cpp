@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <thread>
+#include <unordered_map>
 
 #include "backend.hpp"
 #include "flurry/error.hpp"
@@ -21,6 +23,11 @@ struct Context::Impl {
   ContextOptions options;
   detail::PassOptions pass;
   std::vector<std::unique_ptr<Group>> groups;
+  // A game creates and destroys thousands of groups (effect instances): finding one by name
+  // and the lowest free index must not cost a walk over all of them.
+  std::unordered_map<std::string_view, Group*> byName;  // views of the groups' own names
+  std::vector<std::uint32_t> freeIndices;               // destroyed groups' indices: a min-heap
+  std::uint32_t nextIndex = 0;                          // no group has held this one or above
   std::unique_ptr<detail::ThreadPool> pool;
   std::unique_ptr<detail::BackendImpl> backend;
   Backend backendKind = Backend::Cpu;
@@ -83,23 +90,30 @@ Group& Context::createGroup(std::string name, std::size_t capacity) {
   if (capacity == 0) throw InvalidArgument("capacity", "a group needs a capacity > 0");
   if (capacity > std::size_t(0xFFFFFFF0u))
     throw InvalidArgument("capacity", "at most 4294967280 particles per group");
-  for (auto& g : impl_->groups)
-    if (g->name() == name) throw InvalidArgument("name", "a group named '" + name + "' exists");
+  if (impl_->byName.contains(name))
+    throw InvalidArgument("name", "a group named '" + name + "' exists");
   auto gi = std::make_unique<detail::GroupImpl>();
   gi->name = std::move(name);
   gi->capacity = capacity;
   // The lowest index no group holds: a group created where one was destroyed draws that
   // one's random streams, so the same sequence of calls gives the same particles.
-  std::uint32_t index = 0;
-  for (bool taken = true; taken; ++index) {
-    taken = false;
-    for (auto& g : impl_->groups) taken |= g->impl_->index == index;
-    if (!taken) break;
-  }
-  gi->index = index;
+  auto& freed = impl_->freeIndices;
+  const bool reuse = !freed.empty();
+  gi->index = reuse ? freed.front() : impl_->nextIndex;
   gi->ensureStorage();
-  impl_->groups.push_back(std::unique_ptr<Group>(new Group(std::move(gi))));
-  return *impl_->groups.back();
+  impl_->groups.reserve(impl_->groups.size() + 1);  // nothing below throws
+  impl_->byName.reserve(impl_->byName.size() + 1);
+  auto group = std::unique_ptr<Group>(new Group(std::move(gi)));
+  Group& g = *group;
+  if (reuse) {
+    std::pop_heap(freed.begin(), freed.end(), std::greater<>());
+    freed.pop_back();
+  } else {
+    ++impl_->nextIndex;
+  }
+  impl_->groups.push_back(std::move(group));
+  impl_->byName.emplace(g.name(), &g);
+  return g;
 }
 
 void Context::destroyGroup(Group& group) {
@@ -108,12 +122,14 @@ void Context::destroyGroup(Group& group) {
       std::find_if(all.begin(), all.end(), [&](const auto& g) { return g.get() == &group; });
   if (it == all.end())
     throw InvalidArgument("group", "'" + group.name() + "' is not a group of this context");
+  impl_->byName.erase(group.name());
+  impl_->freeIndices.push_back(group.impl_->index);
+  std::push_heap(impl_->freeIndices.begin(), impl_->freeIndices.end(), std::greater<>());
   all.erase(it);  // its device buffers go after the work queued on them (the mirror waits)
 }
 
 Group& Context::group(std::string_view name) {
-  for (auto& g : impl_->groups)
-    if (g->name() == name) return *g;
+  if (const auto it = impl_->byName.find(name); it != impl_->byName.end()) return *it->second;
   throw Error("no group named '" + std::string(name) + "'");
 }
 

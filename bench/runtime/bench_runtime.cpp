@@ -1,0 +1,159 @@
+// The game runtime: many instances of one small effect against the same particles as one
+// group, in one run (issue #15's aim: 10,000 instances of a 100-particle effect within 1.5x
+// of one group of 1M).
+//
+//   build/release/bench/bench_runtime --benchmark_repetitions=5
+//       --benchmark_enable_random_interleaving=true --benchmark_report_aggregates_only=true
+//
+// (one command line).
+//
+// After the runs it prints the ratio of the medians, per thread count.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "flurry/effect.hpp"
+#include "flurry/flurry.hpp"
+
+using namespace flurry;
+
+namespace {
+
+// A puff of sparks: a sphere emitter firing `rate` a second that live 1 s, falling on a
+// floor: `rate` alive at steady state, a thirtieth born and dying every step. The floor and
+// the emitter are placed by the instance's transform.
+std::string sparks(std::size_t rate) {
+  const std::string r = std::to_string(rate);
+  return R"({"version": 1, "name": "sparks", "dt": 0.0333333333333, "seed": 7,
+    "groups": [{"name": "sparks", "capacity": )" +
+         std::to_string(rate + rate / 4 + 16) + R"(,
+      "emitters": [{"shape": {"type": "sphere", "center": [0, 1, 0], "outerRadius": 0.1},
+        "rate": )" +
+         r + R"(,
+        "types": [{"velocity": {"type": "sphere", "center": [0, 2, 0], "outerRadius": 1},
+                   "lifetime": 1}]}],
+      "actions": [
+        {"type": "Gravity", "acceleration": [0, -9.81, 0]},
+        {"type": "Bounce", "surface": {"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0]},
+         "restitution": 0.5},
+        {"type": "Move"},
+        {"type": "KillOld"}]}]})";
+}
+
+constexpr std::size_t kPerInstance = 100;
+
+// Where instance k of `count` stands: a grid on the ground, each turned its own way.
+Transform placeOf(std::size_t k, std::size_t count) {
+  const auto side = std::size_t(std::ceil(std::sqrt(double(count))));
+  Transform t;
+  t.position = Vec3(float(k % side) * 4.0f, 0.0f, float(k / side) * 4.0f);
+  t.rotation = glm::angleAxis(float(k) * 0.37f, Vec3(0.0f, 1.0f, 0.0f));
+  return t;
+}
+
+// `count` instances of the 100-particle effect (range 0), on `threads` (range 1); each step
+// is Context::step() of them all.
+void Instances(benchmark::State& state) {
+  const auto count = std::size_t(state.range(0));
+  ContextOptions o;
+  o.threads = unsigned(state.range(1));
+  Context ctx(o);
+  const Effect effect = parseEffect(sparks(kPerInstance));
+  std::vector<EffectInstance> all;
+  all.reserve(count);
+  for (std::size_t k = 0; k < count; ++k) {
+    all.push_back(effect.instantiate(ctx, std::to_string(k)));
+    all.back().setTransform(placeOf(k, count));
+  }
+  ctx.run(45);  // 1.5 s: past the lifetime, births and deaths balance
+  double live = 0;
+  for (auto _ : state) {
+    ctx.step();
+    state.PauseTiming();
+    for (const EffectInstance& i : all) live += double(i.groups()[0]->size());
+    state.ResumeTiming();
+  }
+  state.SetItemsProcessed(std::int64_t(live));
+  state.counters["live"] = live / double(state.iterations());
+  state.counters["us/instance"] =
+      benchmark::Counter(double(state.iterations()) * double(count) * 1e-6,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+// The same particles as one group: the effect at `count` times the rate, one instance.
+void OneGroup(benchmark::State& state) {
+  const auto count = std::size_t(state.range(0));
+  ContextOptions o;
+  o.threads = unsigned(state.range(1));
+  Context ctx(o);
+  const Effect effect = parseEffect(sparks(kPerInstance * count));
+  EffectInstance one = effect.instantiate(ctx, "all");
+  one.setTransform(placeOf(1, 1));
+  ctx.run(45);
+  double live = 0;
+  for (auto _ : state) {
+    ctx.step();
+    live += double(one.groups()[0]->size());
+  }
+  state.SetItemsProcessed(std::int64_t(live));
+  state.counters["live"] = live / double(state.iterations());
+}
+
+void args(benchmark::internal::Benchmark* b) {
+  const auto cores = int(std::max(1u, std::thread::hardware_concurrency()));
+  for (int t : {1, cores}) {
+    b->Args({10000, t});
+    if (cores == 1) break;
+  }
+  b->ArgNames({"instances", "threads"})->Unit(benchmark::kMillisecond)->UseRealTime();
+}
+
+BENCHMARK(Instances)->Apply(args);
+BENCHMARK(OneGroup)->Apply(args);
+
+// Prints the ratio of the medians (or single runs) of the two, per thread count.
+class RatioReporter : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    ConsoleReporter::ReportRuns(runs);
+    for (const Run& r : runs) {
+      const bool median = r.run_type == Run::RT_Aggregate && r.aggregate_name == "median";
+      if (r.run_type == Run::RT_Iteration && r.repetitions > 1) continue;
+      if (r.run_type == Run::RT_Aggregate && !median) continue;
+      ms_[r.run_name.function_name + "/" + r.run_name.args] = r.GetAdjustedRealTime();
+    }
+  }
+  void Finalize() override {
+    ConsoleReporter::Finalize();
+    std::printf("\nSummary (medians of this run):\n");
+    for (const auto& [name, ms] : ms_) {
+      if (name.rfind("Instances/", 0) != 0) continue;
+      const std::string args = name.substr(10);
+      const auto one = ms_.find("OneGroup/" + args);
+      if (one == ms_.end()) continue;
+      std::printf(
+          "  %s: %.2f ms a step, the same particles as one group %.2f ms: %.2fx (goal <= 1.5)\n",
+          args.c_str(), ms, one->second, ms / one->second);
+    }
+  }
+
+ private:
+  std::map<std::string, double> ms_;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  RatioReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  benchmark::Shutdown();
+  return 0;
+}
