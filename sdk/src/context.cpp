@@ -29,6 +29,9 @@ struct Context::Impl {
   std::vector<std::uint32_t> freeIndices;               // destroyed groups' indices: a min-heap
   std::uint32_t nextIndex = 0;                          // no group has held this one or above
   std::unique_ptr<detail::ThreadPool> pool;
+  // Small groups (effect instances) are stepped many at once, one per thread, each inline.
+  detail::ThreadPool inlinePool{1};
+  std::vector<detail::GroupImpl*> smallGroups;  // this step's, kept for its storage
   std::unique_ptr<detail::BackendImpl> backend;
   Backend backendKind = Backend::Cpu;
   std::string backendFallback;  // why Backend::Auto took the CPU
@@ -41,6 +44,10 @@ struct Context::Impl {
 };
 
 namespace {
+// A group that can hold no more than this many particles steps inline (its act pass is one
+// task below cpu fused_pass's 32768 particles): many such are stepped side by side.
+constexpr std::size_t kSmallGroupCapacity = 32768;
+
 void checkDt(double dt) {
   if (!std::isfinite(dt) || dt <= 0.0 || dt > 10.0)
     throw InvalidArgument("dt",
@@ -181,10 +188,31 @@ detail::StepParams Context::Impl::params() const {
 
 void Context::step() {
   const detail::StepParams sp = impl_->params();
+  auto& small = impl_->smallGroups;
+  small.clear();
+  // On the CPU a group is independent of every other and its result does not depend on the
+  // thread that steps it: a group too small to share out its own pass steps inline on one
+  // thread while others step theirs (a game's hundreds of instances), a large one on all.
+  const bool spread = impl_->backendKind == Backend::Cpu && impl_->pool->size() > 1;
   for (auto& g : impl_->groups) {
     auto& gi = *g->impl_;
+    if (spread && gi.capacity <= kSmallGroupCapacity) {
+      small.push_back(&gi);
+      continue;
+    }
     stepGroup(*impl_->backend, gi,
               groupStep(sp, gi, impl_->timeAtDtChange, impl_->stepsSinceDtChange, 0));
+  }
+  if (!small.empty()) {
+    detail::StepParams alone = sp;
+    alone.pool = &impl_->inlinePool;
+    constexpr std::size_t kPerTask = 8;  // groups a task takes: fewer hand-outs
+    impl_->pool->parallelFor((small.size() + kPerTask - 1) / kPerTask, [&](std::size_t t) {
+      const std::size_t end = std::min(small.size(), (t + 1) * kPerTask);
+      for (std::size_t i = t * kPerTask; i < end; ++i)
+        stepGroup(*impl_->backend, *small[i],
+                  groupStep(alone, *small[i], impl_->timeAtDtChange, impl_->stepsSinceDtChange, 0));
+    });
   }
   ++impl_->step;
   ++impl_->stepsSinceDtChange;
