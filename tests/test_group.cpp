@@ -10,6 +10,7 @@
 
 #include "builtin.hpp"
 #include "flurry/flurry.hpp"
+#include "group_impl.hpp"
 #include "pass_options.hpp"
 
 using namespace flurry;
@@ -500,6 +501,100 @@ TEST(Context, ManySmallGroupsStepTheSameOnAnyThreadCount) {
   EXPECT_GT(one.front().size(), 0u);
   EXPECT_EQ(run(2), one);
   EXPECT_EQ(run(5), one);
+}
+
+// The live particles' box, taken by hand.
+Bounds boundsByHand(const Group& g) {
+  Bounds b;
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    Vec3 p;
+    for (int c = 0; c < 3; ++c) p[c] = g.lane(Attribute::Position, c)[i];
+    b.min = b.empty ? p : glm::min(b.min, p);
+    b.max = b.empty ? p : glm::max(b.max, p);
+    b.empty = false;
+  }
+  return b;
+}
+
+// Once asked, the bounds are kept by the CPU pass every step (births, deaths, bounces,
+// particles killed for a NaN), fused or not, on any thread count and block size: exactly
+// the box of the live particles. What the host changes is seen at the next call.
+TEST(Group, BoundsAreKeptEveryStepByThePass) {
+  for (const bool fused : {true, false})
+    for (const unsigned threads : {1u, 2u}) {
+      SCOPED_TRACE(std::string(fused ? "fused" : "unfused") + ", threads " +
+                   std::to_string(threads));
+      ContextOptions o;
+      o.threads = threads;
+      Context ctx(o);
+      detail::setPassOptions(ctx, {.blockSize = 256, .fused = fused});
+      Group& g = samples::buildFountain(ctx, 60000, 100000.0, 0.4f);
+      // A callback that throws some particles to NaN (killed) and some far away (the box).
+      Callback far;
+      far.function = [](Particle& p, const CallbackContext&) {
+        if (p.id % 997 == 5) p.position.x = std::nanf("");
+        if (p.id % 1999 == 7) p.position.y = 100.0f + float(p.id % 13);
+      };
+      ActionList acts = g.actions();
+      acts.add(far);
+      g.setActions(std::move(acts));
+      const Group& view = g;
+      EXPECT_TRUE(view.bounds().empty);
+      for (int s = 0; s < 25; ++s) {
+        ctx.step();
+        EXPECT_TRUE(detail::implOf(view).boundsValid) << "step " << s;
+        const Bounds kept = view.bounds(), exact = boundsByHand(view);
+        ASSERT_EQ(kept.empty, exact.empty);
+        EXPECT_EQ(kept.min, exact.min) << "step " << s;
+        EXPECT_EQ(kept.max, exact.max) << "step " << s;
+      }
+      EXPECT_GT(g.stats().killedNonFinite, 0u);
+      EXPECT_GT(view.bounds().max.y, 100.0f);
+      // The host's changes: a particle added, a position written.
+      Particle p;
+      p.position = Vec3(-500.0f, 0.0f, 0.0f);
+      ASSERT_TRUE(g.add(p));
+      EXPECT_EQ(view.bounds().min.x, -500.0f);
+      g.lane(Attribute::Position, 2)[0] = 700.0f;
+      EXPECT_EQ(view.bounds().max.z, 700.0f);
+      g.clear();
+      EXPECT_TRUE(view.bounds().empty);
+    }
+}
+
+// An instance's box holds every live particle of its groups, wherever it is moved.
+TEST(Instance, BoundsHoldEveryParticleOfItsGroups) {
+  const Effect fx = parseEffect(R"({
+    "name": "two", "dt": 0.05,
+    "groups": [
+      {"name": "up", "capacity": 500,
+       "emitters": [{"shape": {"type": "point", "point": [0, 0, 0]}, "rate": 200,
+                     "types": [{"lifetime": 2, "velocity": {"type": "point", "point": [0, 3, 0]}}]}],
+       "actions": [{"type": "Move"}, {"type": "KillOld"}]},
+      {"name": "side", "capacity": 500,
+       "emitters": [{"shape": {"type": "point", "point": [1, 0, 0]}, "rate": 200,
+                     "types": [{"lifetime": 2, "velocity": {"type": "point", "point": [2, 0, 0]}}]}],
+       "actions": [{"type": "Move"}, {"type": "KillOld"}]}]})");
+  Context ctx(fx.contextOptions());
+  EffectInstance inst = fx.instantiate(ctx, "a");
+  EXPECT_TRUE(inst.bounds().empty);
+  Transform t;
+  for (int s = 0; s < 30; ++s) {
+    t.position = Vec3(float(s), 0.0f, -float(s));
+    inst.setTransform(t);
+    ctx.step();
+    const Bounds b = inst.bounds();
+    ASSERT_FALSE(b.empty);
+    for (const Group* g : inst.groups()) {
+      const Bounds e = boundsByHand(*g);
+      EXPECT_EQ(b.min, glm::min(b.min, e.min));
+      EXPECT_EQ(b.max, glm::max(b.max, e.max));
+    }
+    const Bounds up = boundsByHand(*inst.groups()[0]), side = boundsByHand(*inst.groups()[1]);
+    EXPECT_EQ(b.min, glm::min(up.min, side.min));
+    EXPECT_EQ(b.max, glm::max(up.max, side.max));
+  }
+  EXPECT_GT(inst.bounds().max.y, 2.0f);  // the upward group, in the world
 }
 
 // A new group takes the lowest index a destroyed one left (its random streams), whichever

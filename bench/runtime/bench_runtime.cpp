@@ -58,7 +58,8 @@ Transform placeOf(std::size_t k, std::size_t count) {
 }
 
 // `count` instances of the 100-particle effect (range 0), on `threads` (range 1); each step
-// is Context::step() of them all.
+// is Context::step() of them all, and with bounds (range 2) every instance's bounds, as an
+// engine culls them.
 void Instances(benchmark::State& state) {
   const auto count = std::size_t(state.range(0));
   ContextOptions o;
@@ -73,12 +74,17 @@ void Instances(benchmark::State& state) {
   }
   ctx.run(45);  // 1.5 s: past the lifetime, births and deaths balance
   double live = 0;
+  const bool bounds = state.range(2) != 0;
+  float sink = 0.0f;
   for (auto _ : state) {
     ctx.step();
+    if (bounds)
+      for (const EffectInstance& i : all) sink += i.bounds().max.y;
     state.PauseTiming();
     for (const EffectInstance& i : all) live += double(i.groups()[0]->size());
     state.ResumeTiming();
   }
+  benchmark::DoNotOptimize(sink);
   state.SetItemsProcessed(std::int64_t(live));
   state.counters["live"] = live / double(state.iterations());
   state.counters["us/instance"] =
@@ -86,7 +92,8 @@ void Instances(benchmark::State& state) {
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
-// The same particles as one group: the effect at `count` times the rate, one instance.
+// The same particles as one group: the effect at `count` times the rate, one instance; with
+// bounds (range 2) its bounds every step (kept by the pass: the same step or nearly).
 void OneGroup(benchmark::State& state) {
   const auto count = std::size_t(state.range(0));
   ContextOptions o;
@@ -96,11 +103,15 @@ void OneGroup(benchmark::State& state) {
   EffectInstance one = effect.instantiate(ctx, "all");
   one.setTransform(placeOf(1, 1));
   ctx.run(45);
+  const bool bounds = state.range(2) != 0;
+  float sink = 0.0f;
   double live = 0;
   for (auto _ : state) {
     ctx.step();
+    if (bounds) sink += one.bounds().max.y;
     live += double(one.groups()[0]->size());
   }
+  benchmark::DoNotOptimize(sink);
   state.SetItemsProcessed(std::int64_t(live));
   state.counters["live"] = live / double(state.iterations());
 }
@@ -108,10 +119,10 @@ void OneGroup(benchmark::State& state) {
 void args(benchmark::internal::Benchmark* b) {
   const auto cores = int(std::max(1u, std::thread::hardware_concurrency()));
   for (int t : {1, cores}) {
-    b->Args({10000, t});
+    for (int bounds : {0, 1}) b->Args({10000, t, bounds});
     if (cores == 1) break;
   }
-  b->ArgNames({"instances", "threads"})->Unit(benchmark::kMillisecond)->UseRealTime();
+  b->ArgNames({"instances", "threads", "bounds"})->Unit(benchmark::kMillisecond)->UseRealTime();
 }
 
 BENCHMARK(Instances)->Apply(args);
@@ -140,6 +151,15 @@ class RatioReporter : public benchmark::ConsoleReporter {
       std::printf(
           "  %s: %.2f ms a step, the same particles as one group %.2f ms: %.2fx (goal <= 1.5)\n",
           args.c_str(), ms, one->second, ms / one->second);
+    }
+    // What keeping the bounds costs: the same run with and without asking every step.
+    for (const auto& [name, ms] : ms_) {
+      const auto at = name.rfind("/bounds:1");
+      if (at == std::string::npos) continue;
+      const auto without = ms_.find(name.substr(0, at) + "/bounds:0");
+      if (without == ms_.end()) continue;
+      std::printf("  %s: bounds every step %.2f ms, none %.2f ms: %.3fx\n",
+                  name.substr(0, at).c_str(), ms, without->second, ms / without->second);
     }
   }
 

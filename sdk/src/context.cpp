@@ -166,6 +166,7 @@ detail::StepParams groupStep(const detail::StepParams& sp, const detail::GroupIm
 void stepGroup(detail::BackendImpl& backend, detail::GroupImpl& gi, const detail::StepParams& sp) {
   gi.placeEmitters();
   gi.ensureStorage();
+  gi.boundsValid = false;  // the CPU pass takes them again
   if (gi.stats.killedByAction.size() != gi.actions.size())
     gi.stats.killedByAction.assign(gi.actions.size(), 0);
   backend.step(gi, sp);

@@ -557,10 +557,12 @@ const GroupStats& Group::stats() const {
 }
 
 Bounds Group::bounds() const {
+  auto& g = *impl_;
+  g.boundsWanted = true;  // the next steps' passes keep it
+  if (g.size == 0) return {};
+  if (g.boundsValid) return g.stepBounds;
+  g.syncHost({Attribute::Position});
   Bounds b;
-  impl_->syncHost({Attribute::Position});
-  const auto& g = *impl_;
-  if (g.size == 0) return b;
   const detail::Lanes l = g.lanePointers();
   for (int c = 0; c < 3; ++c) {
     const float* x = l.p[c];

@@ -203,6 +203,12 @@ struct GroupImpl {
   std::vector<std::uint8_t> deadCode;      ///< 1 + index of the action that killed
   std::vector<std::uint32_t> deadCount;    ///< per block
   std::vector<std::uint32_t> culledCount;  ///< per block: actions the fused pass skipped
+  /// Group::bounds() was asked: from then on the CPU pass takes the live particles' box
+  /// every step, each block while it is in cache (no pass of its own).
+  bool boundsWanted = false;
+  bool boundsValid = false;        ///< stepBounds is the live particles' box now
+  Bounds stepBounds;               ///< of the last step's pass, when boundsValid
+  std::vector<float> blockBounds;  ///< per block of that pass: min xyz, max xyz
   /// Per block, the dead each action killed and, last, the non-finite ones: counted while
   /// the block is in cache, by its own thread, and summed after the pass.
   std::vector<std::uint32_t> blockKills;
@@ -236,6 +242,7 @@ struct GroupImpl {
     if (mirror) mirror->pullToHost(*this, AttributeSet());
   }
   void hostChanged() {
+    boundsValid = false;
     if (mirror) mirror->hostChanged(*this);
   }
   void syncStats() {

@@ -117,6 +117,9 @@ class EffectInstance {
   /// Starts the instance as if it had run `seconds` already (Context::prewarm of its groups):
   /// call it before the instance's first step. Returns the steps taken.
   std::uint64_t prewarm(double seconds);
+  /// The box of every live particle of the instance, in the world: the union of its groups'
+  /// Group::bounds() (kept by the CPU pass every step once asked). Empty when none lives.
+  Bounds bounds() const;
   /// Destroys its groups (Context::destroyGroup); the handle is empty after.
   void destroy();
 

@@ -173,7 +173,12 @@ class Group {
   std::span<const std::uint32_t> visible() const;
 
   const GroupStats& stats() const;
-  /// Axis-aligned bounds of the live particles' positions (one pass; not maintained per step).
+  /// Axis-aligned bounds of the live particles' positions, in the world (for an engine's
+  /// culling). The first call takes them in a pass of its own; from then on the CPU backend
+  /// keeps them every step inside its action pass, while each block of particles is in cache,
+  /// and a call costs nothing until the host changes the particles (add(), a writable lane(),
+  /// a move in Space::Local, ...). On a device backend (OpenCL) each call reads the positions
+  /// back (once a step) and takes them on the host.
   Bounds bounds() const;
   /// Removes every particle (stats are kept).
   void clear();

@@ -380,6 +380,35 @@ void guardFinite(const Lanes& L, std::size_t n, std::uint32_t* __restrict dead, 
   }
 }
 
+// The box of a block's live positions (the flagged dead left out) into out[0..6): min xyz,
+// max xyz, taken while the block is in cache, for Group::bounds. Every live position is
+// finite (guardFinite killed the others); a block of dead only gives an empty box.
+void liveBounds(const Lanes& L, std::size_t n, const std::uint32_t* __restrict dead, float* out) {
+  constexpr std::size_t W = 16;  // independent lanes: the loops vectorise without -ffast-math
+  for (int c = 0; c < 3; ++c) {
+    const float* __restrict p = L.p[c];
+    float mn[W], mx[W];
+    for (std::size_t j = 0; j < W; ++j) mn[j] = kInfinity, mx[j] = -kInfinity;
+    auto take = [&](std::size_t i, std::size_t j) {
+      const bool live = dead[i] == 0u;
+      const float lo = live ? p[i] : kInfinity, hi = live ? p[i] : -kInfinity;
+      mn[j] = lo < mn[j] ? lo : mn[j];
+      mx[j] = hi > mx[j] ? hi : mx[j];
+    };
+    std::size_t i = 0;
+    for (; i + W <= n; i += W)
+      for (std::size_t j = 0; j < W; ++j) take(i + j, j);
+    for (std::size_t j = 0; i < n; ++i, ++j) take(i, j);
+    float lo = kInfinity, hi = -kInfinity;
+    for (std::size_t j = 0; j < W; ++j) {
+      lo = std::min(lo, mn[j]);
+      hi = std::max(hi, mx[j]);
+    }
+    out[c] = lo;
+    out[3 + c] = hi;
+  }
+}
+
 // Records a block's dead (ascending) in the block's own slice of deadIndex and clears their
 // flags, so that the flags are all zero again for the next block (no fill per block). Few
 // die in a step: runs of 16 with none are skipped after one vectorised test, and a run with
@@ -461,6 +490,8 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
       ++kills[code[j] == kNonFiniteCode ? killSlots - 1 : code[j] - 1u];
   };
   const Lanes lanes = g.lanePointers();
+  const bool bounds = g.boundsWanted && lanes.p[0];
+  if (bounds) g.blockBounds.resize(6 * blocks);  // grows, never shrinks
   Plan plan{planActions(g), substepCount(g, sp, *sp.pool)};
   if (plan.list.guarded) {
     // Where each particle began the step: the guard compares with it.
@@ -543,6 +574,7 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
           g.culledCount[b] += culler.culled;
         }
         guardFinite(blockLanes, m, dead.data(), plan.list.guardVelocity);
+        if (bounds) liveBounds(blockLanes, m, dead.data(), g.blockBounds.data() + 6 * b);
         g.deadCount[b] = collectDead(g, first, m, dead.data());
         tally(b, g.deadCount[b]);
         store.clean = true;
@@ -570,6 +602,9 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
     sp.pool->parallelFor(blocks, [&](std::size_t b) {
       const std::size_t first = b * B, m = std::min(B, n - first);
       guardFinite(lanes.offset(first), m, g.deadFlags.data() + first, plan.list.guardVelocity);
+      if (bounds)
+        liveBounds(lanes.offset(first), m, g.deadFlags.data() + first,
+                   g.blockBounds.data() + 6 * b);
       g.deadCount[b] = collectDead(g, first, m, g.deadFlags.data() + first);
       tally(b, g.deadCount[b]);
     });
@@ -579,6 +614,18 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
     g.stats.blockActionsCulled += g.culledCount[b];
     const std::uint32_t* idx = g.deadIndex.data() + b * B;
     g.holes.insert(g.holes.end(), idx, idx + g.deadCount[b]);  // within the capacity
+  }
+  if (bounds) {
+    Bounds& box = g.stepBounds;
+    box.min = Vec3(kInfinity);
+    box.max = Vec3(-kInfinity);
+    for (std::size_t b = 0; b < blocks; ++b)
+      for (int c = 0; c < 3; ++c) {
+        box.min[c] = std::min(box.min[c], g.blockBounds[6 * b + c]);
+        box.max[c] = std::max(box.max[c], g.blockBounds[6 * b + 3 + c]);
+      }
+    box.empty = !(box.min.x <= box.max.x);  // every particle died (the group is empty then)
+    g.boundsValid = true;
   }
   for (std::size_t a = 0; a < killSlots; ++a) {
     std::uint64_t killed = 0;

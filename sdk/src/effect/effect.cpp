@@ -1092,6 +1092,18 @@ EffectInstance& EffectInstance::setTransform(const Transform& transform) {
   return *this;
 }
 
+Bounds EffectInstance::bounds() const {
+  Bounds all;
+  for (const Group* g : groups_) {
+    const Bounds b = g->bounds();
+    if (b.empty) continue;
+    all.min = all.empty ? b.min : glm::min(all.min, b.min);
+    all.max = all.empty ? b.max : glm::max(all.max, b.max);
+    all.empty = false;
+  }
+  return all;
+}
+
 std::uint64_t EffectInstance::prewarm(double seconds) {
   if (!context_) throw Error("prewarm: an empty EffectInstance (use Effect::instantiate)");
   return context_->prewarm(groups_, seconds);
