@@ -107,6 +107,7 @@ Group& Context::createGroup(std::string name, std::size_t capacity) {
   auto& freed = impl_->freeIndices;
   const bool reuse = !freed.empty();
   gi->index = reuse ? freed.front() : impl_->nextIndex;
+  gi->onDevice = impl_->backendKind != Backend::Cpu;
   gi->ensureStorage();
   impl_->groups.reserve(impl_->groups.size() + 1);  // nothing below throws
   impl_->byName.reserve(impl_->byName.size() + 1);
@@ -167,6 +168,7 @@ void stepGroup(detail::BackendImpl& backend, detail::GroupImpl& gi, const detail
   gi.placeEmitters();
   gi.ensureStorage();
   gi.boundsValid = false;  // the CPU pass takes them again
+  gi.deathEvents.clear();
   if (gi.stats.killedByAction.size() != gi.actions.size())
     gi.stats.killedByAction.assign(gi.actions.size(), 0);
   backend.step(gi, sp);

@@ -6,6 +6,7 @@
 #include <limits>
 #include <new>
 
+#include "action_traits.hpp"
 #include "flurry/error.hpp"
 #include "group_impl.hpp"
 #include "transform.hpp"
@@ -554,6 +555,46 @@ std::span<const std::uint32_t> Group::visible() const {
 const GroupStats& Group::stats() const {
   impl_->syncStats();
   return impl_->stats;
+}
+
+void detail::GroupImpl::recordDeaths(std::size_t B, std::size_t blocks, double t1) {
+  const Lanes L = lanePointers();
+  for (std::size_t b = 0; b < blocks; ++b)
+    for (std::uint32_t j = 0; j < deadCount[b]; ++j) {
+      if (deathEvents.size() == deathsPerStep) {
+        stats.deathEventsDropped += deadCount[b] - j;
+        break;
+      }
+      const std::size_t i = deadIndex[b * B + j];
+      const std::uint8_t code = deadCode[b * B + j];
+      DeathEvent e;
+      for (int c = 0; c < 3; ++c) {
+        e.position[c] = L.p[c][i];
+        if (L.v[0]) e.velocity[c] = L.v[c][i];
+      }
+      e.id = L.id ? L.id[i] : 0u;
+      e.action = code == detail::kNonFiniteCode ? DeathEvent::kNonFinite : std::uint32_t(code) - 1u;
+      e.time = t1;
+      deathEvents.push_back(e);  // within the room reserved by Group::recordDeaths
+    }
+}
+
+Group& Group::recordDeaths(std::size_t perStep) {
+  auto& g = *impl_;
+  if (perStep > 0 && g.onDevice)
+    throw Error("recordDeaths: group '" + g.name +
+                "': death events are recorded by the CPU backend only (this context runs on "
+                "a device)");
+  if (perStep > 0) require({Attribute::Id});
+  // No step has more deaths than the group holds particles.
+  g.deathEvents.clear();
+  g.deathEvents.reserve(std::min(perStep, g.capacity));
+  g.deathsPerStep = perStep;
+  return *this;
+}
+
+std::span<const DeathEvent> Group::deaths() const {
+  return impl_->deathEvents;
 }
 
 Bounds Group::bounds() const {

@@ -203,6 +203,9 @@ struct GroupImpl {
   std::vector<std::uint8_t> deadCode;      ///< 1 + index of the action that killed
   std::vector<std::uint32_t> deadCount;    ///< per block
   std::vector<std::uint32_t> culledCount;  ///< per block: actions the fused pass skipped
+  std::size_t deathsPerStep = 0;           ///< Group::recordDeaths; 0: not recording
+  std::vector<DeathEvent> deathEvents;     ///< the last step's, reserved by recordDeaths
+  bool onDevice = false;                   ///< its context runs a device backend
   /// Group::bounds() was asked: from then on the CPU pass takes the live particles' box
   /// every step, each block while it is in cache (no pass of its own).
   bool boundsWanted = false;
@@ -266,6 +269,10 @@ struct GroupImpl {
   /// frees lanes nobody uses any more.
   void ensureStorage();
   Lanes lanePointers() const;
+  /// The step's dead (deadIndex/deadCode of `blocks` blocks of B, their lanes not yet
+  /// compacted) as DeathEvents at time t1, in particle order up to deathsPerStep; the rest
+  /// counted. Out of line in group.cpp for the reason of assignFill.
+  void recordDeaths(std::size_t B, std::size_t blocks, double t1);
   /// Writes particle p's stored attributes at index i.
   void write(std::size_t i, const Particle& p) { writeParticle(lanePointers(), i, p); }
   Particle read(std::size_t i) const { return readParticle(lanePointers(), i); }

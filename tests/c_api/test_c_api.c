@@ -450,6 +450,8 @@ static void test_group(const char* out_dir) {
   float* vy = NULL;
   const uint32_t* ids = NULL;
   const uint64_t* per = NULL;
+  const flurry_death_event* deaths = NULL;
+  uint64_t dropped = 1, died = 0, by_age = 0, absorbed = 0;
   size_t n = 0, count = 0, stride = 0, cap = 0, written = 0, k;
   int stored = -1, empty = -1, step;
   float lo[3], hi[3];
@@ -527,8 +529,16 @@ static void test_group(const char* out_dir) {
   OK(flurry_group_bounds(g, lo, hi, &empty));
   CHECK(empty == 1);
 
+  OK(flurry_group_record_deaths(g, 100000));
   for (step = 0; step < 40; ++step) {
     OK(flurry_context_step(ctx));
+    OK(flurry_group_deaths(g, &deaths, &count, &dropped));
+    for (k = 0; k < count; ++k) {
+      died++;
+      by_age += deaths[k].action == 4;
+      absorbed += deaths[k].action == 2;
+      CHECK(deaths[k].time > 0.0 && deaths[k].action != FLURRY_DEATH_NON_FINITE);
+    }
     OK(flurry_group_size(g, &n));
     OK(flurry_group_lane(g, FLURRY_ATTR_POSITION, 1, &y, &count, &stride));
     CHECK(count == n && stride == sizeof(float));
@@ -560,6 +570,13 @@ static void test_group(const char* out_dir) {
   CHECK(st.emitted > 0 && st.killed_by_age > 0 && st.absorbed > 0);
   OK(flurry_group_killed_by_action(g, &per, &count));
   CHECK(count == 5 && per[2] == st.absorbed && per[4] == st.killed_by_age);
+  /* Every death was recorded, with what killed it. */
+  CHECK(dropped == 0 && died == st.killed_by_age + st.absorbed + st.killed_non_finite);
+  CHECK(by_age == st.killed_by_age && absorbed == st.absorbed);
+  FAILS(flurry_group_deaths(NULL, &deaths, &count, NULL), FLURRY_ERROR_NULL_ARGUMENT, "group");
+  FAILS(flurry_group_deaths(g, NULL, &count, NULL), FLURRY_ERROR_NULL_ARGUMENT, "events");
+  FAILS(flurry_group_record_deaths(NULL, 1), FLURRY_ERROR_NULL_ARGUMENT, "group");
+  OK(flurry_group_record_deaths(g, 0));
   OK(flurry_group_emitted_by_generation(g, &per, &count));
   CHECK(count >= 1 && per[0] == st.emitted);
 
@@ -753,6 +770,8 @@ static void test_instances(void) {
   float pos[3] = {5, 2, -3}, rot[4] = {0, 0, 0, 1}, back[3] = {0}, scale = 0;
   const float zero[4] = {0, 0, 0, 0};
   uint64_t steps = 0;
+  float lo[3], hi[3];
+  int empty = -1;
   OK(flurry_effect_parse(json, "t", &fx));
   OK(flurry_effect_context_options(fx, &o));
   OK(flurry_context_create(&o, &ctx));
@@ -774,6 +793,9 @@ static void test_instances(void) {
   OK(flurry_instance_group_at(b, 0, &g));
   OK(flurry_group_lane(g, FLURRY_ATTR_POSITION, 0, &x, &n, &stride));
   CHECK(n == 1 && x[0] == 0.0f); /* the other instance stayed at the origin */
+  OK(flurry_instance_bounds(a, lo, hi, &empty));
+  CHECK(empty == 0 && lo[0] == 5.0f && hi[0] == 5.0f && lo[2] == -3.0f);
+  FAILS(flurry_instance_bounds(NULL, lo, hi, &empty), FLURRY_ERROR_NULL_ARGUMENT, "instance");
   /* A refused transform leaves the instance where it was. */
   FAILS(flurry_instance_set_transform(a, pos, zero, 1), FLURRY_ERROR_INVALID_ARGUMENT,
         "transform.rotation");

@@ -227,6 +227,24 @@ TEST(OpenCLBackend, ClearAndRequireBetweenSteps) {
   EXPECT_GT(g.particle(0).size, 0.0f);
 }
 
+// Death events are the CPU's for now: asking a device context is a clear error, not an empty
+// list the game would take for "nobody died"; the group steps on.
+TEST(OpenCLBackend, DeathEventsAreAClearErrorOnTheDevice) {
+  FLURRY_REQUIRE_OPENCL();
+  Context ctx(openclOptions());
+  Group& g = samples::buildFountain(ctx, 2000, 3000, 0.2f);
+  try {
+    g.recordDeaths(100);
+    FAIL() << "recordDeaths on a device context did not throw";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("CPU backend only"), std::string::npos) << e.what();
+  }
+  g.recordDeaths(0);  // turning it off is fine
+  ctx.run(5);
+  EXPECT_GT(g.size(), 0u);
+  EXPECT_TRUE(g.deaths().empty());
+}
+
 // A group larger than one device buffer may be: a clear error, and the group stays usable.
 TEST(OpenCLBackend, TooLargeForTheDeviceIsAClearError) {
   FLURRY_REQUIRE_OPENCL();

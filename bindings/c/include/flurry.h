@@ -304,6 +304,10 @@ FLURRY_C_EXPORT flurry_status flurry_instance_group_count(const flurry_instance*
 /** Group `index` of the instance, in the effect's order (FLURRY_ERROR_NOT_FOUND past them). */
 FLURRY_C_EXPORT flurry_status flurry_instance_group_at(const flurry_instance* instance,
                                                        size_t index, flurry_group** out);
+/** The union of the instance's groups' bounds, for an engine's culling (*empty 1 when no
+ * particle lives). Kept by the CPU pass every step once asked. */
+FLURRY_C_EXPORT flurry_status flurry_instance_bounds(const flurry_instance* instance, float min[3],
+                                                     float max[3], int* empty);
 
 /** Live particles: indices [0, size). */
 FLURRY_C_EXPORT flurry_status flurry_group_size(const flurry_group* group, size_t* size);
@@ -343,6 +347,29 @@ FLURRY_C_EXPORT flurry_status flurry_group_visible(const flurry_group* group, co
 /** Axis-aligned bounds of the live particles (*empty 1 when there are none). */
 FLURRY_C_EXPORT flurry_status flurry_group_bounds(const flurry_group* group, float min[3],
                                                   float max[3], int* empty);
+
+/** flurry_death_event.action of a particle killed for being NaN or infinite. */
+#define FLURRY_DEATH_NON_FINITE 0xFFFFFFFFu
+
+/** A particle's death (flurry::DeathEvent): where it was and how fast it went at the end of
+ * the step that killed it. */
+typedef struct flurry_death_event {
+  float position[3];
+  float velocity[3]; /**< zero when the group stores no velocity */
+  uint32_t id;
+  uint32_t action; /**< index in the action list of what killed it, or FLURRY_DEATH_NON_FINITE */
+  double time;     /**< the end of the step it died in */
+} flurry_death_event;
+
+/** Records each step's deaths, at most `per_step` a step (the first in particle order; the
+ * rest counted in flurry_group_deaths' *dropped); 0 stops. CPU backend only: on a device
+ * FLURRY_ERROR_OTHER says so. */
+FLURRY_C_EXPORT flurry_status flurry_group_record_deaths(flurry_group* group, size_t per_step);
+/** The last step's deaths (valid until the next step); *dropped (may be NULL) gets the deaths
+ * not recorded for want of room, over the group's life. */
+FLURRY_C_EXPORT flurry_status flurry_group_deaths(const flurry_group* group,
+                                                  const flurry_death_event** events, size_t* count,
+                                                  uint64_t* dropped);
 
 /** Where the particles went (flurry::GroupStats):
  * emitted == size + killed_by_age + absorbed + dropped_at_capacity + killed_non_finite. */

@@ -6,6 +6,7 @@
 #include "flurry.h"
 
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <memory>
 #include <new>
@@ -901,6 +902,18 @@ flurry_status flurry_instance_group_at(const flurry_instance* inst, size_t index
     *out = handle(*all[index]);
   });
 }
+flurry_status flurry_instance_bounds(const flurry_instance* inst, float min[3], float max[3],
+                                     int* empty) {
+  return guard([&] {
+    need(inst, "instance");
+    need(min, "min");
+    need(max, "max");
+    need(empty, "empty");
+    const flurry::Bounds b = inst->instance.bounds();
+    for (int k = 0; k < 3; ++k) min[k] = b.min[k], max[k] = b.max[k];
+    *empty = b.empty ? 1 : 0;
+  });
+}
 flurry_status flurry_group_size(const flurry_group* g, size_t* size) {
   return guard([&] {
     need(g, "group");
@@ -1016,6 +1029,29 @@ flurry_status flurry_group_bounds(const flurry_group* g, float min[3], float max
     const flurry::Bounds b = group(g).bounds();
     for (int k = 0; k < 3; ++k) min[k] = b.min[k], max[k] = b.max[k];
     *empty = b.empty ? 1 : 0;
+  });
+}
+// The C event is the C++ one, field for field: deaths() is handed out without a copy.
+static_assert(sizeof(flurry_death_event) == sizeof(flurry::DeathEvent));
+static_assert(offsetof(flurry_death_event, id) == offsetof(flurry::DeathEvent, id));
+static_assert(offsetof(flurry_death_event, time) == offsetof(flurry::DeathEvent, time));
+static_assert(FLURRY_DEATH_NON_FINITE == flurry::DeathEvent::kNonFinite);
+flurry_status flurry_group_record_deaths(flurry_group* g, size_t perStep) {
+  return guard([&] {
+    need(g, "group");
+    group(g).recordDeaths(perStep);
+  });
+}
+flurry_status flurry_group_deaths(const flurry_group* g, const flurry_death_event** events,
+                                  size_t* count, uint64_t* dropped) {
+  return guard([&] {
+    need(g, "group");
+    need(events, "events");
+    need(count, "count");
+    const std::span<const flurry::DeathEvent> d = group(g).deaths();
+    *events = reinterpret_cast<const flurry_death_event*>(d.data());
+    *count = d.size();
+    if (dropped) *dropped = group(g).stats().deathEventsDropped;
   });
 }
 flurry_status flurry_group_stats_get(const flurry_group* g, flurry_group_stats* out) {

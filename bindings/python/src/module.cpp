@@ -227,6 +227,13 @@ void step(ContextBox& pc, std::size_t steps) {
   }
 }
 
+// A Bounds as Python sees it: None when nothing lives, else ((min x, y, z), (max x, y, z)).
+nb::object boundsOf(const flurry::Bounds& b) {
+  if (b.empty) return nb::none();
+  return nb::make_tuple(nb::make_tuple(b.min.x, b.min.y, b.min.z),
+                        nb::make_tuple(b.max.x, b.max.y, b.max.z));
+}
+
 }  // namespace
 
 NB_MODULE(_flurry, m) {
@@ -283,6 +290,7 @@ NB_MODULE(_flurry, m) {
       .def_ro("emitters_dropped", &flurry::GroupStats::emittersDropped)
       .def_ro("idle_steps", &flurry::GroupStats::idleSteps)
       .def_ro("block_actions_culled", &flurry::GroupStats::blockActionsCulled)
+      .def_ro("death_events_dropped", &flurry::GroupStats::deathEventsDropped)
       .def("__repr__", [](const flurry::GroupStats& s) {
         return "GroupStats(emitted=" + std::to_string(s.emitted) +
                ", killed_by_age=" + std::to_string(s.killedByAge) +
@@ -347,6 +355,42 @@ NB_MODULE(_flurry, m) {
           },
           "Hair mode's strands, copied: position (v, 3), color (v, 4), radius (v,), and start "
           "(strands + 1,): strand k is vertices start[k]:start[k+1].")
+      .def(
+          "bounds", [](const GroupRef& pg) { return boundsOf(pg.g->bounds()); },
+          "The live particles' axis-aligned box, ((x, y, z), (x, y, z)), or None when none "
+          "lives; once asked, the CPU pass keeps it every step.")
+      .def(
+          "record_deaths", [](GroupRef& pg, std::size_t perStep) { pg.g->recordDeaths(perStep); },
+          "per_step"_a,
+          "Records each step's deaths, at most per_step a step (the first in particle order; "
+          "the rest counted in stats.death_events_dropped); 0 stops. CPU backend only.")
+      .def(
+          "deaths",
+          [](const GroupRef& pg) {
+            // Copies: the events are replaced by the next step.
+            const auto d = pg.g->deaths();
+            const std::size_t n = d.size();
+            std::vector<float> pos(n * 3), vel(n * 3);
+            std::vector<std::uint32_t> id(n), action(n);
+            std::vector<double> time(n);
+            for (std::size_t i = 0; i < n; ++i) {
+              for (int c = 0; c < 3; ++c) {
+                pos[i * 3 + c] = d[i].position[c];
+                vel[i * 3 + c] = d[i].velocity[c];
+              }
+              id[i] = d[i].id, action[i] = d[i].action, time[i] = d[i].time;
+            }
+            nb::dict out;
+            out["position"] = owned(std::move(pos), {n, 3});
+            out["velocity"] = owned(std::move(vel), {n, 3});
+            out["id"] = owned(std::move(id), {n});
+            out["action"] = owned(std::move(action), {n});
+            out["time"] = owned(std::move(time), {n});
+            return out;
+          },
+          "The last step's deaths (record_deaths), copied: position (n, 3), velocity (n, 3), "
+          "id (n,), action (n,): the index in the action list of what killed it, or "
+          "0xFFFFFFFF for a NaN or infinity, and time (n,): the end of the step.")
       .def(
           "sync", [](GroupRef& pg) { std::as_const(*pg.g).ids(); },
           "Brings the host copy up to date (OpenCL); Context.step does it for groups with views.")
@@ -523,7 +567,10 @@ NB_MODULE(_flurry, m) {
             nb::gil_scoped_release release;
             return pi.instance.prewarm(seconds);
           },
-          "seconds"_a, "Starts the instance as if it had run `seconds`; returns the steps taken.");
+          "seconds"_a, "Starts the instance as if it had run `seconds`; returns the steps taken.")
+      .def(
+          "bounds", [](const InstanceRef& pi) { return boundsOf(pi.instance.bounds()); },
+          "The union of its groups' bounds, or None when no particle lives.");
 
   m.def(
       "load",

@@ -318,6 +318,34 @@ def test_an_instance_is_placed_and_prewarmed():
     torch.set_transform((4, 1, -2), turn, 1.0)  # the live flames come along, one unit up
     assert int((flames.lane("position", 1) > 0.99).sum()) == len(flames)
 
+    # Its box holds both places' flames: the union of its groups' bounds.
+    lo, hi = torch.bounds()
+    assert lo[0] < 1 and hi[0] > 3
+    assert (lo, hi) == flames.bounds()
+
+
+def test_deaths_are_recorded_with_what_killed_them():
+    ctx = fountain()
+    g = ctx.groups[0]
+    g.record_deaths(100000)
+    seen, causes = 0, set()
+    before = g.stats
+    for _ in range(150):
+        ctx.step()
+        d = g.deaths()
+        assert d["position"].shape == (len(d["id"]), 3) and d["velocity"].shape == d["position"].shape
+        assert np.all(d["time"] == pytest.approx(ctx.time))
+        seen += len(d["id"])
+        causes.update(int(a) for a in d["action"])
+    s = g.stats
+    died = (s.killed_by_age + s.absorbed + s.killed_non_finite) - (
+        before.killed_by_age + before.absorbed + before.killed_non_finite)
+    assert seen == died > 0 and s.death_events_dropped == 0
+    assert all(a < len(ctx.groups[0].stats.killed_by_action) for a in causes)
+    g.record_deaths(0)
+    ctx.step()
+    assert len(g.deaths()["id"]) == 0
+
 
 def test_bad_transforms_name_the_field():
     ctx = flurry.Context(threads=1)

@@ -91,6 +91,21 @@ struct GroupStats {
   /// a reader asked for them (lane(), particle(), bounds(), fetch(), an exporter): each stored
   /// attribute crosses at most once per step, and only if read. The CPU backend leaves it 0.
   std::uint64_t bytesReadBack = 0;
+  /// Deaths not recorded because a step had more than Group::recordDeaths' capacity.
+  std::uint64_t deathEventsDropped = 0;
+};
+
+/// A particle's death, recorded for the game (Group::recordDeaths): where the particle was
+/// and how fast it went at the end of the step that killed it.
+struct DeathEvent {
+  /// `action` of a particle killed because the step left it NaN or infinite.
+  static constexpr std::uint32_t kNonFinite = 0xFFFFFFFFu;
+  Vec3 position{0.0f};
+  Vec3 velocity{0.0f};  ///< zero when the group stores no velocity
+  std::uint32_t id = 0;
+  /// The index in the action list of what killed it (a KillOld, a Sink, ...), or kNonFinite.
+  std::uint32_t action = 0;
+  double time = 0.0;  ///< the end of the step it died in
 };
 
 struct Bounds {
@@ -173,6 +188,16 @@ class Group {
   std::span<const std::uint32_t> visible() const;
 
   const GroupStats& stats() const;
+
+  /// Records every step's deaths (by age, by an absorber, for a NaN) as DeathEvents for the
+  /// game to read after the step (deaths()), at most `perStep` a step: the first in particle
+  /// order, the same on any thread count; the rest are counted in
+  /// GroupStats::deathEventsDropped. 0 stops it. The room is taken here, not per step, and
+  /// while off it costs nothing. Stores ids (the events carry them). The CPU backend
+  /// records them; a device backend throws Error (not yet there).
+  Group& recordDeaths(std::size_t perStep);
+  /// The deaths of the last step (empty when not recording), valid until the next step.
+  std::span<const DeathEvent> deaths() const;
   /// Axis-aligned bounds of the live particles' positions, in the world (for an engine's
   /// culling). The first call takes them in a pass of its own; from then on the CPU backend
   /// keeps them every step inside its action pass, while each block of particles is in cache,
