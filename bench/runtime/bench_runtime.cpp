@@ -7,7 +7,8 @@
 //
 // (one command line).
 //
-// After the runs it prints the ratio of the medians, per thread count.
+// After the runs it prints the ratio of the medians, per thread count, what bounds every step
+// cost, and what a recorded death event costs (Deaths: recording on against off).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -47,6 +48,7 @@ std::string sparks(std::size_t rate) {
 }
 
 constexpr std::size_t kPerInstance = 100;
+std::map<std::int64_t, double> deathsPerStep_;  // Deaths' mean deaths a step, by threads
 
 // Where instance k of `count` stands: a grid on the ground, each turned its own way.
 Transform placeOf(std::size_t k, std::size_t count) {
@@ -116,6 +118,31 @@ void OneGroup(benchmark::State& state) {
   state.counters["live"] = live / double(state.iterations());
 }
 
+// Death events: the same 1M-particle group (a thirtieth dying each step) with recording off
+// (range 0 = 0) and on (1): the difference over the deaths is the cost of one event.
+void Deaths(benchmark::State& state) {
+  ContextOptions o;
+  o.threads = unsigned(state.range(1));
+  Context ctx(o);
+  const Effect effect = parseEffect(sparks(kPerInstance * 10000));
+  EffectInstance one = effect.instantiate(ctx, "all");
+  Group& g = *one.groups()[0];
+  g.recordDeaths(state.range(0) != 0 ? g.capacity() : 0);
+  ctx.run(45);
+  double died = 0;
+  for (auto _ : state) {
+    const GroupStats before = g.stats();
+    ctx.step();
+    state.PauseTiming();
+    died += double(g.stats().killedByAge - before.killedByAge + g.stats().absorbed -
+                   before.absorbed);
+    state.ResumeTiming();
+  }
+  benchmark::DoNotOptimize(g.deaths().data());
+  state.counters["deaths"] = died / double(state.iterations());
+  deathsPerStep_[state.range(1)] = died / double(state.iterations());
+}
+
 void args(benchmark::internal::Benchmark* b) {
   const auto cores = int(std::max(1u, std::thread::hardware_concurrency()));
   for (int t : {1, cores}) {
@@ -127,6 +154,14 @@ void args(benchmark::internal::Benchmark* b) {
 
 BENCHMARK(Instances)->Apply(args);
 BENCHMARK(OneGroup)->Apply(args);
+BENCHMARK(Deaths)->Apply([](benchmark::internal::Benchmark* b) {
+  const auto cores = int(std::max(1u, std::thread::hardware_concurrency()));
+  for (int t : {1, cores}) {
+    for (int record : {0, 1}) b->Args({record, t});
+    if (cores == 1) break;
+  }
+  b->ArgNames({"record", "threads"})->Unit(benchmark::kMillisecond)->UseRealTime();
+});
 
 // Prints the ratio of the medians (or single runs) of the two, per thread count.
 class RatioReporter : public benchmark::ConsoleReporter {
@@ -160,6 +195,20 @@ class RatioReporter : public benchmark::ConsoleReporter {
       if (without == ms_.end()) continue;
       std::printf("  %s: bounds every step %.2f ms, none %.2f ms: %.3fx\n",
                   name.substr(0, at).c_str(), ms, without->second, ms / without->second);
+    }
+    // What a recorded death costs: the step with recording on less off, over the deaths.
+    for (const auto& [name, ms] : ms_) {
+      const auto at = name.find("Deaths/record:1/threads:");
+      if (at != 0) continue;
+      const std::string threads = name.substr(std::string("Deaths/record:1/threads:").size());
+      const auto off = ms_.find("Deaths/record:0/threads:" + threads);
+      const auto died = deathsPerStep_.find(std::stoll(threads));
+      if (off == ms_.end() || died == deathsPerStep_.end() || died->second <= 0) continue;
+      std::printf(
+          "  death events, threads:%s: %.0f deaths a step, recorded %.3f ms, off %.3f ms: "
+          "%.1f ns an event\n",
+          threads.c_str(), died->second, ms, off->second,
+          (ms - off->second) * 1e6 / died->second);
     }
   }
 
