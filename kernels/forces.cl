@@ -390,37 +390,10 @@ FL_INLINE void fl_speed_clamp(__global const FlActionParams* a, float* vx, float
 /* ---- Curves over life: u[0] the first key's float in extra, u[1] keys; a key is t then
  * its value (ColorOverLife: r g b a, SizeOverLife: size) ---------------------------------- */
 
-/* actions_more.hpp lookup(): keys of `stride` floats (t, then stride - 1 values) into out. */
-FL_INLINE void fl_force_lookup(__global const float* keys, uint count, uint stride, float t,
-                               float* out) {
-  uint hi = 0;
-  float w = 0.0f;
-  if (t <= keys[0]) {
-    hi = 0;
-  } else {
-    hi = count; /* past the last key: its value */
-    for (uint k = 1; k < count; ++k) {
-      if (t <= keys[k * stride]) {
-        w = fl_key_weight(keys[(k - 1) * stride], keys[k * stride], t);
-        hi = k;
-        break;
-      }
-    }
-  }
-  if (hi == 0 || hi == count) {
-    __global const float* v = keys + (hi == 0 ? 0u : (count - 1) * stride) + 1;
-    for (uint c = 0; c + 1 < stride; ++c) out[c] = v[c];
-    return;
-  }
-  __global const float* v0 = keys + (hi - 1) * stride + 1;
-  __global const float* v1 = keys + hi * stride + 1;
-  for (uint c = 0; c + 1 < stride; ++c) out[c] = v0[c] + (v1[c] - v0[c]) * w;
-}
-
 FL_INLINE void fl_color_over_life(__global const FlActionParams* a, __global const float* extra,
                                   float age, float life, float* r, float* g, float* b, float* al) {
   float c[4];
-  fl_force_lookup(extra + a->u[0], a->u[1], 5u, fl_life_fraction(age, life), c);
+  fl_curve_lookup(extra + a->u[0], a->u[1], 5u, fl_life_fraction(age, life), c);
   *r = c[0];
   *g = c[1];
   *b = c[2];
@@ -430,7 +403,7 @@ FL_INLINE void fl_color_over_life(__global const FlActionParams* a, __global con
 FL_INLINE void fl_size_over_life(__global const FlActionParams* a, __global const float* extra,
                                  float age, float life, float* size) {
   float s[1];
-  fl_force_lookup(extra + a->u[0], a->u[1], 2u, fl_life_fraction(age, life), s);
+  fl_curve_lookup(extra + a->u[0], a->u[1], 2u, fl_life_fraction(age, life), s);
   *size = s[0];
 }
 
@@ -440,7 +413,7 @@ FL_INLINE void fl_color_over_life_scaled(__global const FlActionParams* a,
                                          float r0, float g0, float b0, float a0, float* r, float* g,
                                          float* b, float* al) {
   float c[4];
-  fl_force_lookup(extra + a->u[0], a->u[1], 5u, fl_life_fraction(age, life), c);
+  fl_curve_lookup(extra + a->u[0], a->u[1], 5u, fl_life_fraction(age, life), c);
   *r = r0 * c[0];
   *g = g0 * c[1];
   *b = b0 * c[2];
@@ -451,6 +424,6 @@ FL_INLINE void fl_size_over_life_scaled(__global const FlActionParams* a,
                                         __global const float* extra, float age, float life,
                                         float size0, float* size) {
   float s[1];
-  fl_force_lookup(extra + a->u[0], a->u[1], 2u, fl_life_fraction(age, life), s);
+  fl_curve_lookup(extra + a->u[0], a->u[1], 2u, fl_life_fraction(age, life), s);
   *size = size0 * s[0];
 }

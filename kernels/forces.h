@@ -338,4 +338,32 @@ FL_INLINE float fl_key_weight(float t0, float t1, float t) {
   return span > 0.0f ? (t - t0) / span : 1.0f;
 }
 
+/* A curve's value at t (ColorOverLife, SizeOverLife): `count` keys of `stride` floats, its t
+ * then stride - 1 values, t ascending. Before the first key the first's values, past the
+ * last the last's, linear in between (a key found by walking: curves have a few keys). */
+FL_INLINE void fl_curve_lookup(const FL_GLOBAL float* keys, uint count, uint stride, float t,
+                               float* out) {
+  uint hi = count; /* past the last key: its value */
+  float w = 0.0f;
+  if (t <= keys[0]) {
+    hi = 0;
+  } else {
+    for (uint k = 1; k < count; ++k) {
+      if (t <= keys[k * stride]) {
+        w = fl_key_weight(keys[(k - 1) * stride], keys[k * stride], t);
+        hi = k;
+        break;
+      }
+    }
+  }
+  if (hi == 0 || hi == count) {
+    const FL_GLOBAL float* v = keys + (hi == 0 ? 0u : (count - 1) * stride) + 1;
+    for (uint c = 0; c + 1 < stride; ++c) out[c] = v[c];
+    return;
+  }
+  const FL_GLOBAL float* v0 = keys + (hi - 1) * stride + 1;
+  const FL_GLOBAL float* v1 = keys + hi * stride + 1;
+  for (uint c = 0; c + 1 < stride; ++c) out[c] = v0[c] + (v1[c] - v0[c]) * w;
+}
+
 #endif /* FLURRY_KERNELS_FORCES_H */

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 
 #include "../field_math.hpp"
 #include "../isa_namespace.hpp"
@@ -517,16 +518,14 @@ inline void apply(const SpeedClamp& a, const Lanes& L, std::size_t n, const Bloc
   }
 }
 
-template <class Keys, class Value>
-inline Value lookup(const Keys& keys, float t, Value (*value)(const typename Keys::value_type&)) {
-  if (t <= keys.front().t) return value(keys.front());
-  for (std::size_t k = 1; k < keys.size(); ++k) {
-    if (t <= keys[k].t) {
-      const float w = kernel::fl_key_weight(keys[k - 1].t, keys[k].t, t);
-      return value(keys[k - 1]) + (value(keys[k]) - value(keys[k - 1])) * w;
-    }
-  }
-  return value(keys.back());
+// The keys as the shared lookup reads them: t, then the values, packed.
+static_assert(sizeof(ColorOverLife::Key) == 5 * sizeof(float) &&
+              offsetof(ColorOverLife::Key, color) == sizeof(float));
+static_assert(sizeof(SizeOverLife::Key) == 2 * sizeof(float) &&
+              offsetof(SizeOverLife::Key, size) == sizeof(float));
+template <class Key>
+inline const float* keyFloats(const std::vector<Key>& keys) {
+  return reinterpret_cast<const float*>(keys.data());
 }
 inline float lifeFraction(const Lanes& L, std::size_t i) {
   return kernel::fl_life_fraction(L.age[i], L.lifetime[i]);
@@ -535,17 +534,19 @@ inline float lifeFraction(const Lanes& L, std::size_t i) {
 inline void apply(const ColorOverLife& a, const Lanes& L, std::size_t n, const BlockContext&) {
   const bool multiply = a.mode == OverLifeMode::Multiply;
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec4 col = lookup<std::vector<ColorOverLife::Key>, Vec4>(
-        a.keys, lifeFraction(L, i), [](const ColorOverLife::Key& k) { return k.color; });
+    float col[4];
+    kernel::fl_curve_lookup(keyFloats(a.keys), kernel::uint(a.keys.size()), 5u, lifeFraction(L, i),
+                            col);
     for (int d = 0; d < 4; ++d) L.color[d][i] = multiply ? L.birthColor[d][i] * col[d] : col[d];
   }
 }
 inline void apply(const SizeOverLife& a, const Lanes& L, std::size_t n, const BlockContext&) {
   const bool multiply = a.mode == OverLifeMode::Multiply;
   for (std::size_t i = 0; i < n; ++i) {
-    const float s = lookup<std::vector<SizeOverLife::Key>, float>(
-        a.keys, lifeFraction(L, i), [](const SizeOverLife::Key& k) { return k.size; });
-    L.size[i] = multiply ? L.birthSize[i] * s : s;
+    float s[1];
+    kernel::fl_curve_lookup(keyFloats(a.keys), kernel::uint(a.keys.size()), 2u, lifeFraction(L, i),
+                            s);
+    L.size[i] = multiply ? L.birthSize[i] * s[0] : s[0];
   }
 }
 
