@@ -667,6 +667,201 @@ TEST(Group, DeathEventsSayWhoDiedWhereAndOfWhat) {
   EXPECT_EQ(causes.size(), 2u);       // of age and in the sink
 }
 
+// A death emitter gives each death of its source its count of newborns, at the place of death,
+// with the type's velocity plus the inherited share, born at the end of the step (age 0) and
+// then run through the whole action list.
+TEST(DeathEmitter, EachDeathGivesItsCountWhereItDied) {
+  ContextOptions o;
+  o.dt = 0.125;  // exact in binary: places and ages are exact
+  Context ctx(o);
+  Group& drops = ctx.createGroup("drops", 16);
+  drops.setActions({Move{}, KillOld{}});
+  Group& splash = ctx.createGroup("splash", 64);
+  splash.setActions({Move{}, KillOld{}});
+  DeathEmitter de;
+  de.source = "drops";
+  de.count = 3.0f;
+  de.inheritVelocity = 0.5f;
+  de.types[0].velocity = Domain::point(Vec3(0.0f, 1.0f, 0.0f));
+  de.types[0].lifetime = 10.0f;
+  splash.addDeathEmitter(de);
+  for (int k = 0; k < 5; ++k) {
+    Particle p;
+    p.position = Vec3(float(k), 1.0f, 0.0f);
+    p.velocity = Vec3(0.0f, 2.0f, 0.5f);
+    p.lifetime = 0.3f;  // dies in the third step
+    ASSERT_TRUE(drops.add(p));
+  }
+  ctx.run(2);
+  EXPECT_EQ(splash.size(), 0u);
+  ctx.step();
+  EXPECT_EQ(drops.size(), 0u);
+  ASSERT_EQ(splash.size(), 15u);
+  EXPECT_EQ(splash.stats().emitted, 15u);
+  std::set<std::uint32_t> ids;
+  for (std::size_t i = 0; i < 15; ++i) {
+    const Particle p = splash.particle(i);
+    const std::size_t k = i / 3;  // the deaths in particle order, each's newborns together
+    EXPECT_EQ(p.position, Vec3(float(k), 1.0f + 3 * 0.25f, 3 * 0.0625f)) << i;
+    EXPECT_EQ(p.velocity, Vec3(0.0f, 2.0f, 0.25f)) << i;  // (0, 1, 0) + 0.5 (0, 2, 0.5)
+    EXPECT_EQ(p.age, 0.0f);
+    EXPECT_EQ(p.lifetime, 10.0f);
+    ids.insert(p.id);
+  }
+  EXPECT_EQ(ids.size(), 15u);
+  ctx.step();  // the newborns' first step: the whole list
+  EXPECT_EQ(splash.particle(0).position, Vec3(0.0f, 1.75f + 0.25f, 0.1875f + 0.03125f));
+  EXPECT_EQ(splash.particle(0).age, 0.125f);
+  EXPECT_EQ(splash.size(), 15u);
+}
+
+// The cause picks deaths by the action that killed: the floor's Sink, not old age; a
+// fractional count is a chance; a full group counts what it could not hold; and the whole is
+// bitwise the same on any thread count (a large source stepped on all threads, a small
+// target stepped beside other groups).
+TEST(DeathEmitter, ByCauseFractionalCountsAndThreadCounts) {
+  struct Result {
+    std::vector<float> lanes;
+    std::uint64_t absorbed = 0, old = 0;
+    GroupStats splash;
+    std::size_t size = 0;
+  };
+  auto run = [](unsigned threads) {
+    ContextOptions o;
+    o.threads = threads;
+    Context ctx(o);
+    Group& f = samples::buildFountain(ctx, 80000, 200000.0, 0.3f);
+    ActionList acts = f.actions();
+    const std::size_t sink = acts.size();
+    acts.add(Sink{Domain::box(Vec3(0.1f, -10.0f, -10.0f), Vec3(10.0f, 10.0f, 10.0f))});
+    f.setActions(std::move(acts));
+    for (int k = 0; k < 20; ++k) ctx.createGroup("other" + std::to_string(k), 100);
+    Group& splash = ctx.createGroup("splash", 3000);
+    splash.setActions({Gravity{Vec3(0.0f, -9.81f, 0.0f)}, Move{}, KillOld{}});
+    DeathEmitter de;
+    de.source = f.name();
+    de.count = 0.25f;
+    de.cause = std::int32_t(sink);
+    de.shape = Domain::sphere(Vec3(0.0f), 0.05f);
+    de.types[0].velocity = Domain::sphere(Vec3(0.0f, 2.0f, 0.0f), 1.0f);
+    de.types[0].lifetime = Fuzzy(0.2f, 0.05f);
+    splash.addDeathEmitter(de);
+    for (int s = 0; s < 30; ++s) {
+      ctx.step();
+      // The box the pass kept grew to hold the newborns written after it.
+      const Bounds b = splash.bounds();
+      for (int c = 0; c < 3; ++c) {
+        const auto p = splash.lane(Attribute::Position, c);
+        for (const float x : p) {
+          EXPECT_GE(x, b.min[c]);
+          EXPECT_LE(x, b.max[c]);
+        }
+      }
+    }
+    Result r;
+    r.absorbed = f.stats().absorbed;
+    r.old = f.stats().killedByAge;
+    r.splash = splash.stats();
+    r.size = splash.size();
+    for (int c = 0; c < 3; ++c) {
+      const auto p = splash.lane(Attribute::Position, c);
+      r.lanes.insert(r.lanes.end(), p.begin(), p.end());
+    }
+    return r;
+  };
+  const Result one = run(1);
+  ASSERT_GT(one.absorbed, 20000u);
+  ASSERT_GT(one.old, 20000u);
+  // A quarter of the sink's deaths, none of old age's: within 5 standard deviations.
+  const double mean = 0.25 * double(one.absorbed);
+  const double sd = std::sqrt(double(one.absorbed) * 0.25 * 0.75);
+  EXPECT_NEAR(double(one.splash.emitted), mean, 5 * sd);
+  EXPECT_GT(one.splash.droppedAtCapacity, 0u);  // 3000 could not hold them all
+  EXPECT_EQ(one.splash.emitted, one.size + one.splash.killedByAge + one.splash.droppedAtCapacity);
+  for (unsigned threads : {2u, 3u}) {
+    const Result r = run(threads);
+    EXPECT_EQ(r.splash.emitted, one.splash.emitted) << threads;
+    ASSERT_EQ(r.lanes.size(), one.lanes.size()) << threads;
+    EXPECT_EQ(std::memcmp(r.lanes.data(), one.lanes.data(), r.lanes.size() * sizeof(float)), 0)
+        << threads;
+  }
+}
+
+// A missing source is an error before anything steps; a bad field names itself; removing the
+// emitter (or its group) stops it.
+TEST(DeathEmitter, ErrorsAndRemoval) {
+  Context ctx;
+  Group& a = ctx.createGroup("a", 100);
+  a.setActions({Move{}, KillOld{}});
+  Emitter e;
+  e.rate = 1000;
+  e.types[0].lifetime = 0.05f;
+  a.addEmitter(e);
+  Group& b = ctx.createGroup("b", 1000);
+  DeathEmitter de;
+  de.source = "nobody";
+  b.addDeathEmitter(de);
+  try {
+    ctx.step();
+    FAIL() << "a missing source stepped";
+  } catch (const Error& err) {
+    EXPECT_NE(std::string(err.what()).find("deathEmitters[0].source: no group named 'nobody'"),
+              std::string::npos)
+        << err.what();
+  }
+  EXPECT_EQ(ctx.stepIndex(), 0u);  // nothing stepped
+  EXPECT_EQ(a.size(), 0u);
+  b.deathEmitters()[0].source = "a";
+  ctx.run(10);
+  EXPECT_GT(b.size(), 0u);
+  const std::size_t had = b.size();
+  b.removeDeathEmitter(0);
+  ctx.run(3);
+  EXPECT_EQ(b.size(), had);
+  EXPECT_THROW(b.removeDeathEmitter(0), InvalidArgument);
+  de.count = -1.0f;
+  try {
+    b.addDeathEmitter(de);
+    FAIL() << "a negative count was taken";
+  } catch (const InvalidArgument& err) {
+    EXPECT_EQ(err.parameter(), "deathEmitters[0].count");
+  }
+  de.count = 1.0f;
+  de.source = "";
+  EXPECT_THROW(b.addDeathEmitter(de), InvalidArgument);
+  // A group with a death emitter goes; its source steps on, and so does the context.
+  de.source = "a";
+  ctx.createGroup("c", 10).addDeathEmitter(de);
+  ctx.destroyGroup(ctx.group("c"));
+  ctx.destroyGroup(b);
+  ctx.run(3);
+  EXPECT_TRUE(a.deaths().empty());  // nobody listens: no longer recorded
+}
+
+// Prewarm runs the death emitters of the groups it steps when their source is stepped too.
+TEST(DeathEmitter, PrewarmFeedsThemWhenBothSidesStep) {
+  Context ctx;
+  Group& a = ctx.createGroup("a", 100);
+  a.setActions({Move{}, KillOld{}});
+  Emitter e;
+  e.rate = 300;
+  e.types[0].lifetime = 0.05f;
+  a.addEmitter(e);
+  Group& b = ctx.createGroup("b", 1000);
+  DeathEmitter de;
+  de.source = "a";
+  de.count = 2.0f;
+  b.addDeathEmitter(de);
+  Group* both[] = {&a, &b};
+  ctx.prewarm(both, 0.5);
+  EXPECT_GT(b.size(), 100u);
+  EXPECT_EQ(b.size(), 2 * (a.stats().killedByAge));
+  const std::size_t had = b.size();
+  Group* sourceOnly[] = {&a};
+  ctx.prewarm(sourceOnly, 0.5);
+  EXPECT_EQ(b.size(), had);  // b did not step: its emitter waits
+}
+
 // A new group takes the lowest index a destroyed one left (its random streams), whichever
 // order they were destroyed in; names are found and freed with thousands of groups.
 TEST(Context, ANewGroupTakesTheLowestFreedIndex) {

@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "backend.hpp"
+#include "emission_plan.hpp"
 #include "flurry/error.hpp"
 #include "flurry/version.hpp"
 #include "log.hpp"
@@ -41,6 +42,17 @@ struct Context::Impl {
   std::uint64_t stepsSinceDtChange = 0;
 
   detail::StepParams params() const;
+
+  // Death emitters (Group::addDeathEmitter) in all the groups: while there are none a step
+  // spends nothing on them.
+  std::size_t deathEmitters = 0;
+  bool deathsFed = false;  // some group was told to record its deaths for them
+  /// Tells every source group to record its deaths; throws, before anything steps, for a
+  /// source no group is named.
+  void feedDeathEmitters();
+  /// After the step: the death emitters of `only` (all groups when empty) whose source is
+  /// in `only` too emit, group by group in creation order.
+  void runDeathEmitters(std::span<Group* const> only);
 };
 
 namespace {
@@ -108,6 +120,7 @@ Group& Context::createGroup(std::string name, std::size_t capacity) {
   const bool reuse = !freed.empty();
   gi->index = reuse ? freed.front() : impl_->nextIndex;
   gi->onDevice = impl_->backendKind != Backend::Cpu;
+  gi->contextDeathEmitters = &impl_->deathEmitters;
   gi->ensureStorage();
   impl_->groups.reserve(impl_->groups.size() + 1);  // nothing below throws
   impl_->byName.reserve(impl_->byName.size() + 1);
@@ -131,6 +144,7 @@ void Context::destroyGroup(Group& group) {
   if (it == all.end())
     throw InvalidArgument("group", "'" + group.name() + "' is not a group of this context");
   impl_->byName.erase(group.name());
+  impl_->deathEmitters -= group.impl_->deathEmitters.size();
   impl_->freeIndices.push_back(group.impl_->index);
   std::push_heap(impl_->freeIndices.begin(), impl_->freeIndices.end(), std::greater<>());
   all.erase(it);  // its device buffers go after the work queued on them (the mirror waits)
@@ -189,7 +203,42 @@ detail::StepParams Context::Impl::params() const {
   return sp;
 }
 
+void Context::Impl::feedDeathEmitters() {
+  if (deathEmitters == 0 && !deathsFed) return;
+  for (auto& g : groups) g->impl_->deathsFeed = false;
+  deathsFed = false;
+  if (deathEmitters == 0) return;
+  for (auto& g : groups) {
+    const auto& gi = *g->impl_;
+    for (std::size_t k = 0; k < gi.deathEmitters.size(); ++k) {
+      const DeathEmitter& de = gi.deathEmitters[k];
+      const auto it = byName.find(de.source);
+      if (it == byName.end())
+        throw Error("group '" + gi.name + "': deathEmitters[" + std::to_string(k) +
+                    "].source: no group named '" + de.source + "' in the context");
+      it->second->impl_->feedDeaths();
+      deathsFed = true;
+    }
+  }
+}
+
+void Context::Impl::runDeathEmitters(std::span<Group* const> only) {
+  if (deathEmitters == 0) return;
+  const auto in = [&](const Group* g) {
+    return only.empty() || std::find(only.begin(), only.end(), g) != only.end();
+  };
+  for (auto& g : groups) {
+    auto& gi = *g->impl_;
+    if (gi.deathEmitters.empty() || !in(g.get())) continue;
+    for (std::size_t k = 0; k < gi.deathEmitters.size(); ++k) {
+      const Group* source = byName.at(gi.deathEmitters[k].source);  // feedDeathEmitters found it
+      if (in(source)) detail::emitFromDeaths(gi, k, *source->impl_, options.seed);
+    }
+  }
+}
+
 void Context::step() {
+  impl_->feedDeathEmitters();
   const detail::StepParams sp = impl_->params();
   auto& small = impl_->smallGroups;
   small.clear();
@@ -217,6 +266,7 @@ void Context::step() {
                   groupStep(alone, *small[i], impl_->timeAtDtChange, impl_->stepsSinceDtChange, 0));
     });
   }
+  impl_->runDeathEmitters({});
   ++impl_->step;
   ++impl_->stepsSinceDtChange;
   impl_->time = impl_->timeAtDtChange + double(impl_->stepsSinceDtChange) * impl_->options.dt;
@@ -236,7 +286,8 @@ std::uint64_t Context::prewarm(std::span<Group* const> groups, double seconds) {
   std::uint64_t n = std::uint64_t(std::ceil(q));
   if (n > 0 && double(n - 1) >= q * (1.0 - 1e-9)) --n;
   const detail::StepParams sp = impl_->params();
-  for (std::uint64_t i = 0; i < n; ++i)
+  if (n > 0) impl_->feedDeathEmitters();
+  for (std::uint64_t i = 0; i < n; ++i) {
     for (Group* g : groups) {
       auto& gi = *g->impl_;
       stepGroup(*impl_->backend, gi,
@@ -244,6 +295,10 @@ std::uint64_t Context::prewarm(std::span<Group* const> groups, double seconds) {
       ++gi.stepsAhead;
       if (!std::isnan(gi.aheadSeconds)) gi.aheadSeconds += dt;
     }
+    // Their death emitters fed by these groups' deaths (one of both sides alone would
+    // leave the other side's clock: skipped).
+    if (!groups.empty()) impl_->runDeathEmitters(groups);
+  }
   return n;
 }
 

@@ -386,6 +386,64 @@ void emitNewborns(GroupImpl& g, const StepParams& sp) {
   retireDead(g, t1);
 }
 
+void emitFromDeaths(GroupImpl& g, std::size_t k, const GroupImpl& source, std::uint64_t seed) {
+  const DeathEmitter& de = g.deathEmitters[k];
+  if (source.deathEvents.empty()) return;
+  g.ensureStorage();
+  const Lanes L = g.lanePointers();
+  const std::size_t before = g.size;
+  for (const DeathEvent& d : source.deathEvents) {
+    if (de.cause >= 0 && d.action != std::uint32_t(de.cause)) continue;
+    // How many, keyed by the dead particle, this group and this emitter: two emitters fed by
+    // one source draw apart.
+    Random counter(seed, d.id, g.index, stream::kDeathEmitter + std::uint32_t(k));
+    const float c = std::min(std::max(de.count.sample(counter), 0.0f), 1e6f);
+    std::uint64_t n = std::uint64_t(c);
+    if (counter.uniform() < c - float(n)) ++n;
+    g.stats.emitted += n;
+    const std::uint64_t room = g.capacity - g.size;
+    if (n > room) {
+      g.stats.droppedAtCapacity += n - room;
+      n = room;
+    }
+    for (std::uint64_t j = 0; j < n; ++j) {
+      // A newborn's own stream, as an emitter's newborn has (ids never repeat in a group).
+      const std::uint32_t id = g.nextId++;
+      Random rng(seed, id, g.index, stream::kEmission);
+      const ParticleType& type = de.types[chooseType(de.types, rng)];
+      Particle p;
+      p.position = d.position + de.shape.sample(rng);
+      p.velocity = type.velocity.sample(rng) + d.velocity * de.inheritVelocity;
+      p.prevPosition = p.positionB = p.position;
+      p.velocityB = Vec3(0.0f);
+      p.age = 0.0f;
+      p.id = id;
+      // Only the draws of what the group stores, as the emitters' newborns.
+      if (L.lifetime) p.lifetime = std::max(type.lifetime.sample(rng), 0.0f);
+      if (L.color[0]) p.color = Vec4(type.color.sample(rng), type.alpha.sample(rng));
+      if (L.size) p.size = std::max(type.size.sample(rng), 0.0f);
+      if (L.mass) p.mass = type.mass.sample(rng);
+      if (L.charge) p.charge = type.charge.sample(rng);
+      if (L.up[0]) p.up = type.up.sample(rng);
+      if (L.rot[0]) p.rotVelocity = type.rotVelocity.sample(rng);
+      const std::size_t i = g.size++;
+      g.write(i, p);
+      for (int c4 = 0; c4 < 4; ++c4)
+        if (L.birthColor[c4]) L.birthColor[c4][i] = p.color[c4];
+      if (L.birthSize) L.birthSize[i] = p.size;
+    }
+  }
+  // The step's box, kept by the pass, grows to hold them.
+  if (g.boundsValid)
+    for (std::size_t i = before; i < g.size; ++i) {
+      const Vec3 q(L.p[0][i], L.p[1][i], L.p[2][i]);
+      Bounds& b = g.stepBounds;
+      b.min = b.empty ? q : glm::min(b.min, q);
+      b.max = b.empty ? q : glm::max(b.max, q);
+      b.empty = false;
+    }
+}
+
 void compact(GroupImpl& g, const StepParams& sp) {
   g.bornCount = 0;  // the step's newborns are ordinary particles from now on
   // Close the holes with the live particles at the tail: the lowest hole takes the last.

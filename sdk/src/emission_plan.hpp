@@ -44,6 +44,11 @@ inline Vec3 pathPositionAt(const Emitter& e, double t, std::size_t& key) {
   return pathPositionAt(e.position, e.velocity, e.start, e.path, e.pathLoop, t, key);
 }
 
+/// The newborns of g's death emitter k from the deaths `source` recorded in the step that
+/// ended at t1, appended to g (its bounds grown to hold them when they are kept), in the
+/// order of the deaths; counted in g's statistics like any emission.
+void emitFromDeaths(GroupImpl& g, std::size_t k, const GroupImpl& source, std::uint64_t seed);
+
 /// Drops the live emitters that died by t1 (after their last births are written).
 void retireDead(GroupImpl& g, double t1);
 
@@ -67,6 +72,19 @@ inline double birthTime(const BirthRun& run, const Emitter& em, std::uint64_t q)
 
 inline const Emitter& emitterOf(const GroupImpl& g, const BirthRun& run) {
   return run.live ? g.live[run.index].emitter : g.emitters[run.index];
+}
+
+/// The type a newborn takes, by the types' weights: one uniform draw when there are several.
+inline std::size_t chooseType(const std::vector<ParticleType>& types, Random& rng) {
+  if (types.size() == 1) return 0;
+  float total = 0;
+  for (const auto& t : types) total += t.weight;
+  float u = rng.uniform() * total;
+  for (std::size_t k = 0; k < types.size(); ++k) {
+    if (u < types[k].weight) return k;
+    u -= types[k].weight;
+  }
+  return types.size() - 1;
 }
 }  // namespace FLURRY_ISA_NAMESPACE
 

@@ -51,6 +51,20 @@ Vec3 Emitter::positionAt(double t) const {
   return detail::pathPositionAt(position, velocity, start, path, pathLoop, t, key);
 }
 
+void DeathEmitter::validate(const std::string& where) const {
+  if (source.empty()) throw InvalidArgument(where + ".source", "names no group");
+  count.validate((where + ".count").c_str());
+  if (count.center < 0) throw InvalidArgument(where + ".count", "must be >= 0");
+  if (count.center + count.spread > 1e6f)
+    throw InvalidArgument(where + ".count", "more than a million newborns a death");
+  if (!std::isfinite(inheritVelocity))
+    throw InvalidArgument(where + ".inheritVelocity", "not finite");
+  if (cause < -1) throw InvalidArgument(where + ".cause", "must be an action's index or -1");
+  Emitter e;  // the types are an emitter's
+  e.types = types;
+  e.validate(where);
+}
+
 void Emitter::validate(const std::string& where) const {
   auto fail = [&](const std::string& field, const std::string& why) {
     throw InvalidArgument(where + "." + field, why);

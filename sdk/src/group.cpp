@@ -561,7 +561,7 @@ void detail::GroupImpl::recordDeaths(std::size_t B, std::size_t blocks, double t
   const Lanes L = lanePointers();
   for (std::size_t b = 0; b < blocks; ++b)
     for (std::uint32_t j = 0; j < deadCount[b]; ++j) {
-      if (deathEvents.size() == deathsPerStep) {
+      if (deathEvents.size() == deathRoom()) {
         stats.deathEventsDropped += deadCount[b] - j;
         break;
       }
@@ -579,6 +579,12 @@ void detail::GroupImpl::recordDeaths(std::size_t B, std::size_t blocks, double t
     }
 }
 
+void detail::GroupImpl::feedDeaths() {
+  if (deathsFeed) return;
+  deathEvents.reserve(capacity);  // no step has more deaths than the group holds particles
+  deathsFeed = true;
+}
+
 Group& Group::recordDeaths(std::size_t perStep) {
   auto& g = *impl_;
   if (perStep > 0 && g.onDevice)
@@ -586,11 +592,35 @@ Group& Group::recordDeaths(std::size_t perStep) {
                 "': death events are recorded by the CPU backend only (this context runs on "
                 "a device)");
   if (perStep > 0) require({Attribute::Id});
-  // No step has more deaths than the group holds particles.
   g.deathEvents.clear();
-  g.deathEvents.reserve(std::min(perStep, g.capacity));
+  g.deathEvents.reserve(std::min(std::max(perStep, g.deathRoom()), g.capacity));
   g.deathsPerStep = perStep;
   return *this;
+}
+
+DeathEmitter& Group::addDeathEmitter(DeathEmitter emitter) {
+  auto& g = *impl_;
+  const std::string where = "deathEmitters[" + std::to_string(g.deathEmitters.size()) + "]";
+  if (g.onDevice)
+    throw Error("group '" + g.name + "': " + where +
+                ": a death emitter does not run on the device yet (the CPU backend runs it)");
+  emitter.validate(where);
+  g.deathEmitters.push_back(std::move(emitter));
+  if (g.contextDeathEmitters) ++*g.contextDeathEmitters;
+  return g.deathEmitters.back();
+}
+
+std::span<DeathEmitter> Group::deathEmitters() {
+  return impl_->deathEmitters;
+}
+
+void Group::removeDeathEmitter(std::size_t i) {
+  auto& g = *impl_;
+  if (i >= g.deathEmitters.size())
+    throw InvalidArgument("index", std::to_string(i) + " is past the " +
+                                       std::to_string(g.deathEmitters.size()) + " death emitters");
+  g.deathEmitters.erase(g.deathEmitters.begin() + std::ptrdiff_t(i));
+  if (g.contextDeathEmitters) --*g.contextDeathEmitters;
 }
 
 std::span<const DeathEvent> Group::deaths() const {

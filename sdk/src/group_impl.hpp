@@ -204,8 +204,15 @@ struct GroupImpl {
   std::vector<std::uint32_t> deadCount;    ///< per block
   std::vector<std::uint32_t> culledCount;  ///< per block: actions the fused pass skipped
   std::size_t deathsPerStep = 0;           ///< Group::recordDeaths; 0: not recording
-  std::vector<DeathEvent> deathEvents;     ///< the last step's, reserved by recordDeaths
-  bool onDevice = false;                   ///< its context runs a device backend
+  /// A death emitter names this group (set by Context::step): it records every death.
+  bool deathsFeed = false;
+  /// The deaths a step records: deathsPerStep, or the capacity while deathsFeed.
+  std::size_t deathRoom() const { return deathsFeed ? capacity : deathsPerStep; }
+  std::vector<DeathEmitter> deathEmitters;
+  /// The context's count of death emitters in all its groups (0: Context::step skips them).
+  std::size_t* contextDeathEmitters = nullptr;
+  std::vector<DeathEvent> deathEvents;  ///< the last step's, reserved by recordDeaths
+  bool onDevice = false;                ///< its context runs a device backend
   /// Group::bounds() was asked: from then on the CPU pass takes the live particles' box
   /// every step, each block while it is in cache (no pass of its own).
   bool boundsWanted = false;
@@ -270,9 +277,12 @@ struct GroupImpl {
   void ensureStorage();
   Lanes lanePointers() const;
   /// The step's dead (deadIndex/deadCode of `blocks` blocks of B, their lanes not yet
-  /// compacted) as DeathEvents at time t1, in particle order up to deathsPerStep; the rest
+  /// compacted) as DeathEvents at time t1, in particle order up to deathRoom(); the rest
   /// counted. Out of line in group.cpp for the reason of assignFill.
   void recordDeaths(std::size_t B, std::size_t blocks, double t1);
+  /// Records every death from now on (a death emitter names this group); the room is taken
+  /// here, once.
+  void feedDeaths();
   /// Writes particle p's stored attributes at index i.
   void write(std::size_t i, const Particle& p) { writeParticle(lanePointers(), i, p); }
   Particle read(std::size_t i) const { return readParticle(lanePointers(), i); }

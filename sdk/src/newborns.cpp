@@ -19,18 +19,6 @@ namespace {
 
 constexpr std::size_t kNewbornsPerTask = 8192;  // a multiple of kBatch
 
-std::size_t chooseType(const Emitter& e, Random& rng) {
-  if (e.types.size() == 1) return 0;
-  float total = 0;
-  for (const auto& t : e.types) total += t.weight;
-  float u = rng.uniform() * total;
-  for (std::size_t k = 0; k < e.types.size(); ++k) {
-    if (u < e.types[k].weight) return k;
-    u -= e.types[k].weight;
-  }
-  return e.types.size() - 1;
-}
-
 constexpr std::size_t kBatch = 256;
 constexpr int kMaxDraws = 48;
 
@@ -221,7 +209,7 @@ void emitOneByOne(const NewbornContext& nc, const BirthRun& run, const Emitter& 
   for (std::size_t k = 0; k < m; ++k) {
     const std::uint32_t id = nc.firstId + std::uint32_t(i0 + k);
     Random rng(nc.sp.seed, id, nc.g.index, stream::kEmission);
-    const ParticleType& type = em.types[chooseType(em, rng)];
+    const ParticleType& type = em.types[chooseType(em.types, rng)];
     const double tb = birthTime(run, em, q0 + k);
     nc.remaining[i0 + k] = nc.left(tb);
     Newborn b{};

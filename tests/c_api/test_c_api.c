@@ -577,6 +577,7 @@ static void test_group(const char* out_dir) {
   FAILS(flurry_group_deaths(g, NULL, &count, NULL), FLURRY_ERROR_NULL_ARGUMENT, "events");
   FAILS(flurry_group_record_deaths(NULL, 1), FLURRY_ERROR_NULL_ARGUMENT, "group");
   OK(flurry_group_record_deaths(g, 0));
+
   OK(flurry_group_emitted_by_generation(g, &per, &count));
   CHECK(count >= 1 && per[0] == st.emitted);
 
@@ -654,6 +655,26 @@ static void test_group(const char* out_dir) {
   FAILS(flurry_group_require_instances(NULL), FLURRY_ERROR_NULL_ARGUMENT, "group");
   FAILS(flurry_group_pack_instances(NULL, NULL, 0, NULL, &written), FLURRY_ERROR_NULL_ARGUMENT,
         "group");
+  /* A death emitter in another group: each absorbed particle of `g` gives it 2. */
+  {
+    flurry_group* splash = NULL;
+    flurry_group_stats before, after, got;
+    size_t size = 0;
+    OK(flurry_context_create_group(ctx, "splash", 100000, &splash));
+    OK(flurry_group_add_death_emitter(splash,
+                                      "{\"source\": \"water\", \"count\": 2, \"cause\": 2,"
+                                      " \"types\": [{\"velocity\": [0, 1, 0]}]}"));
+    OK(flurry_group_stats_get(g, &before));
+    for (step = 0; step < 10; ++step) OK(flurry_context_step(ctx));
+    OK(flurry_group_stats_get(g, &after));
+    OK(flurry_group_stats_get(splash, &got));
+    OK(flurry_group_size(splash, &size));
+    CHECK(after.absorbed > before.absorbed);
+    CHECK(got.emitted == 2 * (after.absorbed - before.absorbed) && size == got.emitted);
+    FAILS(flurry_group_add_death_emitter(splash, "{\"source\": \"water\", \"count\": -1}"),
+          FLURRY_ERROR_EFFECT, "deathEmitter.count");
+    FAILS(flurry_group_add_death_emitter(splash, NULL), FLURRY_ERROR_NULL_ARGUMENT, "json");
+  }
   OK(flurry_context_destroy(ctx));
 }
 

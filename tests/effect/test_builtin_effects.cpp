@@ -36,9 +36,9 @@ bool allFinite(const Group& g) {
 
 TEST(BuiltinEffects, ListIsComplete) {
   const auto& all = samples::builtinSamples();
-  for (const char* name :
-       {"fountain", "fireworks", "snow", "hair", "tornado", "pinball2d", "magnetic", "galaxy",
-        "smoke", "shockwave", "campfire", "comet", "waterfall", "rain_on_glass", "grass", "fur"})
+  for (const char* name : {"fountain", "fireworks", "snow", "hair", "tornado", "pinball2d",
+                           "magnetic", "galaxy", "smoke", "shockwave", "campfire", "comet",
+                           "waterfall", "rain_on_glass", "grass", "fur", "rain"})
     EXPECT_NE(samples::findSample(name), nullptr) << name;
   for (const auto& s : all) {
     EXPECT_TRUE(s.effect) << s.name << ": " << s.description;

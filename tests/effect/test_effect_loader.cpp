@@ -349,6 +349,65 @@ TEST(EffectLoader, SinkKillInsideIsADeprecatedAliasOfModeOutside) {
   EXPECT_NE(saved.find("\"outside\""), std::string::npos) << saved;
 }
 
+// Death emitters: read, linked to a group of the effect (the cause indexed as the file writes
+// the list, past a mode2d plane), saved and read back the same, built per instance (each
+// instance's splash fed by its own drops), and refused with the JSON path when they name no
+// group or no action.
+TEST(EffectLoader, DeathEmitters) {
+  const std::string json = R"({"name": "rain", "dt": 0.125, "groups": [
+    {"name": "splash", "capacity": 1000,
+     "deathEmitters": [{"source": "drops", "count": 2, "inheritVelocity": 0.5, "cause": 1,
+                        "types": [{"velocity": [0, 1, 0], "lifetime": 1}]}],
+     "actions": [{"type": "Move"}, {"type": "KillOld"}]},
+    {"name": "drops", "capacity": 100, "mode2d": true,
+     "emitters": [{"bursts": [{"time": 0, "count": 10}], "shape": [0, 5, 0],
+                   "types": [{"velocity": [1, -4, 0], "lifetime": 10}]}],
+     "actions": [{"type": "Move"},
+                 {"type": "Sink", "region": {"type": "box", "min": [-1000, -100, -1],
+                                             "max": [1000, 0, 1]}}]}]})";
+  const Effect fx = parseEffect(json, "rain.json");
+  ASSERT_EQ(fx.groups[0].deathEmitters.size(), 1u);
+  const DeathEmitter& de = fx.groups[0].deathEmitters[0];
+  EXPECT_EQ(de.source, "drops");
+  EXPECT_EQ(de.count.center, 2.0f);
+  // mode2d put its Constrain2D before Move: the Sink, written second, is third in the list.
+  ASSERT_EQ(fx.groups[1].actions.size(), 3u);
+  EXPECT_TRUE(std::holds_alternative<Sink>(fx.groups[1].actions.actions()[2]));
+  EXPECT_EQ(de.cause, 2);
+  const std::string saved = saveEffect(fx);
+  EXPECT_EQ(saveEffect(parseEffect(saved, "saved.json")), saved);
+  EXPECT_EQ(parseEffect(saved, "saved.json").groups[0].deathEmitters[0].cause, 2);
+
+  Context ctx(fx.contextOptions());
+  EffectInstance a = fx.instantiate(ctx, "a");
+  EffectInstance b = fx.instantiate(ctx, "b");
+  b.setTransform({{100, 0, 0}, glm::quat(1, 0, 0, 0), 1.0f});
+  ctx.run(12);  // the drops fall 5 m at 4 m/s: through the floor in the tenth step
+  Group& splashA = ctx.group("splash@a");
+  Group& splashB = ctx.group("splash@b");
+  EXPECT_EQ(splashA.size(), 20u);
+  EXPECT_EQ(splashB.size(), 20u);
+  for (std::size_t i = 0; i < splashB.size(); ++i) EXPECT_GT(splashB.particle(i).position.x, 50);
+  for (std::size_t i = 0; i < splashA.size(); ++i) EXPECT_LT(splashA.particle(i).position.x, 50);
+
+  auto withDeath = [](const std::string& fields) {
+    return R"({"name": "t", "groups": [{"name": "g", "capacity": 10, "actions": [{"type": "Move"}],
+               "deathEmitters": [{)" +
+           fields + "}]}]}";
+  };
+  const EffectError nobody = errorOf(withDeath(R"("source": "h")"));
+  EXPECT_EQ(nobody.path(), "groups[0].deathEmitters[0].source") << nobody.what();
+  EXPECT_NE(nobody.why().find("its groups: g"), std::string::npos) << nobody.what();
+  const EffectError noAction = errorOf(withDeath(R"("source": "g", "cause": 1)"));
+  EXPECT_EQ(noAction.path(), "groups[0].deathEmitters[0].cause") << noAction.what();
+  EXPECT_EQ(errorOf(withDeath(R"("source": "g", "cause": -2)")).path(),
+            "groups[0].deathEmitters[0].cause");
+  EXPECT_EQ(errorOf(withDeath(R"("source": "g", "count": -1)")).path(),
+            "groups[0].deathEmitters[0].count");
+  EXPECT_EQ(errorOf(withDeath(R"("count": 1)")).path(), "groups[0].deathEmitters[0].source");
+  EXPECT_NO_THROW(parseEffect(withDeath(R"("source": "g", "cause": 0)"), "t.json"));
+}
+
 TEST(EffectLoader, EmittersAndPrimeEmitters) {
   const Effect fx = parseEffect(withGroup(R"(
     "emitters": [{"name": "e", "shape": {"type": "sphere", "outerRadius": 1}, "rate": 10.5,

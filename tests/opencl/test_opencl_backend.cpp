@@ -239,6 +239,9 @@ TEST(OpenCLBackend, DeathEventsAreAClearErrorOnTheDevice) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("CPU backend only"), std::string::npos) << e.what();
   }
+  DeathEmitter de;
+  de.source = g.name();
+  EXPECT_THROW(ctx.createGroup("splash", 100).addDeathEmitter(de), Error);
   g.recordDeaths(0);  // turning it off is fine
   ctx.run(5);
   EXPECT_GT(g.size(), 0u);

@@ -190,7 +190,9 @@ const Expect kSamples[] = {Expect{"fountain", 60, 0.02, 0.3, 1, 0.01, 0.999, 300
                            Expect{"rain_on_glass", 60, 0.01, 0.3, 0, 0.01, 0.999, 300},
                            // Green blades over a drawn ground; a ginger coat.
                            Expect{"grass", 60, 0.15, 0.6, 2, 0.02, 0.999, 300},
-                           Expect{"fur", 60, 0.05, 0.3, 1, 0.01, 0.999, 0}};
+                           Expect{"fur", 60, 0.05, 0.3, 1, 0.01, 0.999, 0},
+                           // Rain falls across the whole view, as snow does; the ground drawn.
+                           Expect{"rain", 60, 0.01, 0.4, 0, 1.0, 0.0, 300}};
 INSTANTIATE_TEST_SUITE_P(Builtin, SampleImage, ::testing::ValuesIn(kSamples),
                          [](const ::testing::TestParamInfo<Expect>& info) {
                            return info.param.name;

@@ -361,6 +361,13 @@ typedef struct flurry_death_event {
   double time;     /**< the end of the step it died in */
 } flurry_death_event;
 
+/** Adds a death emitter (flurry::DeathEmitter: particles born where the group named by its
+ * "source" has deaths), given as the JSON object an effect file's "deathEmitters" holds, e.g.
+ * {"source": "rain", "count": 3, "cause": 0, "types": [{"velocity": [0, 2, 0]}]}. Bad fields
+ * are FLURRY_ERROR_EFFECT naming "deathEmitter.FIELD"; the source is looked up when the
+ * context steps (a missing one fails that step, before anything moves). CPU backend only. */
+FLURRY_C_EXPORT flurry_status flurry_group_add_death_emitter(flurry_group* group, const char* json);
+
 /** Records each step's deaths, at most `per_step` a step (the first in particle order; the
  * rest counted in flurry_group_deaths' *dropped); 0 stops. CPU backend only: on a device
  * FLURRY_ERROR_OTHER says so. */

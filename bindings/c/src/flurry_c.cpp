@@ -1036,6 +1036,14 @@ static_assert(sizeof(flurry_death_event) == sizeof(flurry::DeathEvent));
 static_assert(offsetof(flurry_death_event, id) == offsetof(flurry::DeathEvent, id));
 static_assert(offsetof(flurry_death_event, time) == offsetof(flurry::DeathEvent, time));
 static_assert(FLURRY_DEATH_NON_FINITE == flurry::DeathEvent::kNonFinite);
+flurry_status flurry_group_add_death_emitter(flurry_group* g, const char* text) {
+  return guard([&] {
+    need(g, "group");
+    need(text, "json");
+    group(g).addDeathEmitter(
+        flurry::detail::parseEffectDeathEmitter(text, "", "deathEmitter", loadOptions()));
+  });
+}
 flurry_status flurry_group_record_deaths(flurry_group* g, size_t perStep) {
   return guard([&] {
     need(g, "group");

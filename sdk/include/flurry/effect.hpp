@@ -52,6 +52,9 @@ struct EffectGroup {
   std::size_t capacity = 0;
   std::vector<Emitter> emitters;
   std::vector<PrimeEmitter> primeEmitters;
+  /// Emitters fed by deaths; their `source` names a group of the effect (an instance's
+  /// build names that group's instance).
+  std::vector<DeathEmitter> deathEmitters;
   /// The action list, with the 2-D constraint already inserted for a `mode2d` group.
   ActionList actions;
   HairOptions hair;

@@ -132,4 +132,32 @@ struct PrimeEmitter {
   void validate(const std::string& where = "primeEmitter") const;
 };
 
+/// Emits particles where another group's particles die: a sub-emitter on death (a rocket's
+/// burst of sparks, a raindrop's splash where it hit the floor). After each step, every death
+/// the `source` group had in it (by age, by an absorber, for a NaN: see Group::deaths) gives
+/// `count` newborns to the group holding this emitter. They are born at the end of that step,
+/// at the dead particle's place plus a sample of `shape`, with a type's velocity plus
+/// `inheritVelocity` times the dead particle's, and age 0: the next step runs them through
+/// the whole action list. Deaths are taken in the source's particle order and the newborns
+/// written in that order, so the result is the same on any thread count. `shape` and the
+/// types' domains are in the world's frame, as Gravity is: a splash rises whichever way an
+/// instance turns. The CPU backend runs them (a device context refuses to add one).
+struct DeathEmitter {
+  std::string name;
+  /// The group whose deaths emit, by name (it may be this group); it must exist when the
+  /// context steps, which records its deaths from then on (all of them: room for its
+  /// capacity).
+  std::string source;
+  /// Newborns a death gives; a fraction is a chance (2.5: two, and a third half the time).
+  Fuzzy count = 1.0f;
+  float inheritVelocity = 0.0f;  ///< this fraction of the dead particle's velocity is added
+  Domain shape = Domain::point(Vec3(0.0f));  ///< where around the death place they are born
+  std::vector<ParticleType> types{ParticleType{}};
+  /// Only deaths by this entry of the source's action list (e.g. its Sink on the floor);
+  /// -1: every death.
+  std::int32_t cause = -1;
+
+  void validate(const std::string& where = "deathEmitter") const;
+};
+
 }  // namespace flurry

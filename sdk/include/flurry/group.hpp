@@ -161,6 +161,13 @@ class Group {
   PrimeEmitter& addPrimeEmitter(PrimeEmitter prime);
   /// Emitters spawned by prime emitters and still alive.
   std::size_t liveEmitterCount() const;
+  /// Adds an emitter fed by a group's deaths (validated; the source is looked up when the
+  /// context steps). Throws Error in a device context (death events are the CPU's).
+  DeathEmitter& addDeathEmitter(DeathEmitter emitter);
+  /// The death emitters; edits through the span take effect at the next step.
+  std::span<DeathEmitter> deathEmitters();
+  /// Removes death emitter i (throws InvalidArgument "index" past them).
+  void removeDeathEmitter(std::size_t i);
 
   /// Hair mode (see HairOptions). Strands accumulate until clearStrands().
   Group& setHair(HairOptions options);

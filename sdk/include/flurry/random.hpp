@@ -90,6 +90,8 @@ namespace stream {
 inline constexpr std::uint32_t kEmission = 0xFFFF0000u;  ///< a newborn's attributes
 inline constexpr std::uint32_t kEmitterEvent = 0xFFFF0001u;
 inline constexpr std::uint32_t kPassThrough = 0xFFFF0002u;  ///< a Sink's once-per-particle pass
+/// A death emitter's newborn counts: this plus the emitter's index in its group (< 65536).
+inline constexpr std::uint32_t kDeathEmitter = 0xFFFE0000u;
 }  // namespace stream
 
 }  // namespace flurry

@@ -654,6 +654,24 @@ struct Describe<PrimeEmitter> {
       });
 };
 
+template <>
+struct Describe<DeathEmitter> {
+  static constexpr const char* name = "DeathEmitter";
+  static constexpr const char* doc =
+      "Emits where another group's particles die (a sub-emitter on death).";
+  static constexpr auto fields = std::tuple{
+      field("name", &DeathEmitter::name, "", kAny, "names it in statistics"),
+      field("source", &DeathEmitter::source, "", kAny, "the group whose deaths emit", kRequired),
+      field("count", &DeathEmitter::count, "", kAny, "newborns a death (a fraction a chance)"),
+      field("inheritVelocity", &DeathEmitter::inheritVelocity, "", kFinite,
+            "fraction of the dead particle's velocity"),
+      field("shape", &DeathEmitter::shape, "units", kAny, "where, around the death place"),
+      field("types", &DeathEmitter::types, "", kAny, "particle types, drawn by weight"),
+      field("cause", &DeathEmitter::cause, "", Limit{.min = -1},
+            "only deaths by this action of the source's list (-1: all)"),
+  };
+};
+
 // ---- domains (mesh and union hold lists: read and written by hand) --------------------------
 
 /// Calls f(std::type_identity<S>{}) for each described domain shape, in Domain::Shape's order.

@@ -275,6 +275,15 @@ void read(const json& j, const std::string& path, const Loader& L, std::uint32_t
   out = std::uint32_t(readInteger(j, path, L, 0, 0xFFFFFFFFu));
 }
 void read(const json& j, const std::string& path, const Loader& L, int& out) {
+  // Signed: a field's own validation says which values it takes (DeathEmitter.cause: -1).
+  if (j.is_number_integer() && !j.is_number_unsigned() && j.get<std::int64_t>() < 0) {
+    const std::int64_t v = j.get<std::int64_t>();
+    if (v < std::numeric_limits<int>::min())
+      L.fail(path, "must be an integer in [" + std::to_string(std::numeric_limits<int>::min()) +
+                       ", " + std::to_string(std::numeric_limits<int>::max()) + "]");
+    out = int(v);
+    return;
+  }
   out = int(readInteger(j, path, L, 0, std::numeric_limits<int>::max()));
 }
 void read(const json& j, const std::string& path, const Loader& L, std::uint64_t& out) {
@@ -578,6 +587,47 @@ void read(const json& j, const std::string& path, const Loader& L,
   out = std::move(s);
 }
 
+DeathEmitter readDeathEmitter(const json& j, const std::string& path, const Loader& L) {
+  DeathEmitter d;
+  read(j, path, L, d);
+  try {
+    d.validate(path);
+  } catch (const InvalidArgument& x) {
+    L.rethrow(path, x);
+  }
+  return d;
+}
+
+// Death emitters name a group of the effect, and their cause an action of its list as the
+// file writes it: a mode2d group's inserted Constrain2D moves the actions after it on by one.
+void linkDeathEmitters(Effect& fx, const json& groups, const Loader& L) {
+  for (std::size_t i = 0; i < fx.groups.size(); ++i)
+    for (std::size_t k = 0; k < fx.groups[i].deathEmitters.size(); ++k) {
+      DeathEmitter& de = fx.groups[i].deathEmitters[k];
+      const std::string path = index(join(index("groups", i), "deathEmitters"), k);
+      std::size_t src = 0;
+      std::string names;
+      while (src < fx.groups.size() && fx.groups[src].name != de.source)
+        names += (names.empty() ? "" : ", ") + fx.groups[src++].name;
+      if (src == fx.groups.size())
+        L.fail(join(path, "source"),
+               "no group named \"" + de.source + "\" in this effect (its groups: " + names + ")");
+      if (de.cause < 0) continue;
+      const json& g = groups[src];
+      const std::size_t written = g.contains("actions") ? g["actions"].size() : 0;
+      if (std::size_t(de.cause) >= written)
+        L.fail(join(path, "cause"), "group \"" + de.source + "\" has " + std::to_string(written) +
+                                        " actions: the cause is one's index, or -1 for all");
+      const std::vector<Action>& list = fx.groups[src].actions.actions();
+      if (list.size() == written + 1)  // mode2d inserted its Constrain2D
+        for (std::size_t a = 0; a <= std::size_t(de.cause); ++a)
+          if (std::holds_alternative<Constrain2D>(list[a])) {
+            ++de.cause;
+            break;
+          }
+    }
+}
+
 PrimeEmitter readPrime(const json& j, const std::string& path, const Loader& L) {
   PrimeEmitter p;
   read(j, path, L, p);
@@ -774,7 +824,7 @@ void warnGroup(const EffectGroup& g, const std::vector<Action>& actions, const s
                "and deathChildren), more than its maxEmitters of " +
                std::to_string(e.maxEmitters) + ": spawns past it are dropped");
   }
-  const bool filled = !g.emitters.empty() || !g.primeEmitters.empty();
+  const bool filled = !g.emitters.empty() || !g.primeEmitters.empty() || !g.deathEmitters.empty();
   if (!filled) {
     warn(path, "has no emitters or prime emitters: the group stays empty");
     return;  // the rest is about what happens to particles
@@ -828,6 +878,11 @@ EffectGroup readGroup(const json& j, const std::string& path, const Loader& L,
     arrayOf(*ps, o.at("primeEmitters"), L, 0, "an array of prime emitters");
     for (std::size_t i = 0; i < ps->size(); ++i)
       g.primeEmitters.push_back(readPrime((*ps)[i], index(o.at("primeEmitters"), i), L));
+  }
+  if (const json* ds = o.get("deathEmitters")) {
+    arrayOf(*ds, o.at("deathEmitters"), L, 0, "an array of death emitters");
+    for (std::size_t i = 0; i < ds->size(); ++i)
+      g.deathEmitters.push_back(readDeathEmitter((*ds)[i], index(o.at("deathEmitters"), i), L));
   }
 
   // 2-D mode: `true` is the z = 0 plane.
@@ -980,6 +1035,7 @@ Effect readEffect(const json& j, const Loader& L, const std::string& defaultName
   if (gs.empty()) L.fail("groups", "an effect needs at least one group");
   for (std::size_t i = 0; i < gs.size(); ++i)
     fx.groups.push_back(readGroup(gs[i], index("groups", i), L, fx.groups, fx.warnings));
+  linkDeathEmitters(fx, gs, L);
   if (const json* r = o.get("render")) {
     if (!r->is_object()) L.fail(o.at("render"), "expected an object, got " + kindOf(*r));
     if (depthOf(*r) > 64) L.fail(o.at("render"), "nested more than 64 levels deep");
@@ -1059,6 +1115,10 @@ std::vector<Group*> Effect::build(Context& ctx, std::size_t maxCapacity,
       for (std::size_t k = 0; k < eg.emitters.size(); ++k) g.addEmitter(eg.emitters[k]);
       for (std::size_t k = 0; k < eg.primeEmitters.size(); ++k)
         g.addPrimeEmitter(eg.primeEmitters[k]);
+      for (DeathEmitter de : eg.deathEmitters) {
+        if (!instance.empty()) (de.source += '@') += instance;  // its own instance's
+        g.addDeathEmitter(std::move(de));
+      }
       made.push_back(&g);
     } catch (const InvalidArgument& e) {
       throw EffectError(where, path, e.what());
@@ -1260,6 +1320,17 @@ Emitter parseEffectEmitter(std::string_view emitter, const std::string& fileName
   }
 }
 
+DeathEmitter parseEffectDeathEmitter(std::string_view deathEmitter, const std::string& fileName,
+                                     const std::string& path, const EffectLoadOptions& options) {
+  const json j = parsePart(deathEmitter, fileName, path);
+  const Loader L{fileName, &options, 0};
+  try {
+    return readDeathEmitter(j, path, L);
+  } catch (const json::exception& e) {
+    throw EffectError(fileName, path, std::string("malformed: ") + e.what());
+  }
+}
+
 }  // namespace detail
 
 // ---- the writer -----------------------------------------------------------------------------
@@ -1294,6 +1365,7 @@ ojson writeGroup(Writer w, const EffectGroup& g, const std::string& path) {
   o["capacity"] = std::uint64_t(g.capacity);
   if (!g.emitters.empty()) o["emitters"] = write(w, g.emitters);
   if (!g.primeEmitters.empty()) o["primeEmitters"] = write(w, g.primeEmitters);
+  if (!g.deathEmitters.empty()) o["deathEmitters"] = write(w, g.deathEmitters);
   ojson actions = ojson::array();
   for (std::size_t i = 0; i < g.actions.size(); ++i)
     actions.push_back(writeAction(w, g.actions.actions()[i], index(join(path, "actions"), i)));

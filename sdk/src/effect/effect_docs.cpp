@@ -220,7 +220,7 @@ std::string effectSchema() {
          {"required", {"vdb"}},
          {"additionalProperties", false}}}}};
   addDefs<Falloff, ColorOverLife::Key, SizeOverLife::Key, Burst, Keyframe, ParticleType, Emitter,
-          EmitterSpec, PrimeEmitter>(defs);
+          EmitterSpec, PrimeEmitter, DeathEmitter>(defs);
   ojson actions = ojson::array();
   desc::forEachAction([&](auto tag) {
     using A = typename decltype(tag)::type;
@@ -252,6 +252,7 @@ std::string effectSchema() {
   g["capacity"]["description"] = "the most particles the group holds";
   g["emitters"] = arrayOf(defRef("Emitter"));
   g["primeEmitters"] = arrayOf(defRef("PrimeEmitter"));
+  g["deathEmitters"] = arrayOf(defRef("DeathEmitter"));
   g["actions"] = arrayOf(defRef("action"));
   ojson plane = object({{"point", defRef("vec3")}, {"normal", defRef("direction")}});
   g["mode2d"] = {{"anyOf", ojson::array({{{"type", "boolean"}}, plane})}};
@@ -409,7 +410,8 @@ std::string effectReference() {
   out += table<Falloff>("###") + table<ColorOverLife::Key>("###") + table<SizeOverLife::Key>("###");
   out += "## Emitters\n\n";
   out += table<Emitter>("###") + table<ParticleType>("###") + table<Burst>("###") +
-         table<Keyframe>("###") + table<PrimeEmitter>("###") + table<EmitterSpec>("###");
+         table<Keyframe>("###") + table<PrimeEmitter>("###") + table<EmitterSpec>("###") +
+         table<DeathEmitter>("###");
   out +=
       "## Domains\n\n"
       "A domain is `[x, y, z]` (a point) or `{\"type\": \"kind\", ...fields}`; besides the "
@@ -427,13 +429,13 @@ std::string effectReference() {
 std::string fuzzDictionary() {
   std::set<std::string> keys = {
       // the effect, groups, fuzzy values, sampled fields: no descriptors yet
-      "version",     "name",   "description", "dt",       "seed",         "frames",
-      "space",       "groups", "render",      "capacity", "emitters",     "primeEmitters",
-      "actions",     "mode2d", "integrator",  "substeps", "maxStep",      "maxDistance",
-      "maxSubsteps", "hair",   "enabled",     "every",    "maxVertices",  "require",
-      "type",        "center", "spread",      "percent",  "distribution", "origin",
-      "voxelSize",   "dims",   "data",        "vdb",      "grid",         "normal",
-      "point"};
+      "version",       "name",        "description", "dt",         "seed",     "frames",
+      "space",         "groups",      "render",      "capacity",   "emitters", "primeEmitters",
+      "deathEmitters", "actions",     "mode2d",      "integrator", "substeps", "maxStep",
+      "maxDistance",   "maxSubsteps", "hair",        "enabled",    "every",    "maxVertices",
+      "require",       "type",        "center",      "spread",     "percent",  "distribution",
+      "origin",        "voxelSize",   "dims",        "data",       "vdb",      "grid",
+      "normal",        "point"};
   std::set<std::string> values = {"world", "local", "uniform", "normal", "inf",
                                   "-inf",  "true",  "false",   "null"};
   for (const DomainKind& k : domainKinds()) {
@@ -456,7 +458,7 @@ std::string fuzzDictionary() {
   described(Tag<Falloff>{}), described(Tag<ColorOverLife::Key>{});
   described(Tag<SizeOverLife::Key>{}), described(Tag<Burst>{}), described(Tag<Keyframe>{});
   described(Tag<ParticleType>{}), described(Tag<Emitter>{}), described(Tag<EmitterSpec>{});
-  described(Tag<PrimeEmitter>{});
+  described(Tag<PrimeEmitter>{}), described(Tag<DeathEmitter>{});
   desc::forEachDomainKind([&](auto tag) {
     using S = typename decltype(tag)::type;
     values.insert(desc::Describe<S>::name);

@@ -31,4 +31,11 @@ ActionList parseEffectActions(std::string_view actions, const std::string& fileN
 Emitter parseEffectEmitter(std::string_view emitter, const std::string& fileName,
                            const std::string& path, const EffectLoadOptions& options = {});
 
+/// Reads and validates `deathEmitter`, the JSON text of one death emitter object, as the
+/// loader reads a group's deathEmitters[i] (its source is not looked up: the context does
+/// that when it steps); `path` is its JSON path. Throws EffectError.
+DeathEmitter parseEffectDeathEmitter(std::string_view deathEmitter, const std::string& fileName,
+                                     const std::string& path,
+                                     const EffectLoadOptions& options = {});
+
 }  // namespace flurry::detail
