@@ -789,14 +789,22 @@ TEST(DeathEmitter, ByCauseFractionalCountsAndThreadCounts) {
 
 // A missing source is an error before anything steps; a bad field names itself; removing the
 // emitter (or its group) stops it.
-TEST(DeathEmitter, ErrorsAndRemoval) {
-  Context ctx;
+namespace {
+// A group "a" of short-lived particles born at `rate`.
+Group& shortLived(Context& ctx, double rate) {
   Group& a = ctx.createGroup("a", 100);
   a.setActions({Move{}, KillOld{}});
   Emitter e;
-  e.rate = 1000;
+  e.rate = rate;
   e.types[0].lifetime = 0.05f;
   a.addEmitter(e);
+  return a;
+}
+}  // namespace
+
+TEST(DeathEmitter, ErrorsAndRemoval) {
+  Context ctx;
+  Group& a = shortLived(ctx, 1000);
   Group& b = ctx.createGroup("b", 1000);
   DeathEmitter de;
   de.source = "nobody";
@@ -841,12 +849,7 @@ TEST(DeathEmitter, ErrorsAndRemoval) {
 // Prewarm runs the death emitters of the groups it steps when their source is stepped too.
 TEST(DeathEmitter, PrewarmFeedsThemWhenBothSidesStep) {
   Context ctx;
-  Group& a = ctx.createGroup("a", 100);
-  a.setActions({Move{}, KillOld{}});
-  Emitter e;
-  e.rate = 300;
-  e.types[0].lifetime = 0.05f;
-  a.addEmitter(e);
+  Group& a = shortLived(ctx, 300);
   Group& b = ctx.createGroup("b", 1000);
   DeathEmitter de;
   de.source = "a";

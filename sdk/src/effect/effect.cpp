@@ -562,8 +562,10 @@ void read(const json& j, const std::string& path, const Loader& L, E& out) {
   L.fail(path, "\"" + s + "\" is not one of " + list + suggestion(s, all));
 }
 
-Emitter readEmitter(const json& j, const std::string& path, const Loader& L) {
-  Emitter e;
+/// A described emitter kind read, then validated by its own validate() at its JSON path.
+template <class E>
+E readValidated(const json& j, const std::string& path, const Loader& L) {
+  E e;
   read(j, path, L, e);
   try {
     e.validate(path);
@@ -571,6 +573,10 @@ Emitter readEmitter(const json& j, const std::string& path, const Loader& L) {
     L.rethrow(path, x);
   }
   return e;
+}
+
+Emitter readEmitter(const json& j, const std::string& path, const Loader& L) {
+  return readValidated<Emitter>(j, path, L);
 }
 
 /// A prime emitter's levels nest: bounded like domains.
@@ -588,14 +594,7 @@ void read(const json& j, const std::string& path, const Loader& L,
 }
 
 DeathEmitter readDeathEmitter(const json& j, const std::string& path, const Loader& L) {
-  DeathEmitter d;
-  read(j, path, L, d);
-  try {
-    d.validate(path);
-  } catch (const InvalidArgument& x) {
-    L.rethrow(path, x);
-  }
-  return d;
+  return readValidated<DeathEmitter>(j, path, L);
 }
 
 // Death emitters name a group of the effect, and their cause an action of its list as the
@@ -629,14 +628,7 @@ void linkDeathEmitters(Effect& fx, const json& groups, const Loader& L) {
 }
 
 PrimeEmitter readPrime(const json& j, const std::string& path, const Loader& L) {
-  PrimeEmitter p;
-  read(j, path, L, p);
-  try {
-    p.validate(path);
-  } catch (const InvalidArgument& x) {
-    L.rethrow(path, x);
-  }
-  return p;
+  return readValidated<PrimeEmitter>(j, path, L);
 }
 
 // ---- actions --------------------------------------------------------------------------------
