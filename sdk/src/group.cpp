@@ -9,6 +9,7 @@
 #include "action_traits.hpp"
 #include "flurry/error.hpp"
 #include "group_impl.hpp"
+#include "thread_pool.hpp"
 #include "transform.hpp"
 
 namespace flurry {
@@ -557,26 +558,40 @@ const GroupStats& Group::stats() const {
   return impl_->stats;
 }
 
-void detail::GroupImpl::recordDeaths(std::size_t B, std::size_t blocks, double t1) {
+void detail::GroupImpl::recordDeaths(std::size_t B, std::size_t blocks, double t1,
+                                     ThreadPool& pool) {
+  // Where each block's events start: the first in particle order are kept, up to the room.
+  if (deathStart.size() < blocks + 1) deathStart.resize(blocks + 1);  // grows once
+  std::size_t total = 0;
+  for (std::size_t b = 0; b < blocks; ++b) {
+    deathStart[b] = total;
+    total += deadCount[b];
+  }
+  deathStart[blocks] = total;
+  const std::size_t kept = std::min(total, deathRoom());
+  stats.deathEventsDropped += total - kept;
+  deathEvents.resize(kept);  // within the room reserved by Group::recordDeaths: no allocation
+  if (kept == 0) return;
   const Lanes L = lanePointers();
-  for (std::size_t b = 0; b < blocks; ++b)
-    for (std::uint32_t j = 0; j < deadCount[b]; ++j) {
-      if (deathEvents.size() == deathRoom()) {
-        stats.deathEventsDropped += deadCount[b] - j;
-        break;
+  constexpr std::size_t kBlocksPerTask = 64;
+  pool.parallelFor((blocks + kBlocksPerTask - 1) / kBlocksPerTask, [&](std::size_t task) {
+    const std::size_t end = std::min(blocks, (task + 1) * kBlocksPerTask);
+    for (std::size_t b = task * kBlocksPerTask; b < end && deathStart[b] < kept; ++b) {
+      const std::size_t n = std::min<std::size_t>(deadCount[b], kept - deathStart[b]);
+      for (std::size_t j = 0; j < n; ++j) {
+        const std::size_t i = deadIndex[b * B + j];
+        const std::uint8_t code = deadCode[b * B + j];
+        DeathEvent& e = deathEvents[deathStart[b] + j];
+        for (int c = 0; c < 3; ++c) {
+          e.position[c] = L.p[c][i];
+          e.velocity[c] = L.v[0] ? L.v[c][i] : 0.0f;
+        }
+        e.id = L.id ? L.id[i] : 0u;
+        e.action = code == kNonFiniteCode ? DeathEvent::kNonFinite : std::uint32_t(code) - 1u;
+        e.time = t1;
       }
-      const std::size_t i = deadIndex[b * B + j];
-      const std::uint8_t code = deadCode[b * B + j];
-      DeathEvent e;
-      for (int c = 0; c < 3; ++c) {
-        e.position[c] = L.p[c][i];
-        if (L.v[0]) e.velocity[c] = L.v[c][i];
-      }
-      e.id = L.id ? L.id[i] : 0u;
-      e.action = code == detail::kNonFiniteCode ? DeathEvent::kNonFinite : std::uint32_t(code) - 1u;
-      e.time = t1;
-      deathEvents.push_back(e);  // within the room reserved by Group::recordDeaths
     }
+  });
 }
 
 void detail::GroupImpl::feedDeaths() {

@@ -14,6 +14,8 @@
 
 namespace flurry::detail {
 
+class ThreadPool;
+
 /// One 64-byte aligned array of 32-bit values. Large arrays ask for transparent huge pages:
 /// the update is bandwidth-bound, and huge pages measurably raise the bandwidth reached.
 class LaneBuffer {
@@ -212,6 +214,7 @@ struct GroupImpl {
   /// The context's count of death emitters in all its groups (0: Context::step skips them).
   std::size_t* contextDeathEmitters = nullptr;
   std::vector<DeathEvent> deathEvents;  ///< the last step's, reserved by recordDeaths
+  std::vector<std::size_t> deathStart;  ///< scratch: each block's first event
   bool onDevice = false;                ///< its context runs a device backend
   /// Group::bounds() was asked: from then on the CPU pass takes the live particles' box
   /// every step, each block while it is in cache (no pass of its own).
@@ -279,7 +282,7 @@ struct GroupImpl {
   /// The step's dead (deadIndex/deadCode of `blocks` blocks of B, their lanes not yet
   /// compacted) as DeathEvents at time t1, in particle order up to deathRoom(); the rest
   /// counted. Out of line in group.cpp for the reason of assignFill.
-  void recordDeaths(std::size_t B, std::size_t blocks, double t1);
+  void recordDeaths(std::size_t B, std::size_t blocks, double t1, ThreadPool& pool);
   /// Records every death from now on (a death emitter names this group); the room is taken
   /// here, once.
   void feedDeaths();

@@ -615,7 +615,7 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
     const std::uint32_t* idx = g.deadIndex.data() + b * B;
     g.holes.insert(g.holes.end(), idx, idx + g.deadCount[b]);  // within the capacity
   }
-  if (g.deathRoom() > 0) g.recordDeaths(B, blocks, sp.time + sp.dt);
+  if (g.deathRoom() > 0) g.recordDeaths(B, blocks, sp.time + sp.dt, *sp.pool);
   if (bounds) {
     Bounds& box = g.stepBounds;
     box.min = Vec3(kInfinity);
