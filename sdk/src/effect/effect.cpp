@@ -1301,26 +1301,29 @@ ActionList parseEffectActions(std::string_view actions, const std::string& fileN
   }
 }
 
-Emitter parseEffectEmitter(std::string_view emitter, const std::string& fileName,
-                           const std::string& path, const EffectLoadOptions& options) {
-  const json j = parsePart(emitter, fileName, path);
+namespace {
+// One part of an effect (an emitter, a death emitter) from its own JSON text, by `read`.
+template <class Read>
+auto parseEffectPart(std::string_view text, const std::string& fileName, const std::string& path,
+                     const EffectLoadOptions& options, Read read) {
+  const json j = parsePart(text, fileName, path);
   const Loader L{fileName, &options, 0};
   try {
-    return readEmitter(j, path, L);
+    return read(j, path, L);
   } catch (const json::exception& e) {
     throw EffectError(fileName, path, std::string("malformed: ") + e.what());
   }
 }
+}  // namespace
+
+Emitter parseEffectEmitter(std::string_view emitter, const std::string& fileName,
+                           const std::string& path, const EffectLoadOptions& options) {
+  return parseEffectPart(emitter, fileName, path, options, readEmitter);
+}
 
 DeathEmitter parseEffectDeathEmitter(std::string_view deathEmitter, const std::string& fileName,
                                      const std::string& path, const EffectLoadOptions& options) {
-  const json j = parsePart(deathEmitter, fileName, path);
-  const Loader L{fileName, &options, 0};
-  try {
-    return readDeathEmitter(j, path, L);
-  } catch (const json::exception& e) {
-    throw EffectError(fileName, path, std::string("malformed: ") + e.what());
-  }
+  return parseEffectPart(deathEmitter, fileName, path, options, readDeathEmitter);
 }
 
 }  // namespace detail
