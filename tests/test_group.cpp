@@ -846,6 +846,28 @@ TEST(DeathEmitter, ErrorsAndRemoval) {
   EXPECT_TRUE(a.deaths().empty());  // nobody listens: no longer recorded
 }
 
+// A particle killed for a NaN has no place to emit from: it gives no newborns.
+TEST(DeathEmitter, ANaNDeathGivesNone) {
+  Context ctx;
+  Group& a = ctx.createGroup("a", 10);
+  a.setActions({Move{}, KillOld{}});
+  Particle p;
+  p.velocity = Vec3(std::nanf(""), 0.0f, 0.0f);
+  ASSERT_TRUE(a.add(p));
+  p.velocity = Vec3(1.0f, 0.0f, 0.0f);
+  p.lifetime = 0.01f;  // dies of age in the first step
+  ASSERT_TRUE(a.add(p));
+  Group& b = ctx.createGroup("b", 10);
+  DeathEmitter de;
+  de.source = "a";
+  b.addDeathEmitter(de);
+  ctx.step();
+  EXPECT_EQ(a.stats().killedNonFinite, 1u);
+  EXPECT_EQ(a.stats().killedByAge, 1u);
+  ASSERT_EQ(b.size(), 1u);  // the one that died of age
+  EXPECT_TRUE(std::isfinite(b.particle(0).position.x));
+}
+
 // Prewarm runs the death emitters of the groups it steps when their source is stepped too.
 TEST(DeathEmitter, PrewarmFeedsThemWhenBothSidesStep) {
   Context ctx;

@@ -393,6 +393,8 @@ void emitFromDeaths(GroupImpl& g, std::size_t k, const GroupImpl& source, std::u
   const Lanes L = g.lanePointers();
   const std::size_t before = g.size;
   for (const DeathEvent& d : source.deathEvents) {
+    // A particle killed for a NaN or an infinity has no place to emit from.
+    if (d.action == DeathEvent::kNonFinite) continue;
     if (de.cause >= 0 && d.action != std::uint32_t(de.cause)) continue;
     // How many, keyed by the dead particle, this group and this emitter: two emitters fed by
     // one source draw apart.

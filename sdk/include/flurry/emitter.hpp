@@ -134,7 +134,8 @@ struct PrimeEmitter {
 
 /// Emits particles where another group's particles die: a sub-emitter on death (a rocket's
 /// burst of sparks, a raindrop's splash where it hit the floor). After each step, every death
-/// the `source` group had in it (by age, by an absorber, for a NaN: see Group::deaths) gives
+/// the `source` group had in it (by age or by an absorber: see Group::deaths; one for a NaN
+/// has no place and gives none) gives
 /// `count` newborns to the group holding this emitter. They are born at the end of that step,
 /// at the dead particle's place plus a sample of `shape`, with a type's velocity plus
 /// `inheritVelocity` times the dead particle's, and age 0: the next step runs them through
