@@ -399,6 +399,15 @@ void detail::GroupImpl::placeEmitters() {
   frame->emittersDerived = emittersVersion;
 }
 
+namespace {
+// Throws InvalidArgument "index" unless i < n (n of `what`).
+void checkIndex(std::size_t i, std::size_t n, const char* what) {
+  if (i >= n)
+    throw InvalidArgument("index",
+                          std::to_string(i) + " is past the " + std::to_string(n) + " " + what);
+}
+}  // namespace
+
 Emitter& Group::addEmitter(Emitter emitter) {
   emitter.validate("emitters[" + std::to_string(impl_->emitters.size()) + "]");
   auto& g = *impl_;
@@ -426,9 +435,7 @@ std::span<Emitter> Group::emitters() {
 
 void Group::removeEmitter(std::size_t i) {
   auto& g = *impl_;
-  if (i >= g.emitters.size())
-    throw InvalidArgument("index", std::to_string(i) + " is past the " +
-                                       std::to_string(g.emitters.size()) + " emitters");
+  checkIndex(i, g.emitters.size(), "emitters");
   g.emitters.erase(g.emitters.begin() + std::ptrdiff_t(i));
   if (g.frame) g.frame->emitters.erase(g.frame->emitters.begin() + std::ptrdiff_t(i));
   g.emitterState.erase(g.emitterState.begin() + std::ptrdiff_t(i));
@@ -631,9 +638,7 @@ std::span<DeathEmitter> Group::deathEmitters() {
 
 void Group::removeDeathEmitter(std::size_t i) {
   auto& g = *impl_;
-  if (i >= g.deathEmitters.size())
-    throw InvalidArgument("index", std::to_string(i) + " is past the " +
-                                       std::to_string(g.deathEmitters.size()) + " death emitters");
+  checkIndex(i, g.deathEmitters.size(), "death emitters");
   g.deathEmitters.erase(g.deathEmitters.begin() + std::ptrdiff_t(i));
   if (g.contextDeathEmitters) --*g.contextDeathEmitters;
 }

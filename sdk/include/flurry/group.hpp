@@ -199,7 +199,8 @@ class Group {
   /// Records every step's deaths (by age, by an absorber, for a NaN) as DeathEvents for the
   /// game to read after the step (deaths()), at most `perStep` a step: the first in particle
   /// order, the same on any thread count; the rest are counted in
-  /// GroupStats::deathEventsDropped. 0 stops it. The room is taken here, not per step, and
+  /// GroupStats::deathEventsDropped (while a DeathEmitter names the group, all of them are
+  /// recorded for it). 0 stops it. The room is taken here, not per step, and
   /// while off it costs nothing. Stores ids (the events carry them). The CPU backend
   /// records them; a device backend throws Error (not yet there).
   Group& recordDeaths(std::size_t perStep);
