@@ -69,10 +69,18 @@ void checkDt(double dt) {
 
 Context::Context(ContextOptions options) : impl_(std::make_unique<Impl>()) {
   checkDt(options.dt);
-  if (options.threads == 0) options.threads = std::max(1u, std::thread::hardware_concurrency());
-  if (options.threads > 1024) throw InvalidArgument("threads", "must be <= 1024");
+  if (options.scheduler) {
+    if (options.threads != 0)
+      throw InvalidArgument("threads",
+                            "must be 0 with a scheduler (its concurrency() counts them)");
+    impl_->pool = std::make_unique<detail::ThreadPool>(options.scheduler);
+    options.threads = impl_->pool->size();
+  } else {
+    if (options.threads == 0) options.threads = std::max(1u, std::thread::hardware_concurrency());
+    if (options.threads > 1024) throw InvalidArgument("threads", "must be <= 1024");
+    impl_->pool = std::make_unique<detail::ThreadPool>(options.threads);
+  }
   impl_->options = options;
-  impl_->pool = std::make_unique<detail::ThreadPool>(options.threads);
   switch (options.backend) {
     case Backend::Cpu:
       break;

@@ -20,6 +20,15 @@ ThreadPool::ThreadPool(unsigned threads) {
   }
 }
 
+ThreadPool::ThreadPool(std::shared_ptr<TaskScheduler> external) : external_(std::move(external)) {
+  if (!external_) throw InvalidArgument("scheduler", "is null");
+  const unsigned n = external_->concurrency();
+  if (n < 1 || n > 1024)
+    throw InvalidArgument("scheduler",
+                          "concurrency() must be 1 to 1024 (got " + std::to_string(n) + ")");
+  externalSize_ = n;
+}
+
 ThreadPool::~ThreadPool() {
   stopWorkers();
 }
@@ -64,7 +73,40 @@ void ThreadPool::workerLoop() {
   }
 }
 
+void ThreadPool::runExternal(std::size_t tasks, Job job) {
+  // The game's job system never sees an exception: the first a task throws is kept and
+  // rethrown here, and the tasks after it return at once.
+  struct Shared {
+    Job job;
+    std::atomic<std::size_t> ran{0};
+    std::atomic<bool> failed{false};
+    std::exception_ptr error;
+    std::mutex errorMutex;
+  } shared;
+  shared.job = job;
+  auto call = [](void* context, std::size_t i) {
+    auto& sh = *static_cast<Shared*>(context);
+    sh.ran.fetch_add(1, std::memory_order_relaxed);
+    if (sh.failed.load(std::memory_order_relaxed)) return;
+    try {
+      sh.job.call(sh.job.fn, i);
+    } catch (...) {
+      std::lock_guard lock(sh.errorMutex);
+      if (!sh.error) sh.error = std::current_exception();
+      sh.failed.store(true, std::memory_order_relaxed);
+    }
+  };
+  external_->parallelFor(tasks, TaskRef{&shared, call});
+  if (shared.error) std::rethrow_exception(shared.error);
+  // A scheduler that returned early would leave particles half stepped: say so.
+  const std::size_t ran = shared.ran.load();
+  if (ran != tasks)
+    throw Error("the TaskScheduler's parallelFor returned after running " + std::to_string(ran) +
+                " of " + std::to_string(tasks) + " tasks (each must run exactly once)");
+}
+
 void ThreadPool::run(std::size_t tasks, Job job) {
+  if (external_) return runExternal(tasks, job);
   {
     std::lock_guard lock(mutex_);
     job_ = job;

@@ -6,10 +6,13 @@
 #include <condition_variable>
 #include <cstddef>
 #include <exception>
+#include <memory>
 #include <mutex>
 #include <thread>
 #include <type_traits>
 #include <vector>
+
+#include "flurry/scheduler.hpp"
 
 namespace flurry::detail {
 
@@ -18,11 +21,14 @@ class ThreadPool {
   /// `threads` counts the calling thread: 1 runs everything inline. Throws flurry::Error if
   /// the system cannot start them (no thread is left running).
   explicit ThreadPool(unsigned threads);
+  /// Runs the work on a game's job system; its concurrency() (1 to 1024, read now) is the
+  /// size. Throws InvalidArgument "scheduler" otherwise.
+  explicit ThreadPool(std::shared_ptr<TaskScheduler> external);
   ~ThreadPool();
   ThreadPool(const ThreadPool&) = delete;
   ThreadPool& operator=(const ThreadPool&) = delete;
 
-  unsigned size() const { return unsigned(workers_.size()) + 1; }
+  unsigned size() const { return external_ ? externalSize_ : unsigned(workers_.size()) + 1; }
 
   /// Runs f(i) for every i in [0, tasks) and returns when all are done. The first exception
   /// a task throws is rethrown here (the remaining tasks still finish or are skipped).
@@ -31,7 +37,7 @@ class ThreadPool {
   template <class F>
   void parallelFor(std::size_t tasks, F&& f) {
     if (tasks == 0) return;
-    if (workers_.empty() || tasks == 1) {
+    if (size() == 1 || tasks == 1) {
       for (std::size_t i = 0; i < tasks; ++i) f(i);
       return;
     }
@@ -48,10 +54,13 @@ class ThreadPool {
     void (*call)(void*, std::size_t) = nullptr;
   };
   void run(std::size_t tasks, Job job);
+  void runExternal(std::size_t tasks, Job job);
   void workerLoop();
   void stopWorkers();
   void runTasks();
 
+  std::shared_ptr<TaskScheduler> external_;  // when set, no workers of its own
+  unsigned externalSize_ = 1;
   std::vector<std::thread> workers_;
   std::mutex mutex_;
   std::condition_variable wake_, done_;

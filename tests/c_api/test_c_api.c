@@ -846,6 +846,84 @@ static void test_instances(void) {
   OK(flurry_effect_destroy(fx));
 }
 
+/* A job system in a few lines: every task on the calling thread, last first. */
+typedef struct reverse_scheduler {
+  int calls;
+  size_t tasks;
+} reverse_scheduler;
+
+static void reverse_parallel_for(void* user, size_t count, flurry_task_fn task, void* context) {
+  reverse_scheduler* s = (reverse_scheduler*)user;
+  size_t i;
+  ++s->calls;
+  s->tasks += count;
+  for (i = count; i-- > 0;) task(context, i);
+}
+
+/* 100,000 particles born at once (the emission and the pass in several tasks), 3 steps:
+ * their x positions, copied into `x`. */
+static void burst_positions(const flurry_scheduler* scheduler, float* x, size_t* n) {
+  const char* json =
+      "{\"name\": \"t\", \"dt\": 0.05, \"groups\": [{\"name\": \"g\", \"capacity\": 100000,"
+      " \"emitters\": [{\"bursts\": [{\"time\": 0, \"count\": 100000}], \"types\":"
+      " [{\"velocity\": {\"type\": \"sphere\", \"center\": [0, 1, 0], \"outerRadius\": 1}}]}],"
+      " \"actions\": [{\"type\": \"Gravity\", \"acceleration\": [0, -9.8, 0]},"
+      " {\"type\": \"Move\"}]}]}";
+  flurry_effect* fx = NULL;
+  flurry_context* ctx = NULL;
+  flurry_context_options o;
+  flurry_group* g = NULL;
+  const float* lane = NULL;
+  size_t stride = 0;
+  *n = 0;
+  OK(flurry_effect_parse(json, "t", &fx));
+  OK(flurry_effect_context_options(fx, &o));
+  o.threads = scheduler ? 0 : 1;
+  if (scheduler)
+    OK(flurry_context_create_with_scheduler(&o, scheduler, &ctx));
+  else
+    OK(flurry_context_create(&o, &ctx));
+  OK(flurry_effect_build(fx, ctx, 0));
+  OK(flurry_context_run(ctx, 3));
+  OK(flurry_context_group(ctx, "g", &g));
+  OK(flurry_group_lane(g, FLURRY_ATTR_POSITION, 0, &lane, n, &stride));
+  if (lane && *n <= 100000) memcpy(x, lane, *n * sizeof(float));
+  OK(flurry_context_destroy(ctx));
+  OK(flurry_effect_destroy(fx));
+}
+
+static void test_scheduler(void) {
+  static float own[100000], theirs[100000];
+  size_t n_own = 0, n_theirs = 0;
+  reverse_scheduler counts = {0, 0};
+  flurry_scheduler s;
+  flurry_context_options o;
+  flurry_context* ctx = NULL;
+  s.user = &counts;
+  s.concurrency = 4;
+  s.parallel_for = reverse_parallel_for;
+  burst_positions(NULL, own, &n_own);
+  burst_positions(&s, theirs, &n_theirs);
+  CHECK(n_own == 100000 && n_theirs == n_own);
+  CHECK(memcmp(own, theirs, n_own * sizeof(float)) == 0); /* bitwise, in any order */
+  CHECK(counts.calls >= 3 && counts.tasks > (size_t)counts.calls);
+  OK(flurry_context_options_init(&o));
+  o.threads = 2;
+  FAILS(flurry_context_create_with_scheduler(&o, &s, &ctx), FLURRY_ERROR_INVALID_ARGUMENT,
+        "threads");
+  CHECK(ctx == NULL);
+  o.threads = 0;
+  FAILS(flurry_context_create_with_scheduler(&o, NULL, &ctx), FLURRY_ERROR_NULL_ARGUMENT,
+        "scheduler");
+  s.concurrency = 0;
+  FAILS(flurry_context_create_with_scheduler(&o, &s, &ctx), FLURRY_ERROR_INVALID_ARGUMENT,
+        "concurrency");
+  s.concurrency = 2;
+  s.parallel_for = NULL;
+  FAILS(flurry_context_create_with_scheduler(&o, &s, &ctx), FLURRY_ERROR_INVALID_ARGUMENT,
+        "parallel_for");
+}
+
 int main(int argc, char** argv) {
   if (argc != 3) {
     fprintf(stderr, "usage: test_c_api FOUNTAIN_JSON OUT_DIR\n");
@@ -861,6 +939,7 @@ int main(int argc, char** argv) {
   test_visible();
   test_transform();
   test_instances();
+  test_scheduler();
   if (failures) {
     fprintf(stderr, "%d checks failed\n", failures);
     return 1;

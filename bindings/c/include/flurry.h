@@ -128,6 +128,25 @@ FLURRY_C_EXPORT flurry_status flurry_context_options_init(flurry_context_options
  * FLURRY_ERROR_NOT_BUILT (no OpenCL in this build) or FLURRY_ERROR_NO_DEVICE. */
 FLURRY_C_EXPORT flurry_status flurry_context_create(const flurry_context_options* options,
                                                     flurry_context** out);
+/** One parallel loop's body: call task(task_context, i) with each index (it never unwinds
+ * into the caller: what the work fails with is reported by the call that asked for it). */
+typedef void (*flurry_task_fn)(void* task_context, size_t index);
+/** A game's own job system, to run the context's parallel work instead of its own threads. */
+typedef struct flurry_scheduler {
+  void* user;           /**< handed back to parallel_for; must outlive the context */
+  unsigned concurrency; /**< tasks it may run at once, the calling thread counted: 1 to 1024 */
+  /** Runs task(task_context, i) exactly once for every i in [0, count), on any threads and in
+   * any order, and returns when all have returned. Called from the thread that called the
+   * context (flurry_context_step, ...), never from inside a task, and only for count >= 2.
+   * The particles are bitwise the same whatever the order and the threads. */
+  void (*parallel_for)(void* user, size_t count, flurry_task_fn task, void* task_context);
+} flurry_scheduler;
+
+/** flurry_context_create with the work run on `scheduler` (copied; its `user` must outlive
+ * the context). `options->threads` must be 0 (FLURRY_ERROR_INVALID_ARGUMENT naming "threads"
+ * otherwise); a NULL parallel_for or a concurrency outside 1..1024 names "scheduler". */
+FLURRY_C_EXPORT flurry_status flurry_context_create_with_scheduler(
+    const flurry_context_options* options, const flurry_scheduler* scheduler, flurry_context** out);
 FLURRY_C_EXPORT flurry_status flurry_context_destroy(flurry_context* ctx);
 /** Advances every group by one time step. */
 FLURRY_C_EXPORT flurry_status flurry_context_step(flurry_context* ctx);

@@ -379,11 +379,33 @@ flurry_status flurry_context_options_init(flurry_context_options* options) {
   });
 }
 
-flurry_status flurry_context_create(const flurry_context_options* options, flurry_context** out) {
+namespace {
+
+// A flurry_scheduler as the SDK's TaskScheduler.
+class CScheduler final : public flurry::TaskScheduler {
+ public:
+  explicit CScheduler(const flurry_scheduler& s) : s_(s) {}
+  unsigned concurrency() const override { return s_.concurrency; }
+  void parallelFor(std::size_t count, flurry::TaskRef task) override {
+    s_.parallel_for(s_.user, count, task.call, task.context);
+  }
+
+ private:
+  flurry_scheduler s_;
+};
+
+flurry_status createContext(const flurry_context_options* options, bool withScheduler,
+                            const flurry_scheduler* scheduler, flurry_context** out) {
   return guard([&] {
     need(out, "out");
     *out = nullptr;
     flurry::ContextOptions o;
+    if (withScheduler) {
+      need(scheduler, "scheduler");
+      if (!scheduler->parallel_for)
+        throw flurry::InvalidArgument("scheduler", "parallel_for is NULL");
+      o.scheduler = std::make_shared<CScheduler>(*scheduler);
+    }
     if (options) {
       const long long backend = rawValue(options->backend);
       if (backend < 0 || backend > FLURRY_BACKEND_AUTO)
@@ -403,6 +425,18 @@ flurry_status flurry_context_create(const flurry_context_options* options, flurr
 #endif
     *out = new flurry_context(o);
   });
+}
+
+}  // namespace
+
+flurry_status flurry_context_create(const flurry_context_options* options, flurry_context** out) {
+  return createContext(options, false, nullptr, out);
+}
+
+flurry_status flurry_context_create_with_scheduler(const flurry_context_options* options,
+                                                   const flurry_scheduler* scheduler,
+                                                   flurry_context** out) {
+  return createContext(options, true, scheduler, out);
 }
 
 flurry_status flurry_context_destroy(flurry_context* ctx) {

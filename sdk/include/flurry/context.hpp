@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "flurry/group.hpp"
+#include "flurry/scheduler.hpp"
 
 namespace flurry {
 
@@ -31,6 +32,9 @@ struct ContextOptions {
   /// reach it this step. Exact: results are bitwise the same either way; false is for
   /// comparisons.
   bool cull = true;
+  /// A game's job system to run the parallel work on (TaskScheduler); null: the Context's
+  /// own threads. With one, `threads` must be 0: its concurrency() says how many.
+  std::shared_ptr<TaskScheduler> scheduler;
 };
 
 class Context {
