@@ -846,6 +846,40 @@ TEST(DeathEmitter, ErrorsAndRemoval) {
   EXPECT_TRUE(a.deaths().empty());  // nobody listens: no longer recorded
 }
 
+// The source is found by its name; the context keeps the group it found until a group comes
+// or goes or the name changes. A source destroyed is an error at the next step (nothing
+// moves); one made again under the name feeds the emitter again; a name edited in place is
+// looked up again.
+TEST(DeathEmitter, FollowsItsSourceByName) {
+  Context ctx;
+  Group& b = ctx.createGroup("b", 100000);
+  DeathEmitter de;
+  de.source = "a";
+  b.addDeathEmitter(de);
+  shortLived(ctx, 1000);
+  ctx.run(5);
+  const std::size_t fed = b.size();
+  EXPECT_GT(fed, 0u);
+  ctx.destroyGroup(ctx.group("a"));
+  EXPECT_THROW(ctx.step(), Error);
+  EXPECT_EQ(ctx.stepIndex(), 5u);
+  EXPECT_EQ(b.size(), fed);
+  shortLived(ctx, 1000);  // "a" again: a new group
+  ctx.run(5);
+  const std::size_t fedAgain = b.size();
+  EXPECT_GT(fedAgain, fed);
+  Group& quiet = ctx.createGroup("quiet", 10);  // no particles, no deaths
+  b.deathEmitters()[0].source = "quiet";
+  ctx.run(5);
+  EXPECT_EQ(b.size(), fedAgain);
+  EXPECT_EQ(quiet.size(), 0u);
+  b.deathEmitters()[0].source = "nobody";
+  EXPECT_THROW(ctx.step(), Error);
+  b.deathEmitters()[0].source = "a";
+  ctx.run(5);
+  EXPECT_GT(b.size(), fedAgain);
+}
+
 // A particle killed for a NaN has no place to emit from: it gives no newborns.
 TEST(DeathEmitter, ANaNDeathGivesNone) {
   Context ctx;

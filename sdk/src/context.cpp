@@ -45,6 +45,9 @@ struct Context::Impl {
 
   // Death emitters (Group::addDeathEmitter) in all the groups: while there are none a step
   // spends nothing on them.
+  std::uint64_t groupsVersion = 0;  // changes when a group is created or destroyed
+  /// Death emitter k's source group, or null (found by name only when something changed).
+  Group* sourceOf(detail::GroupImpl& gi, std::size_t k);
   std::size_t deathEmitters = 0;
   bool deathsFed = false;  // some group was told to record its deaths for them
   /// Tells every source group to record its deaths; throws, before anything steps, for a
@@ -142,6 +145,7 @@ Group& Context::createGroup(std::string name, std::size_t capacity) {
   }
   impl_->groups.push_back(std::move(group));
   impl_->byName.emplace(g.name(), &g);
+  ++impl_->groupsVersion;
   return g;
 }
 
@@ -152,6 +156,7 @@ void Context::destroyGroup(Group& group) {
   if (it == all.end())
     throw InvalidArgument("group", "'" + group.name() + "' is not a group of this context");
   impl_->byName.erase(group.name());
+  ++impl_->groupsVersion;
   impl_->deathEmitters -= group.impl_->deathEmitters.size();
   impl_->freeIndices.push_back(group.impl_->index);
   std::push_heap(impl_->freeIndices.begin(), impl_->freeIndices.end(), std::greater<>());
@@ -211,20 +216,32 @@ detail::StepParams Context::Impl::params() const {
   return sp;
 }
 
+Group* Context::Impl::sourceOf(detail::GroupImpl& gi, std::size_t k) {
+  if (gi.deathSources.size() != gi.deathEmitters.size())
+    gi.deathSources.resize(gi.deathEmitters.size());  // a removal shifts them: names tell
+  auto& found = gi.deathSources[k];
+  const std::string& name = gi.deathEmitters[k].source;
+  if (found.version == groupsVersion && found.name == name) return found.group;
+  const auto it = byName.find(name);
+  found.group = it == byName.end() ? nullptr : it->second;
+  found.name = name;
+  found.version = groupsVersion;
+  return found.group;
+}
+
 void Context::Impl::feedDeathEmitters() {
   if (deathEmitters == 0 && !deathsFed) return;
   for (auto& g : groups) g->impl_->deathsFeed = false;
   deathsFed = false;
   if (deathEmitters == 0) return;
   for (auto& g : groups) {
-    const auto& gi = *g->impl_;
+    auto& gi = *g->impl_;
     for (std::size_t k = 0; k < gi.deathEmitters.size(); ++k) {
-      const DeathEmitter& de = gi.deathEmitters[k];
-      const auto it = byName.find(de.source);
-      if (it == byName.end())
+      Group* source = sourceOf(gi, k);
+      if (!source)
         throw Error("group '" + gi.name + "': deathEmitters[" + std::to_string(k) +
-                    "].source: no group named '" + de.source + "' in the context");
-      it->second->impl_->feedDeaths();
+                    "].source: no group named '" + gi.deathEmitters[k].source + "' in the context");
+      source->impl_->feedDeaths();
       deathsFed = true;
     }
   }
@@ -239,7 +256,7 @@ void Context::Impl::runDeathEmitters(std::span<Group* const> only) {
     auto& gi = *g->impl_;
     if (gi.deathEmitters.empty() || !in(g.get())) continue;
     for (std::size_t k = 0; k < gi.deathEmitters.size(); ++k) {
-      const Group* source = byName.at(gi.deathEmitters[k].source);  // feedDeathEmitters found it
+      const Group* source = sourceOf(gi, k);  // feedDeathEmitters found it
       if (in(source)) detail::emitFromDeaths(gi, k, *source->impl_, options.seed);
     }
   }

@@ -211,6 +211,15 @@ struct GroupImpl {
   /// The deaths a step records: deathsPerStep, or the capacity while deathsFeed.
   std::size_t deathRoom() const { return deathsFeed ? capacity : deathsPerStep; }
   std::vector<DeathEmitter> deathEmitters;
+  /// Each death emitter's source as Context::step last found it: the group, the name it was
+  /// found by and the context's groups' version then. Found again when either changed
+  /// (DeathEmitter::source is the caller's to edit), not by name every step.
+  struct FoundSource {
+    Group* group = nullptr;
+    std::string name;
+    std::uint64_t version = ~std::uint64_t(0);
+  };
+  std::vector<FoundSource> deathSources;
   /// The context's count of death emitters in all its groups (0: Context::step skips them).
   std::size_t* contextDeathEmitters = nullptr;
   std::vector<DeathEvent> deathEvents;  ///< the last step's, reserved by recordDeaths
