@@ -600,6 +600,126 @@ TEST(Instance, BoundsHoldEveryParticleOfItsGroups) {
 // Deaths are recorded where and when they happen: particles of known motion die of age at a
 // known step; the room a step has is kept (first in particle order, the rest counted); a
 // busy fountain's events are the same on any thread count and match its statistics.
+// Collision events: where, when and how fast each deflected particle met the surface, with
+// the surface's normal on its side; exact on known paths, the first kept past the room, the
+// same on any thread count.
+namespace {
+// One particle from `p` at velocity `v` through `actions` until `until` seconds (dt 1/8,
+// exact in binary): every collision event.
+std::vector<CollisionEvent> collisionsOf(Vec3 p, Vec3 v, ActionList actions, double until) {
+  ContextOptions o;
+  o.dt = 0.125;
+  Context ctx(o);
+  Group& g = ctx.createGroup("g", 4);
+  g.setActions(std::move(actions));
+  g.recordCollisions(8);
+  Particle q;
+  q.position = p;
+  q.velocity = v;
+  q.id = 0;
+  EXPECT_TRUE(g.add(q));
+  std::vector<CollisionEvent> all;
+  while (ctx.time() < until - 1e-9) {
+    ctx.step();
+    all.insert(all.end(), g.collisions().begin(), g.collisions().end());
+  }
+  return all;
+}
+
+void expectNear(Vec3 a, Vec3 b, float tol) {
+  EXPECT_NEAR(a.x, b.x, tol);
+  EXPECT_NEAR(a.y, b.y, tol);
+  EXPECT_NEAR(a.z, b.z, tol);
+}
+}  // namespace
+
+TEST(Group, CollisionEventsSayWhereWhenAndHowFast) {
+  // A wall at x = 2.05, met at t = 2.05 s in the middle of a step, from the -x side.
+  Bounce wall{Domain::plane(Vec3(2.05f, 0.0f, 0.0f), Vec3(1.0f, 0.0f, 0.0f))};
+  wall.restitution = 0.5f;
+  auto hits = collisionsOf(Vec3(0.0f, 1.0f, 0.0f), Vec3(1.0f, 0.0f, 0.0f), {wall, Move{}}, 4.0);
+  ASSERT_EQ(hits.size(), 1u);
+  expectNear(hits[0].position, Vec3(2.05f, 1.0f, 0.0f), 1e-5f);
+  EXPECT_EQ(hits[0].velocity, Vec3(1.0f, 0.0f, 0.0f));
+  EXPECT_EQ(hits[0].normal, Vec3(-1.0f, 0.0f, 0.0f));
+  EXPECT_NEAR(hits[0].time, 2.05, 1e-5);
+  EXPECT_EQ(hits[0].action, 0u);
+  EXPECT_EQ(hits[0].id, 0u);
+
+  // Dropped from 1 m on a floor under gravity, integrated exactly: the bounce finds the
+  // impact on the parabola, at t = sqrt(2/g) and v = -sqrt(2g).
+  const float g0 = 9.81f;
+  ActionList fall{Gravity{Vec3(0.0f, -g0, 0.0f)},
+                  Bounce{Domain::plane(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f)), 0.0f}, Move{}};
+  fall.setIntegrator(Integrator::Exact);
+  hits = collisionsOf(Vec3(3.0f, 1.0f, 0.0f), Vec3(0.0f), fall, 0.5);
+  ASSERT_EQ(hits.size(), 1u);
+  expectNear(hits[0].position, Vec3(3.0f, 0.0f, 0.0f), 1e-5f);
+  expectNear(hits[0].velocity, Vec3(0.0f, -std::sqrt(2.0f * g0), 0.0f), 1e-4f);
+  EXPECT_EQ(hits[0].normal, Vec3(0.0f, 1.0f, 0.0f));
+  EXPECT_NEAR(hits[0].time, std::sqrt(2.0 / g0), 1e-5);
+  EXPECT_EQ(hits[0].action, 1u);
+
+  // Kept inside a sphere of radius 2 about (1, 0, 0): leaves it at (3, 0, 0) at t = 2; the
+  // normal points back in.
+  Bounce ball{Domain::sphere(Vec3(1.0f, 0.0f, 0.0f), 2.0f)};
+  ball.inside = true;
+  hits = collisionsOf(Vec3(1.0f, 0.0f, 0.0f), Vec3(1.0f, 0.0f, 0.0f), {ball, Move{}}, 2.5);
+  ASSERT_EQ(hits.size(), 1u);
+  expectNear(hits[0].position, Vec3(3.0f, 0.0f, 0.0f), 1e-5f);
+  expectNear(hits[0].normal, Vec3(-1.0f, 0.0f, 0.0f), 1e-6f);
+  EXPECT_NEAR(hits[0].time, 2.0, 1e-5);
+
+  // A box met from outside on its -z face at t = 1.5.
+  Bounce box{Domain::box(Vec3(-1.0f, -1.0f, 0.0f), Vec3(1.0f, 1.0f, 2.0f))};
+  hits = collisionsOf(Vec3(0.5f, 0.25f, -3.0f), Vec3(0.0f, 0.0f, 2.0f), {box, Move{}}, 2.0);
+  ASSERT_EQ(hits.size(), 1u);
+  expectNear(hits[0].position, Vec3(0.5f, 0.25f, 0.0f), 1e-5f);
+  EXPECT_EQ(hits[0].normal, Vec3(0.0f, 0.0f, -1.0f));
+  EXPECT_NEAR(hits[0].time, 1.5, 1e-5);
+
+  // A busy fountain (a floor, action 1, and four walls, 2-5): every event on the piece its
+  // action names, arriving against the normal, the same on 1 and 2 threads; past the room
+  // the first are kept and the rest counted.
+  auto busy = [](unsigned threads, std::size_t room, std::uint64_t* dropped) {
+    ContextOptions bo;
+    bo.threads = threads;
+    Context c(bo);
+    Group& f = samples::buildFountain(c, 80000, 100000.0, 1.0f);
+    f.recordCollisions(room);
+    std::vector<CollisionEvent> all;
+    for (int s = 0; s < 40; ++s) {
+      c.step();
+      all.insert(all.end(), f.collisions().begin(), f.collisions().end());
+    }
+    *dropped = f.stats().collisionEventsDropped;
+    return all;
+  };
+  std::uint64_t dropped1 = 0, dropped2 = 0, droppedFew = 0;
+  const auto one = busy(1, 1000000, &dropped1), two = busy(2, 1000000, &dropped2);
+  ASSERT_GT(one.size(), 1000u);
+  EXPECT_EQ(dropped1, 0u);
+  ASSERT_EQ(one.size(), two.size());
+  EXPECT_EQ(std::memcmp(one.data(), two.data(), one.size() * sizeof(CollisionEvent)), 0);
+  std::size_t onTheirPiece = 0, onFloor = 0;
+  for (const CollisionEvent& e : one) {
+    // The plane of each piece: the coordinate it fixes and where.
+    const int axis[6] = {-1, 1, 2, 2, 0, 0};
+    const float at[6] = {0.0f, 0.0f, -2.6f, 2.6f, -2.6f, 2.6f};
+    if (e.action < 1 || e.action > 5) continue;
+    const int k = axis[e.action];
+    onTheirPiece += std::abs(e.position[k] - at[e.action]) < 1e-3f &&
+                    std::abs(std::abs(e.normal[k]) - 1.0f) < 1e-6f &&
+                    glm::dot(e.velocity, e.normal) <= 0.0f;
+    onFloor += e.action == 1;
+  }
+  EXPECT_EQ(onTheirPiece, one.size());
+  EXPECT_GT(onFloor, one.size() / 2);
+  const auto few = busy(2, 10, &droppedFew);
+  EXPECT_LE(few.size(), 40u * 10u);
+  EXPECT_EQ(few.size() + droppedFew, one.size());
+}
+
 TEST(Group, DeathEventsSayWhoDiedWhereAndOfWhat) {
   ContextOptions o;
   o.dt = 0.125;  // exact in binary: ages and places are exact

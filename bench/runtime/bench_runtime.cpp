@@ -8,7 +8,8 @@
 // (one command line).
 //
 // After the runs it prints the ratio of the medians, per thread count, what bounds every step
-// cost, and what a recorded death event costs (Deaths: recording on against off).
+// cost, and what a recorded death or collision event costs (Deaths, Collisions: recording on
+// against off).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -146,6 +147,30 @@ void Deaths(benchmark::State& state) {
   deathsPerStep_[state.range(1)] = died / double(state.iterations());
 }
 
+std::map<std::int64_t, double> collisionsPerStep_;  // Collisions' mean events a step, by threads
+
+// Collision events: a 1M-particle group of sparks falling on a floor (a third of them are
+// deflected every step, many resting on it) with recording off (range 0 = 0) and on (1): the
+// difference over the events is an event's cost.
+void Collisions(benchmark::State& state) {
+  ContextOptions o;
+  o.threads = unsigned(state.range(1));
+  Context ctx(o);
+  const Effect effect = parseEffect(sparks(kPerInstance * 10000));
+  EffectInstance one = effect.instantiate(ctx, "all");
+  Group& g = *one.groups()[0];
+  g.recordCollisions(state.range(0) != 0 ? 4 * g.capacity() : 0);
+  ctx.run(45);
+  double events = 0;
+  for (auto _ : state) {
+    ctx.step();
+    events += double(g.collisions().size());
+  }
+  benchmark::DoNotOptimize(g.collisions().data());
+  state.counters["events"] = events / double(state.iterations());
+  if (state.range(0) != 0) collisionsPerStep_[state.range(1)] = events / double(state.iterations());
+}
+
 void args(benchmark::internal::Benchmark* b) {
   const auto cores = int(std::max(1u, std::thread::hardware_concurrency()));
   for (int t : {1, cores}) {
@@ -158,6 +183,15 @@ void args(benchmark::internal::Benchmark* b) {
 BENCHMARK(Instances)->Apply(args);
 BENCHMARK(OneGroup)->Apply(args);
 BENCHMARK(Deaths)->Apply([](benchmark::internal::Benchmark* b) {
+  const auto cores = int(std::max(1u, std::thread::hardware_concurrency()));
+  for (int t : {1, cores}) {
+    for (int record : {0, 1}) b->Args({record, t});
+    if (cores == 1) break;
+  }
+  b->ArgNames({"record", "threads"})->Unit(benchmark::kMillisecond)->UseRealTime();
+});
+
+BENCHMARK(Collisions)->Apply([](benchmark::internal::Benchmark* b) {
   const auto cores = int(std::max(1u, std::thread::hardware_concurrency()));
   for (int t : {1, cores}) {
     for (int record : {0, 1}) b->Args({record, t});
@@ -211,6 +245,18 @@ class RatioReporter : public benchmark::ConsoleReporter {
           "  death events, threads:%s: %.0f deaths a step, recorded %.3f ms, off %.3f ms: "
           "%.1f ns an event\n",
           threads.c_str(), died->second, ms, off->second, (ms - off->second) * 1e6 / died->second);
+    }
+    for (const auto& [name, ms] : ms_) {
+      const std::string on = "Collisions/record:1/threads:";
+      if (name.rfind(on, 0) != 0) continue;
+      const std::string threads = name.substr(on.size());
+      const auto off = ms_.find("Collisions/record:0/threads:" + threads);
+      const auto hits = collisionsPerStep_.find(std::stoll(threads));
+      if (off == ms_.end() || hits == collisionsPerStep_.end() || hits->second <= 0) continue;
+      std::printf(
+          "  collision events, threads:%s: %.0f a step, recorded %.3f ms, off %.3f ms: "
+          "%.1f ns an event\n",
+          threads.c_str(), hits->second, ms, off->second, (ms - off->second) * 1e6 / hits->second);
     }
   }
 

@@ -196,6 +196,7 @@ void stepGroup(detail::BackendImpl& backend, detail::GroupImpl& gi, const detail
   gi.ensureStorage();
   gi.boundsValid = false;  // the CPU pass takes them again
   gi.deathEvents.clear();
+  gi.collisionEvents.clear();
   if (gi.stats.killedByAction.size() != gi.actions.size())
     gi.stats.killedByAction.assign(gi.actions.size(), 0);
   backend.step(gi, sp);

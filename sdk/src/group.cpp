@@ -601,6 +601,42 @@ void detail::GroupImpl::recordDeaths(std::size_t B, std::size_t blocks, double t
   });
 }
 
+void detail::GroupImpl::beginCollisions(std::size_t blocks) {
+  if (blockCollisions.size() < blocks) blockCollisions.resize(blocks);
+  for (std::size_t b = 0; b < blocks; ++b) blockCollisions[b].clear();
+}
+
+void detail::GroupImpl::addCollision(std::size_t block, const CollisionEvent& e) {
+  blockCollisions[block].push_back(e);
+}
+
+void detail::GroupImpl::endCollisions(std::size_t blocks) {
+  collisionEvents.clear();
+  for (std::size_t b = 0; b < blocks; ++b) {
+    const auto& found = blockCollisions[b];
+    const std::size_t take = std::min(found.size(), collisionsPerStep - collisionEvents.size());
+    collisionEvents.insert(collisionEvents.end(), found.begin(), found.begin() + take);
+    stats.collisionEventsDropped += found.size() - take;
+  }
+}
+
+Group& Group::recordCollisions(std::size_t perStep) {
+  auto& g = *impl_;
+  if (perStep > 0 && g.onDevice)
+    throw Error("recordCollisions: group '" + g.name +
+                "': collision events are recorded by the CPU backend only (this context runs "
+                "on a device)");
+  if (perStep > 0) require({Attribute::Id});
+  g.collisionEvents.clear();
+  g.collisionEvents.reserve(std::min(perStep, g.capacity));
+  g.collisionsPerStep = perStep;
+  return *this;
+}
+
+std::span<const CollisionEvent> Group::collisions() const {
+  return impl_->collisionEvents;
+}
+
 void detail::GroupImpl::feedDeaths() {
   if (deathsFeed) return;
   deathEvents.reserve(capacity);  // no step has more deaths than the group holds particles

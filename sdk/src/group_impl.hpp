@@ -222,6 +222,16 @@ struct GroupImpl {
   std::vector<FoundSource> deathSources;
   /// The context's count of death emitters in all its groups (0: Context::step skips them).
   std::size_t* contextDeathEmitters = nullptr;
+  std::size_t collisionsPerStep = 0;            ///< Group::recordCollisions; 0: not recording
+  std::vector<CollisionEvent> collisionEvents;  ///< the last step's, reserved up to the room
+  /// Each block's collisions as the pass finds them (a block's in its own order), merged in
+  /// block order after it: the same on any thread count. They only grow.
+  std::vector<std::vector<CollisionEvent>> blockCollisions;
+  /// Out of line here (see assignFill): the pass clears `blocks` blocks' lists, adds to one,
+  /// and takes the first collisionsPerStep of them in block order after.
+  void beginCollisions(std::size_t blocks);
+  void addCollision(std::size_t block, const CollisionEvent& e);
+  void endCollisions(std::size_t blocks);
   std::vector<DeathEvent> deathEvents;  ///< the last step's, reserved by recordDeaths
   std::vector<std::size_t> deathStart;  ///< scratch: each block's first event
   bool onDevice = false;                ///< its context runs a device backend

@@ -846,6 +846,56 @@ static void test_instances(void) {
   OK(flurry_effect_destroy(fx));
 }
 
+/* Drops falling from 1 m on a floor (action 1) under gravity: every collision there, when it
+ * happens, arriving downwards. */
+static void test_collisions(void) {
+  const char* json =
+      "{\"name\": \"t\", \"dt\": 0.02, \"groups\": [{\"name\": \"g\", \"capacity\": 1000,"
+      " \"emitters\": [{\"rate\": 1000, \"shape\": [0, 1, 0],"
+      " \"types\": [{\"velocity\": [0.5, 0, 0], \"lifetime\": 2}]}],"
+      " \"actions\": [{\"type\": \"Gravity\", \"acceleration\": [0, -9.81, 0]},"
+      " {\"type\": \"Bounce\", \"surface\": {\"type\": \"plane\", \"point\": [0, 0, 0],"
+      " \"normal\": [0, 1, 0]}, \"restitution\": 0.5}, {\"type\": \"Move\"},"
+      " {\"type\": \"KillOld\"}]}]}";
+  flurry_effect* fx = NULL;
+  flurry_context* ctx = NULL;
+  flurry_context_options o;
+  flurry_group* g = NULL;
+  const flurry_collision_event* hits = NULL;
+  size_t count = 0, k;
+  uint64_t dropped = 1, bounced = 0;
+  double t0 = 0, t1 = 0;
+  int step;
+  OK(flurry_effect_parse(json, "t", &fx));
+  OK(flurry_effect_context_options(fx, &o));
+  OK(flurry_context_create(&o, &ctx));
+  OK(flurry_effect_build(fx, ctx, 0));
+  OK(flurry_context_group(ctx, "g", &g));
+  OK(flurry_group_record_collisions(g, 100000));
+  for (step = 0; step < 60; ++step) {
+    OK(flurry_context_time(ctx, &t0));
+    OK(flurry_context_step(ctx));
+    OK(flurry_context_time(ctx, &t1));
+    OK(flurry_group_collisions(g, &hits, &count, &dropped));
+    for (k = 0; k < count; ++k) {
+      bounced++;
+      CHECK(hits[k].action == 1 && fabsf(hits[k].position[1]) < 1e-3f);
+      CHECK(hits[k].normal[1] == 1.0f && hits[k].velocity[1] < 0.0f);
+      CHECK(hits[k].time >= t0 && hits[k].time <= t1 + 1e-9);
+    }
+  }
+  CHECK(bounced > 100 && dropped == 0);
+  FAILS(flurry_group_collisions(NULL, &hits, &count, NULL), FLURRY_ERROR_NULL_ARGUMENT, "group");
+  FAILS(flurry_group_collisions(g, &hits, NULL, NULL), FLURRY_ERROR_NULL_ARGUMENT, "count");
+  FAILS(flurry_group_record_collisions(NULL, 1), FLURRY_ERROR_NULL_ARGUMENT, "group");
+  OK(flurry_group_record_collisions(g, 0));
+  OK(flurry_context_step(ctx));
+  OK(flurry_group_collisions(g, &hits, &count, NULL));
+  CHECK(count == 0);
+  OK(flurry_context_destroy(ctx));
+  OK(flurry_effect_destroy(fx));
+}
+
 /* A job system in a few lines: every task on the calling thread, last first. */
 typedef struct reverse_scheduler {
   int calls;
@@ -940,6 +990,7 @@ int main(int argc, char** argv) {
   test_transform();
   test_instances();
   test_scheduler();
+  test_collisions();
   if (failures) {
     fprintf(stderr, "%d checks failed\n", failures);
     return 1;

@@ -239,6 +239,7 @@ TEST(OpenCLBackend, DeathEventsAreAClearErrorOnTheDevice) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("CPU backend only"), std::string::npos) << e.what();
   }
+  EXPECT_THROW(g.recordCollisions(100), Error);
   DeathEmitter de;
   de.source = g.name();
   EXPECT_THROW(ctx.createGroup("splash", 100).addDeathEmitter(de), Error);

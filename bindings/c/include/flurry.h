@@ -397,6 +397,27 @@ FLURRY_C_EXPORT flurry_status flurry_group_deaths(const flurry_group* group,
                                                   const flurry_death_event** events, size_t* count,
                                                   uint64_t* dropped);
 
+/** A particle deflected by a Bounce (flurry::CollisionEvent): where and when it met the
+ * surface, how fast it came, and the surface's unit normal on its side. */
+typedef struct flurry_collision_event {
+  float position[3]; /**< the point of impact */
+  float velocity[3]; /**< arriving there, before the bounce */
+  float normal[3];
+  uint32_t id;
+  uint32_t action; /**< index of the Bounce in the action list */
+  double time;     /**< the moment of impact */
+} flurry_collision_event;
+
+/** Records each step's collisions, at most `per_step` a step (the first in particle order; the
+ * rest counted in flurry_group_collisions' *dropped); 0 stops. CPU backend only: on a device
+ * FLURRY_ERROR_OTHER says so. */
+FLURRY_C_EXPORT flurry_status flurry_group_record_collisions(flurry_group* group, size_t per_step);
+/** The last step's collisions (valid until the next step); *dropped (may be NULL) gets those
+ * not recorded for want of room, over the group's life. */
+FLURRY_C_EXPORT flurry_status flurry_group_collisions(const flurry_group* group,
+                                                      const flurry_collision_event** events,
+                                                      size_t* count, uint64_t* dropped);
+
 /** Where the particles went (flurry::GroupStats):
  * emitted == size + killed_by_age + absorbed + dropped_at_capacity + killed_non_finite. */
 typedef struct flurry_group_stats {

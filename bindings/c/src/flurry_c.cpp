@@ -1096,6 +1096,28 @@ flurry_status flurry_group_deaths(const flurry_group* g, const flurry_death_even
     if (dropped) *dropped = group(g).stats().deathEventsDropped;
   });
 }
+static_assert(sizeof(flurry_collision_event) == sizeof(flurry::CollisionEvent));
+static_assert(offsetof(flurry_collision_event, normal) == offsetof(flurry::CollisionEvent, normal));
+static_assert(offsetof(flurry_collision_event, id) == offsetof(flurry::CollisionEvent, id));
+static_assert(offsetof(flurry_collision_event, time) == offsetof(flurry::CollisionEvent, time));
+flurry_status flurry_group_record_collisions(flurry_group* g, size_t perStep) {
+  return guard([&] {
+    need(g, "group");
+    group(g).recordCollisions(perStep);
+  });
+}
+flurry_status flurry_group_collisions(const flurry_group* g, const flurry_collision_event** events,
+                                      size_t* count, uint64_t* dropped) {
+  return guard([&] {
+    need(g, "group");
+    need(events, "events");
+    need(count, "count");
+    const std::span<const flurry::CollisionEvent> c = group(g).collisions();
+    *events = reinterpret_cast<const flurry_collision_event*>(c.data());
+    *count = c.size();
+    if (dropped) *dropped = group(g).stats().collisionEventsDropped;
+  });
+}
 flurry_status flurry_group_stats_get(const flurry_group* g, flurry_group_stats* out) {
   return guard([&] {
     need(g, "group");

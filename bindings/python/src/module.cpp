@@ -291,6 +291,7 @@ NB_MODULE(_flurry, m) {
       .def_ro("idle_steps", &flurry::GroupStats::idleSteps)
       .def_ro("block_actions_culled", &flurry::GroupStats::blockActionsCulled)
       .def_ro("death_events_dropped", &flurry::GroupStats::deathEventsDropped)
+      .def_ro("collision_events_dropped", &flurry::GroupStats::collisionEventsDropped)
       .def("__repr__", [](const flurry::GroupStats& s) {
         return "GroupStats(emitted=" + std::to_string(s.emitted) +
                ", killed_by_age=" + std::to_string(s.killedByAge) +
@@ -391,6 +392,41 @@ NB_MODULE(_flurry, m) {
           "The last step's deaths (record_deaths), copied: position (n, 3), velocity (n, 3), "
           "id (n,), action (n,): the index in the action list of what killed it, or "
           "0xFFFFFFFF for a NaN or infinity, and time (n,): the end of the step.")
+      .def(
+          "record_collisions",
+          [](GroupRef& pg, std::size_t perStep) { pg.g->recordCollisions(perStep); }, "per_step"_a,
+          "Records each step's collisions (each time a Bounce deflects a particle), at most "
+          "per_step a step (the first in particle order; the rest counted in "
+          "stats.collision_events_dropped); 0 stops. CPU backend only.")
+      .def(
+          "collisions",
+          [](const GroupRef& pg) {
+            // Copies: the events are replaced by the next step.
+            const auto d = pg.g->collisions();
+            const std::size_t n = d.size();
+            std::vector<float> pos(n * 3), vel(n * 3), nrm(n * 3);
+            std::vector<std::uint32_t> id(n), action(n);
+            std::vector<double> time(n);
+            for (std::size_t i = 0; i < n; ++i) {
+              for (int c = 0; c < 3; ++c) {
+                pos[i * 3 + c] = d[i].position[c];
+                vel[i * 3 + c] = d[i].velocity[c];
+                nrm[i * 3 + c] = d[i].normal[c];
+              }
+              id[i] = d[i].id, action[i] = d[i].action, time[i] = d[i].time;
+            }
+            nb::dict out;
+            out["position"] = owned(std::move(pos), {n, 3});
+            out["velocity"] = owned(std::move(vel), {n, 3});
+            out["normal"] = owned(std::move(nrm), {n, 3});
+            out["id"] = owned(std::move(id), {n});
+            out["action"] = owned(std::move(action), {n});
+            out["time"] = owned(std::move(time), {n});
+            return out;
+          },
+          "The last step's collisions (record_collisions), copied: position (n, 3) of impact, "
+          "velocity (n, 3) arriving, normal (n, 3) of the surface on the particle's side, id "
+          "(n,), action (n,): the Bounce's index in the action list, and time (n,) of impact.")
       .def(
           "sync", [](GroupRef& pg) { std::as_const(*pg.g).ids(); },
           "Brings the host copy up to date (OpenCL); Context.step does it for groups with views.")

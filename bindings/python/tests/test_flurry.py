@@ -347,6 +347,31 @@ def test_deaths_are_recorded_with_what_killed_them():
     assert len(g.deaths()["id"]) == 0
 
 
+def test_collisions_say_where_when_and_how_fast():
+    ctx = fountain()  # a floor (action 1) and four walls (2-5)
+    g = ctx.groups[0]
+    g.record_collisions(100000)
+    seen, on_floor = 0, 0
+    for _ in range(60):
+        t0 = ctx.time
+        ctx.step()
+        c = g.collisions()
+        n = len(c["id"])
+        assert c["position"].shape == c["velocity"].shape == c["normal"].shape == (n, 3)
+        assert np.all((c["time"] >= t0 - 1e-9) & (c["time"] <= ctx.time + 1e-9))
+        assert np.allclose(np.linalg.norm(c["normal"], axis=1), 1.0)
+        assert np.all(np.einsum("ij,ij->i", c["velocity"], c["normal"]) <= 0)
+        assert np.all((c["action"] >= 1) & (c["action"] <= 5))
+        floor = c["action"] == 1
+        assert np.all(np.abs(c["position"][floor, 1]) < 1e-3)
+        seen += n
+        on_floor += int(floor.sum())
+    assert on_floor > 0 and seen >= on_floor and g.stats.collision_events_dropped == 0
+    g.record_collisions(0)
+    ctx.step()
+    assert len(g.collisions()["id"]) == 0
+
+
 def test_bad_transforms_name_the_field():
     ctx = flurry.Context(threads=1)
     g = ctx.create_group("g", 10)

@@ -93,6 +93,8 @@ struct GroupStats {
   std::uint64_t bytesReadBack = 0;
   /// Deaths not recorded because a step had more than Group::recordDeaths' capacity.
   std::uint64_t deathEventsDropped = 0;
+  /// Collisions not recorded because a step had more than Group::recordCollisions' capacity.
+  std::uint64_t collisionEventsDropped = 0;
 };
 
 /// A particle's death, recorded for the game (Group::recordDeaths): where the particle was
@@ -106,6 +108,17 @@ struct DeathEvent {
   /// The index in the action list of what killed it (a KillOld, a Sink, ...), or kNonFinite.
   std::uint32_t action = 0;
   double time = 0.0;  ///< the end of the step it died in
+};
+
+/// A particle deflected by a Bounce, recorded for the game (Group::recordCollisions): where
+/// and when it met the surface, how fast it came, and the surface's normal there.
+struct CollisionEvent {
+  Vec3 position{0.0f};  ///< the point of impact, on the surface
+  Vec3 velocity{0.0f};  ///< arriving there (before the bounce)
+  Vec3 normal{0.0f};    ///< the surface's unit normal there, on the side the particle came from
+  std::uint32_t id = 0;
+  std::uint32_t action = 0;  ///< the index of the Bounce in the action list
+  double time = 0.0;         ///< the moment of impact
 };
 
 struct Bounds {
@@ -206,6 +219,15 @@ class Group {
   Group& recordDeaths(std::size_t perStep);
   /// The deaths of the last step (empty when not recording), valid until the next step.
   std::span<const DeathEvent> deaths() const;
+  /// Records every step's collisions (each time a Bounce deflects a particle) as
+  /// CollisionEvents for the game to read after the step (collisions()), at most `perStep`
+  /// a step: the first in particle order, the same on any thread count; the rest are counted
+  /// in GroupStats::collisionEventsDropped. 0 stops it; while off it costs nothing. A
+  /// particle resting on a floor is deflected, and reported, every step it rests (filter by
+  /// the speed). Stores ids. The CPU backend records them; a device backend throws Error.
+  Group& recordCollisions(std::size_t perStep);
+  /// The collisions of the last step (empty when not recording), valid until the next step.
+  std::span<const CollisionEvent> collisions() const;
   /// Axis-aligned bounds of the live particles' positions, in the world (for an engine's
   /// culling). The first call takes them in a pass of its own; from then on the CPU backend
   /// keeps them every step inside its action pass, while each block of particles is in cache,

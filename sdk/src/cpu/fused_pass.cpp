@@ -17,6 +17,7 @@
 #include "../action_traits.hpp"
 #include "../backend.hpp"
 #include "actions_more.hpp"
+#include "collisions.hpp"
 #include "integrate.hpp"
 #include "kernels.hpp"
 
@@ -230,7 +231,7 @@ void applyCulled(const Action& a, const Lanes& L, std::size_t n, const cpu::Bloc
 void runActions(const std::vector<Action>& acts, const Plan& plan, std::size_t first,
                 std::size_t last, const Lanes& lanes, std::size_t n, cpu::BlockContext ctx,
                 Culler* cull = nullptr) {
-  thread_local cpu::IntegratorScratch scratchStore;
+  thread_local cpu::IntegratorScratch scratchStore, keepStore;
   for (std::size_t k = first; k < last; ++k) {
     ctx.action = std::uint32_t(k);
     if (plan.list.gathered[k]) continue;  // evaluated inside its Move
@@ -260,6 +261,14 @@ void runActions(const std::vector<Action>& acts, const Plan& plan, std::size_t f
       }
       continue;
     }
+    // While the group records collisions, a Bounce's state before it is kept to find them.
+    float* before = nullptr;
+    if (ctx.collisions && std::holds_alternative<Bounce>(acts[k])) {
+      cpu::IntegratorScratch& keep = keepStore;
+      keep.reset(n, 6);
+      before = keep.take(6 * n);
+      cpu::keepState(lanes, n, before);
+    }
     if (plan.list.curvedBy[k]) {
       // The acceleration the Move's integrator starts from, taken as constant over the step.
       cpu::IntegratorScratch& scratch = scratchStore;
@@ -267,10 +276,15 @@ void runActions(const std::vector<Action>& acts, const Plan& plan, std::size_t f
       float* acc[3] = {scratch.take(n), scratch.take(n), scratch.take(n)};
       cpu::startAcceleration(acts, plan.list.forcesOf[plan.list.curvedBy[k] - 1], lanes, n, ctx,
                              acc);
-      cpu::applyAccelerated(std::get<Bounce>(acts[k]), lanes, n, ctx, acc);
+      const Bounce& b = std::get<Bounce>(acts[k]);
+      cpu::applyAccelerated(b, lanes, n, ctx, acc);
+      if (before) cpu::logCollisions(b, std::uint32_t(k), lanes, n, ctx, before, acc);
       continue;
     }
     std::visit([&](const auto& a) { cpu::apply(a, lanes, n, ctx); }, acts[k]);
+    if (before)
+      cpu::logCollisions(std::get<Bounce>(acts[k]), std::uint32_t(k), lanes, n, ctx, before,
+                         nullptr);
   }
 }
 
@@ -545,6 +559,8 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
 
   // Culling needs velocities for the swept bounds (a list that moves nothing has none).
   const bool cull = sp.cull && plan.list.cullable && lanes.v[0];
+  const bool logHits = g.collisionsPerStep > 0 && lanes.v[0];
+  if (logHits) g.beginCollisions(blocks);
   if (sp.fused) {
     sp.pool->parallelFor(tasks, [&](std::size_t t) {
       // The dead flags, all zero between blocks (collectDead clears what it takes); filled
@@ -567,7 +583,10 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
         ctx.dead = dead.data();
         const Lanes blockLanes = lanes.offset(first);
         const std::size_t old = oldIn(first, m);
+        cpu::CollisionLog log{&g, b, t1, plan.substeps, 0};
+        ctx.collisions = logHits ? &log : nullptr;
         for (std::uint32_t s = 0; s < plan.substeps; ++s) {
+          log.sub = s;
           Culler culler;  // the sub-step's own bounds
           runBlock(acts, plan, 0, acts.size(), blockLanes, m, old, atSubstep(ctx, s),
                    remainingAt(first, old), s, t1, cull ? &culler : nullptr);
@@ -592,6 +611,8 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
             cpu::BlockContext ctx = base;
             ctx.base = first;
             ctx.dead = g.deadFlags.data() + first;
+            cpu::CollisionLog log{&g, b, t1, plan.substeps, s};
+            ctx.collisions = logHits ? &log : nullptr;
             const std::size_t old = oldIn(first, m);
             runBlock(acts, plan, k, k + 1, lanes.offset(first), m, old, atSubstep(ctx, s),
                      remainingAt(first, old), s, t1);
@@ -616,6 +637,7 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
     g.holes.insert(g.holes.end(), idx, idx + g.deadCount[b]);  // within the capacity
   }
   if (g.deathRoom() > 0) g.recordDeaths(B, blocks, sp.time + sp.dt, *sp.pool);
+  if (logHits) g.endCollisions(blocks);
   if (bounds) {
     Bounds& box = g.stepBounds;
     box.min = Vec3(kInfinity);

@@ -40,6 +40,16 @@ struct Snapshot {
   std::size_t size = 0;
 };
 
+/// Where a block's collisions go while the group records them (Group::recordCollisions):
+/// the group, the block, the end of the step and the sub-step (an event's time is found
+/// from them and the particle's own step length).
+struct CollisionLog {
+  GroupImpl* group = nullptr;
+  std::size_t block = 0;
+  double t1 = 0.0;
+  std::uint32_t substeps = 1, sub = 0;
+};
+
 struct BlockContext {
   float dt;
   std::uint64_t seed;
@@ -54,6 +64,7 @@ struct BlockContext {
   /// Newborns: each particle's own step length (what is left of its birth step), indexed as
   /// `dead`; null when every particle of the block steps `dt`.
   const float* ownDt = nullptr;
+  CollisionLog* collisions = nullptr;  ///< non-null while the group records collisions
   /// Particle i's step length.
   float dtAt(std::size_t i) const { return ownDt ? ownDt[i] : dt; }
 };

@@ -1,0 +1,141 @@
+// Collision events (Group::recordCollisions): a Bounce's deflections, found by comparing each
+// particle's velocity before and after the action, and described from the state before it,
+// on the path the bounce itself took (the parabola of kernels/deflect.h for a planar piece
+// bounced with the acceleration, the straight line otherwise). Only while a group records:
+// the pass otherwise never reaches this code.
+#pragma once
+
+#include <cmath>
+#include <cstring>
+
+#include "kernels.hpp"
+
+namespace flurry::detail::cpu {
+inline namespace FLURRY_ISA_NAMESPACE {  // see isa_namespace.hpp
+
+/// A block's positions and velocities before a Bounce: six arrays of n in `keep`.
+inline void keepState(const Lanes& L, std::size_t n, float* keep) {
+  for (int c = 0; c < 3; ++c) {
+    std::memcpy(keep + c * n, L.p[c], n * sizeof(float));
+    std::memcpy(keep + (3 + c) * n, L.v[c], n * sizeof(float));
+  }
+}
+
+namespace collision {
+
+// When a straight path p + v·t meets a sphere (from outside: its first meeting; from inside:
+// its way out), within [0, dt]; the outward normal at that point.
+inline float sphereHit(Vec3 p, Vec3 v, const SphereDomain& s, bool inside, float dt, Vec3& n) {
+  const Vec3 d = p - s.center;
+  const float a = glm::dot(v, v), b = glm::dot(d, v),
+              c = glm::dot(d, d) - s.outerRadius * s.outerRadius;
+  const float disc = std::max(b * b - a * c, 0.0f);
+  float t = a > 0.0f ? (inside ? (-b + std::sqrt(disc)) / a : (-b - std::sqrt(disc)) / a) : 0.0f;
+  t = std::clamp(t, 0.0f, dt);
+  const Vec3 h = d + v * t;
+  const float len = glm::length(h);
+  n = len > 0.0f ? h / len : Vec3(0.0f, 1.0f, 0.0f);
+  return t;
+}
+
+// The same for a box: the face the path enters by (outside) or leaves by (inside); the
+// face's outward normal.
+inline float boxHit(Vec3 p, Vec3 v, const BoxDomain& box, bool inside, float dt, Vec3& n) {
+  float best = inside ? kInfinity : -kInfinity;
+  int axis = 0;
+  float sign = 1.0f;
+  for (int k = 0; k < 3; ++k) {
+    if (v[k] == 0.0f) continue;
+    const float t0 = (box.min[k] - p[k]) / v[k], t1 = (box.max[k] - p[k]) / v[k];
+    const float enter = std::min(t0, t1), leave = std::max(t0, t1);
+    // Outside: the latest entry; inside: the earliest exit.
+    if (inside ? leave < best : enter > best) {
+      best = inside ? leave : enter;
+      axis = k;
+      // The face met: max when moving + and leaving, or moving - and entering.
+      sign = (v[k] > 0.0f) == inside ? 1.0f : -1.0f;
+    }
+  }
+  n = Vec3(0.0f);
+  n[axis] = sign;
+  return std::isfinite(best) ? std::clamp(best, 0.0f, dt) : 0.0f;
+}
+
+}  // namespace collision
+
+/// flag[j] = 1 where particle j lives and its velocity (u) differs from what it was (v): a
+/// loop over __restrict parameters, which GCC vectorises (over a lambda's captures it does
+/// not).
+inline void deflectedFlags(const float* __restrict ux, const float* __restrict uy,
+                           const float* __restrict uz, const float* __restrict vx,
+                           const float* __restrict vy, const float* __restrict vz,
+                           const std::uint32_t* __restrict dead, std::size_t m,
+                           std::uint8_t* __restrict flag) {
+  for (std::size_t j = 0; j < m; ++j)
+    flag[j] =
+        std::uint8_t((dead[j] == 0) & ((ux[j] != vx[j]) | (uy[j] != vy[j]) | (uz[j] != vz[j])));
+}
+
+/// After Bounce `b` (action `action`) ran over the block's n particles whose state before is
+/// in `keep` (keepState): an event for each live particle whose velocity it changed. `acc`:
+/// the acceleration it bounced planar pieces with (three arrays), or null.
+inline void logCollisions(const Bounce& b, std::uint32_t action, const Lanes& L, std::size_t n,
+                          const BlockContext& c, const float* keep, const float* const* acc) {
+  CollisionLog& log = *c.collisions;
+  const float *px = keep, *py = keep + n, *pz = keep + 2 * n;
+  const float *vx = keep + 3 * n, *vy = keep + 4 * n, *vz = keep + 5 * n;
+  // Who was deflected, flags first (a loop that vectorises; most were not), then only those.
+  // A particle killed earlier in the list is not deflected, whatever the bounce did to it.
+  constexpr std::size_t kChunk = 256;
+  alignas(32) std::uint8_t hit[kChunk];
+  auto each = [&](auto&& event) {
+    for (std::size_t c0 = 0; c0 < n; c0 += kChunk) {
+      const std::size_t m = std::min(kChunk, n - c0);
+      deflectedFlags(L.v[0] + c0, L.v[1] + c0, L.v[2] + c0, vx + c0, vy + c0, vz + c0, c.dead + c0,
+                     m, hit);
+      for (std::size_t j = 0; j < m; ++j)
+        if (hit[j]) event(c0 + j);
+    }
+  };
+  auto finish = [&](CollisionEvent& e, std::size_t i, float dt, float tau, Vec3 v, Vec3 a) {
+    e.velocity = v + a * tau;
+    e.id = L.id ? L.id[i] : 0u;
+    e.action = action;
+    // The particle's sub-step began (substeps - sub) of its sub-step lengths before the end.
+    e.time = log.t1 - double(dt) * double(log.substeps - log.sub) + double(tau);
+    log.group->addCollision(log.block, e);
+  };
+  const bool planar = withPlanarPiece(b, [&](Vec3 P, Vec3 N, auto) {
+    each([&](std::size_t i) {
+      const float dt = c.dtAt(i);
+      const Vec3 v(vx[i], vy[i], vz[i]);
+      const Vec3 a = acc ? Vec3(acc[0][i], acc[1][i], acc[2][i]) : Vec3(0.0f);
+      CollisionEvent e;
+      float side, tau, hx, hy, hz;
+      kernel::fl_planar_accel_hit(px[i], py[i], pz[i], v.x, v.y, v.z, a.x, a.y, a.z, dt, P.x, P.y,
+                                  P.z, N.x, N.y, N.z, &side, &tau, &hx, &hy, &hz);
+      e.position = Vec3(hx, hy, hz);
+      e.normal = N * side;
+      finish(e, i, dt, tau, v, a);
+    });
+  });
+  if (planar) return;
+  const auto& shape = b.surface.shape();
+  each([&](std::size_t i) {
+    const float dt = c.dtAt(i);
+    const Vec3 p(px[i], py[i], pz[i]), v(vx[i], vy[i], vz[i]);
+    Vec3 nrm(0.0f);
+    float tau = 0.0f;
+    if (const auto* s = std::get_if<SphereDomain>(&shape))
+      tau = collision::sphereHit(p, v, *s, b.inside, dt, nrm);
+    else if (const auto* bx = std::get_if<BoxDomain>(&shape))
+      tau = collision::boxHit(p, v, *bx, b.inside, dt, nrm);
+    CollisionEvent e;
+    e.position = p + v * tau;
+    e.normal = b.inside ? -nrm : nrm;  // towards where the particle came from
+    finish(e, i, dt, tau, v, Vec3(0.0f));
+  });
+}
+
+}  // namespace FLURRY_ISA_NAMESPACE
+}  // namespace flurry::detail::cpu
