@@ -1000,6 +1000,71 @@ TEST(DeathEmitter, FollowsItsSourceByName) {
   EXPECT_GT(b.size(), fedAgain);
 }
 
+// On collision: each deflection gives `count` newborns at the point of impact, with the
+// arriving velocity inherited; bitwise on any thread count.
+TEST(DeathEmitter, OnCollisionEmitsAtEachImpact) {
+  ContextOptions o;
+  o.dt = 0.125;
+  Context ctx(o);
+  Group& balls = ctx.createGroup("balls", 16);
+  balls.setActions({Bounce{Domain::plane(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f))}, Move{}});
+  balls.recordCollisions(1);  // room for one: the emitter is still fed them all
+  for (int k = 0; k < 5; ++k) {
+    Particle p;
+    p.position = Vec3(float(k), 1.05f, 0.0f);  // meets the floor at t = 1.05
+    p.velocity = Vec3(0.0f, -1.0f, 0.0f);
+    ASSERT_TRUE(balls.add(p));
+  }
+  Group& sparks = ctx.createGroup("sparks", 100);
+  sparks.setActions({Move{}});  // stores velocities
+  DeathEmitter hits;
+  hits.source = "balls";
+  hits.on = DeathEmitter::Trigger::Collision;
+  hits.count = 2.0f;
+  hits.inheritVelocity = -0.5f;
+  sparks.addDeathEmitter(hits);
+  DeathEmitter byMove = hits;  // collisions with action 1 (the Move): there are none
+  byMove.cause = 1;
+  sparks.addDeathEmitter(byMove);
+  ctx.run(8);
+  EXPECT_EQ(sparks.size(), 0u);
+  ctx.step();
+  EXPECT_EQ(balls.collisions().size(), 5u);
+  ASSERT_EQ(sparks.size(), 10u);
+  for (std::size_t i = 0; i < sparks.size(); ++i) {
+    const Particle p = sparks.particle(i);
+    EXPECT_NEAR(p.position.x, float(i / 2), 1e-6f);
+    EXPECT_NEAR(p.position.y, 0.0f, 1e-5f);
+    EXPECT_EQ(p.velocity, Vec3(0.0f, 0.5f, 0.0f));
+    EXPECT_EQ(p.age, 0.0f);
+  }
+  ctx.run(5);  // bounced up and away: no more
+  EXPECT_EQ(sparks.size(), 10u);
+
+  // A fountain's splashes off its floor and walls, a third of a spark each on average.
+  auto busy = [](unsigned threads) {
+    ContextOptions bo;
+    bo.threads = threads;
+    Context c(bo);
+    samples::buildFountain(c, 80000, 100000.0, 1.0f);
+    Group& s = c.createGroup("splash", 200000);
+    DeathEmitter de;
+    de.source = "fountain";
+    de.on = DeathEmitter::Trigger::Collision;
+    de.count = 0.3f;
+    de.types[0].velocity = Domain::sphere(Vec3(0.0f, 1.0f, 0.0f), 0.5f);
+    s.addDeathEmitter(de);
+    s.setActions({Move{}});
+    c.run(30);
+    const auto x = s.lane(Attribute::Position, 0);
+    return std::vector<float>(x.begin(), x.end());
+  };
+  const auto one = busy(1), two = busy(2);
+  EXPECT_GT(one.size(), 1000u);
+  ASSERT_EQ(one.size(), two.size());
+  EXPECT_EQ(std::memcmp(one.data(), two.data(), one.size() * sizeof(float)), 0);
+}
+
 // A particle killed for a NaN has no place to emit from: it gives no newborns.
 TEST(DeathEmitter, ANaNDeathGivesNone) {
   Context ctx;

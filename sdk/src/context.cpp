@@ -232,7 +232,7 @@ Group* Context::Impl::sourceOf(detail::GroupImpl& gi, std::size_t k) {
 
 void Context::Impl::feedDeathEmitters() {
   if (deathEmitters == 0 && !deathsFed) return;
-  for (auto& g : groups) g->impl_->deathsFeed = false;
+  for (auto& g : groups) g->impl_->deathsFeed = g->impl_->collisionsFeed = false;
   deathsFed = false;
   if (deathEmitters == 0) return;
   for (auto& g : groups) {
@@ -242,7 +242,10 @@ void Context::Impl::feedDeathEmitters() {
       if (!source)
         throw Error("group '" + gi.name + "': deathEmitters[" + std::to_string(k) +
                     "].source: no group named '" + gi.deathEmitters[k].source + "' in the context");
-      source->impl_->feedDeaths();
+      if (gi.deathEmitters[k].on == DeathEmitter::Trigger::Collision)
+        source->impl_->collisionsFeed = true;  // records them all for it
+      else
+        source->impl_->feedDeaths();
       deathsFed = true;
     }
   }

@@ -7,7 +7,9 @@
 // holes the pass leaves are filled from the tail afterwards.
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
+#include <span>
 
 #include "backend.hpp"
 #include "emission_plan.hpp"
@@ -386,19 +388,39 @@ void emitNewborns(GroupImpl& g, const StepParams& sp) {
   retireDead(g, t1);
 }
 
-void emitFromDeaths(GroupImpl& g, std::size_t k, const GroupImpl& source, std::uint64_t seed) {
+namespace {
+
+// An event a DeathEmitter emits from: where, how fast, the particle and the action, and the
+// key of its count's random draws (a particle dies once; it may be deflected many times, each
+// at its own moment).
+struct Trigger {
+  Vec3 position, velocity;
+  std::uint32_t id, action, key;
+};
+Trigger triggerOf(const DeathEvent& d) {
+  return {d.position, d.velocity, d.id, d.action, d.id};
+}
+Trigger triggerOf(const CollisionEvent& c) {
+  const auto t = std::bit_cast<std::uint64_t>(c.time);
+  return {c.position, c.velocity, c.id, c.action,
+          c.id ^ std::uint32_t(t) ^ std::uint32_t(t >> 32) * 0x9E3779B9u};
+}
+
+template <class Event>
+void emitFrom(GroupImpl& g, std::size_t k, std::span<const Event> events, std::uint64_t seed) {
   const DeathEmitter& de = g.deathEmitters[k];
-  if (source.deathEvents.empty()) return;
+  if (events.empty()) return;
   g.ensureStorage();
   const Lanes L = g.lanePointers();
   const std::size_t before = g.size;
-  for (const DeathEvent& d : source.deathEvents) {
+  for (const Event& event : events) {
+    const Trigger d = triggerOf(event);
     // A particle killed for a NaN or an infinity has no place to emit from.
     if (d.action == DeathEvent::kNonFinite) continue;
     if (de.cause >= 0 && d.action != std::uint32_t(de.cause)) continue;
-    // How many, keyed by the dead particle, this group and this emitter: two emitters fed by
-    // one source draw apart.
-    Random counter(seed, d.id, g.index, stream::kDeathEmitter + std::uint32_t(k));
+    // How many, keyed by the event, this group and this emitter: two emitters fed by one
+    // source draw apart.
+    Random counter(seed, d.key, g.index, stream::kDeathEmitter + std::uint32_t(k));
     const float c = std::min(std::max(de.count.sample(counter), 0.0f), 1e6f);
     std::uint64_t n = std::uint64_t(c);
     if (counter.uniform() < c - float(n)) ++n;
@@ -444,6 +466,15 @@ void emitFromDeaths(GroupImpl& g, std::size_t k, const GroupImpl& source, std::u
       b.max = b.empty ? q : glm::max(b.max, q);
       b.empty = false;
     }
+}
+
+}  // namespace
+
+void emitFromDeaths(GroupImpl& g, std::size_t k, const GroupImpl& source, std::uint64_t seed) {
+  if (g.deathEmitters[k].on == DeathEmitter::Trigger::Collision)
+    emitFrom<CollisionEvent>(g, k, source.collisionEvents, seed);
+  else
+    emitFrom<DeathEvent>(g, k, source.deathEvents, seed);
 }
 
 void compact(GroupImpl& g, const StepParams& sp) {

@@ -614,7 +614,7 @@ void detail::GroupImpl::endCollisions(std::size_t blocks) {
   collisionEvents.clear();
   for (std::size_t b = 0; b < blocks; ++b) {
     const auto& found = blockCollisions[b];
-    const std::size_t take = std::min(found.size(), collisionsPerStep - collisionEvents.size());
+    const std::size_t take = std::min(found.size(), collisionRoom() - collisionEvents.size());
     collisionEvents.insert(collisionEvents.end(), found.begin(), found.begin() + take);
     stats.collisionEventsDropped += found.size() - take;
   }

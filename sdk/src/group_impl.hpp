@@ -222,7 +222,10 @@ struct GroupImpl {
   std::vector<FoundSource> deathSources;
   /// The context's count of death emitters in all its groups (0: Context::step skips them).
   std::size_t* contextDeathEmitters = nullptr;
-  std::size_t collisionsPerStep = 0;            ///< Group::recordCollisions; 0: not recording
+  std::size_t collisionsPerStep = 0;  ///< Group::recordCollisions; 0: not recording
+  /// A collision emitter names this group (set by Context::step): it records every collision.
+  bool collisionsFeed = false;
+  std::size_t collisionRoom() const { return collisionsFeed ? ~std::size_t(0) : collisionsPerStep; }
   std::vector<CollisionEvent> collisionEvents;  ///< the last step's, reserved up to the room
   /// Each block's collisions as the pass finds them (a block's in its own order), merged in
   /// block order after it: the same on any thread count. They only grow.

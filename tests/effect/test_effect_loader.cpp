@@ -406,6 +406,18 @@ TEST(EffectLoader, DeathEmitters) {
             "groups[0].deathEmitters[0].count");
   EXPECT_EQ(errorOf(withDeath(R"("count": 1)")).path(), "groups[0].deathEmitters[0].source");
   EXPECT_NO_THROW(parseEffect(withDeath(R"("source": "g", "cause": 0)"), "t.json"));
+  // On collision: the cause must be a Bounce; "on" takes "death" or "collision".
+  const EffectError notBounce =
+      errorOf(withDeath(R"("source": "g", "on": "collision", "cause": 0)"));
+  EXPECT_EQ(notBounce.path(), "groups[0].deathEmitters[0].cause") << notBounce.what();
+  EXPECT_NE(notBounce.why().find("not a Bounce"), std::string::npos) << notBounce.what();
+  EXPECT_EQ(errorOf(withDeath(R"("source": "g", "on": "impact")")).path(),
+            "groups[0].deathEmitters[0].on");
+  const Effect onHit = parseEffect(withDeath(R"("source": "g", "on": "collision")"), "t.json");
+  EXPECT_EQ(onHit.groups[0].deathEmitters[0].on, DeathEmitter::Trigger::Collision);
+  const std::string savedOnHit = saveEffect(onHit);
+  EXPECT_NE(savedOnHit.find(R"("on": "collision")"), std::string::npos) << savedOnHit;
+  EXPECT_EQ(saveEffect(parseEffect(savedOnHit, "saved.json")), savedOnHit);
 }
 
 TEST(EffectLoader, EmittersAndPrimeEmitters) {

@@ -143,7 +143,15 @@ struct PrimeEmitter {
 /// written in that order, so the result is the same on any thread count. `shape` and the
 /// types' domains are in the world's frame, as Gravity is: a splash rises whichever way an
 /// instance turns. The CPU backend runs them (a device context refuses to add one).
+///
+/// With `on` = Trigger::Collision it emits where the source's particles are deflected by a
+/// Bounce instead (a sub-emitter on collision: sparks where a grinder's chips hit a wall):
+/// each deflection (see Group::collisions) gives `count` newborns at the point of impact, with
+/// `inheritVelocity` times the velocity the particle arrived with; `cause` is then the index
+/// of a Bounce in the source's list (-1: all its Bounces).
 struct DeathEmitter {
+  /// What of the source's particles emits.
+  enum class Trigger { Death, Collision };
   std::string name;
   /// The group whose deaths emit, by name (it may be this group); it must exist when the
   /// context steps, which records its deaths from then on (all of them: room for its
@@ -157,6 +165,7 @@ struct DeathEmitter {
   /// Only deaths by this entry of the source's action list (e.g. its Sink on the floor);
   /// -1: every death.
   std::int32_t cause = -1;
+  Trigger on = Trigger::Death;
 
   void validate(const std::string& where = "deathEmitter") const;
 };

@@ -559,7 +559,7 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
 
   // Culling needs velocities for the swept bounds (a list that moves nothing has none).
   const bool cull = sp.cull && plan.list.cullable && lanes.v[0];
-  const bool logHits = g.collisionsPerStep > 0 && lanes.v[0];
+  const bool logHits = g.collisionRoom() > 0 && lanes.v[0];
   if (logHits) g.beginCollisions(blocks);
   if (sp.fused) {
     sp.pool->parallelFor(tasks, [&](std::size_t t) {

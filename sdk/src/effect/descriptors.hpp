@@ -127,6 +127,12 @@ struct EnumNames<Sink::Mode> {
                                                                   {"hit", Sink::Mode::Hit}};
 };
 
+template <>
+struct EnumNames<DeathEmitter::Trigger> {
+  static constexpr std::pair<const char*, DeathEmitter::Trigger> values[] = {
+      {"death", DeathEmitter::Trigger::Death}, {"collision", DeathEmitter::Trigger::Collision}};
+};
+
 // ---- parts shared by actions ----------------------------------------------------------------
 
 template <>
@@ -658,7 +664,8 @@ template <>
 struct Describe<DeathEmitter> {
   static constexpr const char* name = "DeathEmitter";
   static constexpr const char* doc =
-      "Emits where another group's particles die (a sub-emitter on death).";
+      "Emits where another group's particles die (a sub-emitter on death), or with \"on\": "
+      "\"collision\" where a Bounce deflects them (a sub-emitter on collision).";
   static constexpr auto fields = std::tuple{
       field("name", &DeathEmitter::name, "", kAny, "names it in statistics"),
       field("source", &DeathEmitter::source, "", kAny, "the group whose deaths emit", kRequired),
@@ -668,7 +675,10 @@ struct Describe<DeathEmitter> {
       field("shape", &DeathEmitter::shape, "units", kAny, "where, around the death place"),
       field("types", &DeathEmitter::types, "", kAny, "particle types, drawn by weight"),
       field("cause", &DeathEmitter::cause, "", Limit{.min = -1},
-            "only deaths by this action of the source's list (-1: all)"),
+            "only deaths by this action of the source's list, or collisions with this Bounce "
+            "(-1: all)"),
+      field("on", &DeathEmitter::on, "", kAny,
+            "what emits: the source's deaths or its collisions (Bounce deflections)"),
   };
 };
 

@@ -618,12 +618,19 @@ void linkDeathEmitters(Effect& fx, const json& groups, const Loader& L) {
         L.fail(join(path, "cause"), "group \"" + de.source + "\" has " + std::to_string(written) +
                                         " actions: the cause is one's index, or -1 for all");
       const std::vector<Action>& list = fx.groups[src].actions.actions();
+      const std::int32_t asWritten = de.cause;
       if (list.size() == written + 1)  // mode2d inserted its Constrain2D
         for (std::size_t a = 0; a <= std::size_t(de.cause); ++a)
           if (std::holds_alternative<Constrain2D>(list[a])) {
             ++de.cause;
             break;
           }
+      if (de.on == DeathEmitter::Trigger::Collision &&
+          !std::holds_alternative<Bounce>(list[std::size_t(de.cause)]))
+        L.fail(join(path, "cause"), "action " + std::to_string(asWritten) + " of group \"" +
+                                        de.source +
+                                        "\" is not a Bounce: collisions come from "
+                                        "Bounce actions (or -1 for all of them)");
     }
 }
 
