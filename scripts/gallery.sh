@@ -21,7 +21,7 @@ sed -n '/^## Run times$/,$p' docs/gallery.md >"$tmp/times.md" 2>/dev/null || tru
 # name:frame — the frame each still is taken at (a moment where the effect reads best).
 shots="fountain:90 fireworks:100 galaxy:120 magnetic:30 pinball2d:150 smoke:200 hair:5
        tornado:200 snow:150 shockwave:40 campfire:150 comet:120 waterfall:150
-       rain_on_glass:150 grass:5 fur:5 rain:90"
+       rain_on_glass:150 grass:5 fur:5 rain:90 grinder:90"
 # name:first:last — the frames each animated preview plays (every other one, at 15 fps:
 # real time for the samples' 1/30 s step).
 previews="fireworks:40:160 campfire:60:180 waterfall:60:180 comet:60:180"

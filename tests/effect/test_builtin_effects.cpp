@@ -38,7 +38,7 @@ TEST(BuiltinEffects, ListIsComplete) {
   const auto& all = samples::builtinSamples();
   for (const char* name : {"fountain", "fireworks", "snow", "hair", "tornado", "pinball2d",
                            "magnetic", "galaxy", "smoke", "shockwave", "campfire", "comet",
-                           "waterfall", "rain_on_glass", "grass", "fur", "rain"})
+                           "waterfall", "rain_on_glass", "grass", "fur", "rain", "grinder"})
     EXPECT_NE(samples::findSample(name), nullptr) << name;
   for (const auto& s : all) {
     EXPECT_TRUE(s.effect) << s.name << ": " << s.description;

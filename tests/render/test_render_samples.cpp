@@ -192,7 +192,10 @@ const Expect kSamples[] = {Expect{"fountain", 60, 0.02, 0.3, 1, 0.01, 0.999, 300
                            Expect{"grass", 60, 0.15, 0.6, 2, 0.02, 0.999, 300},
                            Expect{"fur", 60, 0.05, 0.3, 1, 0.01, 0.999, 0},
                            // Rain falls across the whole view, as snow does; the ground drawn.
-                           Expect{"rain", 60, 0.01, 0.4, 0, 1.0, 0.0, 300}};
+                           Expect{"rain", 60, 0.01, 0.4, 0, 1.0, 0.0, 300},
+                           // Hot sparks and their spray off the wall: a yellow-orange hue; the
+                           // wall and floor drawn.
+                           Expect{"grinder", 60, 0.005, 0.3, 1, 0.01, 0.999, 300}};
 INSTANTIATE_TEST_SUITE_P(Builtin, SampleImage, ::testing::ValuesIn(kSamples),
                          [](const ::testing::TestParamInfo<Expect>& info) {
                            return info.param.name;
