@@ -9,6 +9,7 @@
 #include <set>
 
 #include "builtin.hpp"
+#include "flurry/effect.hpp"
 #include "flurry/flurry.hpp"
 #include "group_impl.hpp"
 #include "pass_options.hpp"
@@ -600,6 +601,43 @@ TEST(Instance, BoundsHoldEveryParticleOfItsGroups) {
 // Deaths are recorded where and when they happen: particles of known motion die of age at a
 // known step; the room a step has is kept (first in particle order, the rest counted); a
 // busy fountain's events are the same on any thread count and match its statistics.
+// Context::stats: what a game's overlay shows, summed over the groups.
+TEST(Context, StatsSumTheGroupsForAnOverlay) {
+  Context ctx;
+  const Effect fx = parseEffect(R"({"name": "puff", "groups": [{"name": "p", "capacity": 50,
+      "emitters": [{"rate": 3000, "types": [{"velocity": [0, -3, 0], "lifetime": 1}]}],
+      "actions": [{"type": "Bounce", "surface": {"type": "plane", "point": [0, -0.05, 0],
+                   "normal": [0, 1, 0]}}, {"type": "Move"}, {"type": "KillOld"}]}]})");
+  EffectInstance a = fx.instantiate(ctx, "a"), b = fx.instantiate(ctx, "b");
+  samples::buildFountain(ctx, 1000, 500.0, 1.0f);
+  a.groups()[0]->recordCollisions(1);  // many collide a step: the rest are dropped
+  ctx.run(10);
+  const ContextStats s = ctx.stats();
+  EXPECT_EQ(s.groups, 3u);
+  EXPECT_EQ(s.instances, 2u);
+  std::size_t particles = 0, capacity = 0;
+  std::uint64_t emitted = 0, dropped = 0;
+  for (const Group* g : ctx.groups()) {
+    particles += g->size();
+    capacity += g->capacity();
+    emitted += g->stats().emitted;
+    dropped += g->stats().droppedAtCapacity;
+  }
+  EXPECT_EQ(s.particles, particles);
+  EXPECT_EQ(s.capacity, 1100u);
+  EXPECT_EQ(capacity, 1100u);
+  EXPECT_EQ(s.emitted, emitted);
+  EXPECT_EQ(s.droppedAtCapacity, dropped);
+  EXPECT_GT(dropped, 0u);  // 100 a step into 50
+  EXPECT_EQ(s.collisionEventsDropped, a.groups()[0]->stats().collisionEventsDropped);
+  EXPECT_GT(s.collisionEventsDropped, 0u);
+  EXPECT_GT(s.lastStepSeconds, 0.0);
+  EXPECT_GT(s.lastStepParts.act, 0.0);
+  EXPECT_LE(s.lastStepParts.act, a.groups()[0]->stats().stepSeconds.act +
+                                     b.groups()[0]->stats().stepSeconds.act +
+                                     ctx.group("fountain").stats().stepSeconds.act);
+}
+
 // Collision events: where, when and how fast each deflected particle met the surface, with
 // the surface's normal on its side; exact on known paths, the first kept past the room, the
 // same on any thread count.

@@ -1,11 +1,13 @@
 #include "flurry/context.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <functional>
 #include <thread>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "backend.hpp"
 #include "emission_plan.hpp"
@@ -45,6 +47,7 @@ struct Context::Impl {
 
   // Death emitters (Group::addDeathEmitter) in all the groups: while there are none a step
   // spends nothing on them.
+  double lastStepSeconds = 0.0;     // wall clock of the last step()
   std::uint64_t groupsVersion = 0;  // changes when a group is created or destroyed
   /// Death emitter k's source group, or null (found by name only when something changed).
   Group* sourceOf(detail::GroupImpl& gi, std::size_t k);
@@ -267,6 +270,7 @@ void Context::Impl::runDeathEmitters(std::span<Group* const> only) {
 }
 
 void Context::step() {
+  const auto started = std::chrono::steady_clock::now();
   impl_->feedDeathEmitters();
   const detail::StepParams sp = impl_->params();
   auto& small = impl_->smallGroups;
@@ -296,6 +300,8 @@ void Context::step() {
     });
   }
   impl_->runDeathEmitters({});
+  impl_->lastStepSeconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   ++impl_->step;
   ++impl_->stepsSinceDtChange;
   impl_->time = impl_->timeAtDtChange + double(impl_->stepsSinceDtChange) * impl_->options.dt;
@@ -354,6 +360,32 @@ void Context::setTimeStep(double dt) {
   impl_->stepsSinceDtChange = 0;
   impl_->options.dt = dt;
 }
+ContextStats Context::stats() const {
+  ContextStats s;
+  s.groups = impl_->groups.size();
+  s.lastStepSeconds = impl_->lastStepSeconds;
+  std::unordered_set<std::string_view> instances;
+  for (const auto& g : impl_->groups) {
+    const std::string& name = g->name();
+    if (const auto at = name.rfind('@'); at != std::string::npos)
+      instances.insert(std::string_view(name).substr(at + 1));
+    s.particles += g->size();
+    s.capacity += g->capacity();
+    const GroupStats& gs = g->stats();
+    s.emitted += gs.emitted;
+    s.droppedAtCapacity += gs.droppedAtCapacity;
+    s.deathEventsDropped += gs.deathEventsDropped;
+    s.collisionEventsDropped += gs.collisionEventsDropped;
+    s.idleSteps += gs.idleSteps;
+    const auto& parts = g->impl_->lastStepParts;
+    s.lastStepParts.emit += parts.emit;
+    s.lastStepParts.act += parts.act;
+    s.lastStepParts.compact += parts.compact;
+  }
+  s.instances = instances.size();
+  return s;
+}
+
 unsigned Context::threads() const {
   return impl_->pool->size();
 }

@@ -222,7 +222,8 @@ struct GroupImpl {
   std::vector<FoundSource> deathSources;
   /// The context's count of death emitters in all its groups (0: Context::step skips them).
   std::size_t* contextDeathEmitters = nullptr;
-  std::size_t collisionsPerStep = 0;  ///< Group::recordCollisions; 0: not recording
+  GroupStats::StepSeconds lastStepParts;  ///< the last step's (the CPU backend's clock)
+  std::size_t collisionsPerStep = 0;      ///< Group::recordCollisions; 0: not recording
   /// A collision emitter names this group (set by Context::step): it records every collision.
   bool collisionsFeed = false;
   std::size_t collisionRoom() const { return collisionsFeed ? ~std::size_t(0) : collisionsPerStep; }

@@ -885,6 +885,16 @@ static void test_collisions(void) {
     }
   }
   CHECK(bounced > 100 && dropped == 0);
+  {
+    flurry_context_stats cs;
+    size_t alive = 0;
+    OK(flurry_context_stats_get(ctx, &cs));
+    OK(flurry_group_size(g, &alive));
+    CHECK(cs.groups == 1 && cs.instances == 0 && cs.particles == alive && cs.capacity == 1000);
+    CHECK(cs.last_step_seconds > 0 && cs.last_act_seconds > 0 && cs.emitted >= alive);
+    FAILS(flurry_context_stats_get(NULL, &cs), FLURRY_ERROR_NULL_ARGUMENT, "ctx");
+    FAILS(flurry_context_stats_get(ctx, NULL), FLURRY_ERROR_NULL_ARGUMENT, "stats");
+  }
   FAILS(flurry_group_collisions(NULL, &hits, &count, NULL), FLURRY_ERROR_NULL_ARGUMENT, "group");
   FAILS(flurry_group_collisions(g, &hits, NULL, NULL), FLURRY_ERROR_NULL_ARGUMENT, "count");
   FAILS(flurry_group_record_collisions(NULL, 1), FLURRY_ERROR_NULL_ARGUMENT, "group");

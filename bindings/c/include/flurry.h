@@ -159,6 +159,21 @@ FLURRY_C_EXPORT flurry_status flurry_context_set_time_step(flurry_context* ctx, 
 FLURRY_C_EXPORT flurry_status flurry_context_backend(const flurry_context* ctx,
                                                      flurry_backend* backend);
 /** Why FLURRY_BACKEND_AUTO took the CPU ("" when it did not). */
+/** What a game's overlay shows, summed over the context's groups (flurry::ContextStats). */
+typedef struct flurry_context_stats {
+  size_t groups;
+  size_t instances; /**< distinct INSTANCE names of groups named GROUP@INSTANCE */
+  size_t particles; /**< alive now */
+  size_t capacity;
+  double last_step_seconds; /**< wall clock of the last step */
+  /** The last step's parts over every group (CPU seconds: parallel groups add up). */
+  double last_emit_seconds, last_act_seconds, last_compact_seconds;
+  uint64_t emitted, dropped_at_capacity, death_events_dropped, collision_events_dropped;
+  uint64_t idle_steps;
+} flurry_context_stats;
+
+FLURRY_C_EXPORT flurry_status flurry_context_stats_get(const flurry_context* ctx,
+                                                       flurry_context_stats* stats);
 FLURRY_C_EXPORT flurry_status flurry_context_backend_fallback(const flurry_context* ctx,
                                                               const char** why);
 /** A new empty group of fixed capacity, owned by the context. */

@@ -439,6 +439,27 @@ flurry_status flurry_context_create_with_scheduler(const flurry_context_options*
   return createContext(options, true, scheduler, out);
 }
 
+flurry_status flurry_context_stats_get(const flurry_context* ctx, flurry_context_stats* out) {
+  return guard([&] {
+    need(ctx, "ctx");
+    need(out, "stats");
+    const flurry::ContextStats s = ctx->ctx.stats();
+    out->groups = s.groups;
+    out->instances = s.instances;
+    out->particles = s.particles;
+    out->capacity = s.capacity;
+    out->last_step_seconds = s.lastStepSeconds;
+    out->last_emit_seconds = s.lastStepParts.emit;
+    out->last_act_seconds = s.lastStepParts.act;
+    out->last_compact_seconds = s.lastStepParts.compact;
+    out->emitted = s.emitted;
+    out->dropped_at_capacity = s.droppedAtCapacity;
+    out->death_events_dropped = s.deathEventsDropped;
+    out->collision_events_dropped = s.collisionEventsDropped;
+    out->idle_steps = s.idleSteps;
+  });
+}
+
 flurry_status flurry_context_destroy(flurry_context* ctx) {
   return guard([&] { delete ctx; });  // NULL is fine, as free(NULL)
 }

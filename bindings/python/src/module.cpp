@@ -300,6 +300,26 @@ NB_MODULE(_flurry, m) {
                ", killed_non_finite=" + std::to_string(s.killedNonFinite) + ")";
       });
 
+  nb::class_<flurry::ContextStats>(m, "ContextStats",
+                                   "What a game's overlay shows, summed over the groups "
+                                   "(Context.stats).")
+      .def_ro("groups", &flurry::ContextStats::groups)
+      .def_ro("instances", &flurry::ContextStats::instances)
+      .def_ro("particles", &flurry::ContextStats::particles)
+      .def_ro("capacity", &flurry::ContextStats::capacity)
+      .def_ro("last_step_seconds", &flurry::ContextStats::lastStepSeconds)
+      .def_prop_ro("last_step_emit_seconds",
+                   [](const flurry::ContextStats& s) { return s.lastStepParts.emit; })
+      .def_prop_ro("last_step_act_seconds",
+                   [](const flurry::ContextStats& s) { return s.lastStepParts.act; })
+      .def_prop_ro("last_step_compact_seconds",
+                   [](const flurry::ContextStats& s) { return s.lastStepParts.compact; })
+      .def_ro("emitted", &flurry::ContextStats::emitted)
+      .def_ro("dropped_at_capacity", &flurry::ContextStats::droppedAtCapacity)
+      .def_ro("death_events_dropped", &flurry::ContextStats::deathEventsDropped)
+      .def_ro("collision_events_dropped", &flurry::ContextStats::collisionEventsDropped)
+      .def_ro("idle_steps", &flurry::ContextStats::idleSteps);
+
   nb::class_<GroupRef>(m, "Group", "A particle group of a Context (it keeps its Context alive).")
       .def_prop_ro("name", [](const GroupRef& g) { return g.g->name(); })
       .def("__len__", [](const GroupRef& g) { return g.g->size(); })
@@ -509,6 +529,9 @@ NB_MODULE(_flurry, m) {
           [](ContextBox& pc, double dt) { pc.ctx->setTimeStep(dt); })
       .def_prop_ro("seed", [](const ContextBox& pc) { return pc.ctx->seed(); })
       .def_prop_ro("threads", [](const ContextBox& pc) { return pc.ctx->threads(); })
+      .def_prop_ro(
+          "stats", [](const ContextBox& pc) { return pc.ctx->stats(); },
+          "The groups' statistics summed, and what the last step cost (a snapshot).")
       .def_prop_ro(
           "backend", [](const ContextBox& pc) { return backendName(pc.ctx->backend()); },
           "The backend running: \"cpu\" or \"opencl\".")

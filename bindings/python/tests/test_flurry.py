@@ -372,6 +372,17 @@ def test_collisions_say_where_when_and_how_fast():
     assert len(g.collisions()["id"]) == 0
 
 
+def test_context_stats_sum_the_groups():
+    ctx = fountain()
+    for _ in range(20):
+        ctx.step()
+    s = ctx.stats
+    assert s.groups == len(ctx.groups) and s.instances == 0
+    assert s.particles == sum(len(g) for g in ctx.groups) > 0
+    assert s.emitted == sum(g.stats.emitted for g in ctx.groups)
+    assert s.last_step_seconds > 0 and s.last_step_act_seconds > 0
+
+
 def test_bad_transforms_name_the_field():
     ctx = flurry.Context(threads=1)
     g = ctx.create_group("g", 10)

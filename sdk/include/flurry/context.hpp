@@ -37,6 +37,27 @@ struct ContextOptions {
   std::shared_ptr<TaskScheduler> scheduler;
 };
 
+/// What a game shows in its performance overlay: the context's groups, instances and
+/// particles now, what its last step cost and what was dropped (Context::stats).
+struct ContextStats {
+  std::size_t groups = 0;
+  /// Effect instances: the distinct INSTANCE names of groups named "GROUP@INSTANCE".
+  std::size_t instances = 0;
+  std::size_t particles = 0;  ///< alive now, in all groups
+  std::size_t capacity = 0;   ///< all groups' capacities together
+  /// Wall-clock seconds of the last step() (its death emitters included).
+  double lastStepSeconds = 0.0;
+  /// The last step's parts over every group, as GroupStats::stepSeconds counts them (CPU
+  /// seconds: groups stepped side by side on several threads add up).
+  GroupStats::StepSeconds lastStepParts;
+  /// Over the groups' lives, all groups together (see GroupStats).
+  std::uint64_t emitted = 0;
+  std::uint64_t droppedAtCapacity = 0;
+  std::uint64_t deathEventsDropped = 0;
+  std::uint64_t collisionEventsDropped = 0;
+  std::uint64_t idleSteps = 0;
+};
+
 class Context {
  public:
   explicit Context(ContextOptions options = {});
@@ -86,6 +107,9 @@ class Context {
   /// empty when it did not. The library reports it here rather than printing it.
   const std::string& backendFallback() const;
   const ContextOptions& options() const;
+  /// Sums the groups' statistics now (a walk over the groups: call it once a frame, not per
+  /// group). On a device backend the live counts are brought up to date first.
+  ContextStats stats() const;
 
  private:
   friend struct detail::ContextAccess;

@@ -204,6 +204,7 @@ class CpuBackend final : public BackendImpl {
   void step(GroupImpl& group, const StepParams& params) override {
     // Idle: nothing alive and no emitter that will fire. Such a step would change nothing
     // (its emitters' state included), so it costs no pass, no clock and no worker.
+    group.lastStepParts = {};
     if (group.size == 0 && !group.hair.enabled && !mayEmit(group, params)) {
       // What a step's planning would have done: count generation 0 (see planBirths).
       if (!group.emitters.empty() && group.stats.emittedByGeneration.empty())
@@ -214,17 +215,19 @@ class CpuBackend final : public BackendImpl {
     // Each part's time, for GroupStats::stepSeconds.
     using Clock = std::chrono::steady_clock;
     auto last = Clock::now();
-    auto lap = [&](double& total) {
+    auto lap = [&](double& total, double& thisStep) {
       const auto now = Clock::now();
-      total += std::chrono::duration<double>(now - last).count();
+      thisStep = std::chrono::duration<double>(now - last).count();
+      total += thisStep;
       last = now;
     };
+    auto& parts = group.lastStepParts;
     emitNewborns(group, params);
-    lap(group.stats.stepSeconds.emit);
+    lap(group.stats.stepSeconds.emit, parts.emit);
     actFused(group, params);
-    lap(group.stats.stepSeconds.act);
+    lap(group.stats.stepSeconds.act, parts.act);
     compact(group, params);
-    lap(group.stats.stepSeconds.compact);
+    lap(group.stats.stepSeconds.compact, parts.compact);
     if (group.hair.enabled) simulateHair(group, params);
   }
 };
