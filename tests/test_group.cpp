@@ -716,13 +716,32 @@ TEST(Group, CollisionEventsSayWhereWhenAndHowFast) {
   EXPECT_EQ(hits[0].normal, Vec3(0.0f, 0.0f, -1.0f));
   EXPECT_NEAR(hits[0].time, 1.5, 1e-5);
 
+  // A particle the list leaves NaN is killed by the step, not reported.
+  {
+    Context ctx;
+    Group& g = ctx.createGroup("g", 4);
+    g.setActions({Bounce{Domain::plane(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f))}, Move{}});
+    g.recordCollisions(8);
+    Particle nan, fine;
+    nan.position = fine.position = Vec3(0.0f, 0.01f, 0.0f);
+    nan.velocity = Vec3(std::nanf(""), -1.0f, 0.0f);
+    fine.velocity = Vec3(0.0f, -1.0f, 0.0f);
+    ASSERT_TRUE(g.add(nan) && g.add(fine));
+    ctx.step();
+    ASSERT_EQ(g.collisions().size(), 1u);
+    EXPECT_EQ(g.collisions()[0].id, 1u);
+    EXPECT_EQ(g.stats().killedNonFinite, 1u);
+  }
+
   // A busy fountain (a floor, action 1, and four walls, 2-5): every event on the piece its
   // action names, arriving against the normal, the same on 1 and 2 threads; past the room
   // the first are kept and the rest counted.
-  auto busy = [](unsigned threads, std::size_t room, std::uint64_t* dropped) {
+  auto busy = [](unsigned threads, std::size_t room, std::uint64_t* dropped,
+                 detail::PassOptions pass = {}) {
     ContextOptions bo;
     bo.threads = threads;
     Context c(bo);
+    detail::setPassOptions(c, pass);
     Group& f = samples::buildFountain(c, 80000, 100000.0, 1.0f);
     f.recordCollisions(room);
     std::vector<CollisionEvent> all;
@@ -753,6 +772,51 @@ TEST(Group, CollisionEventsSayWhereWhenAndHowFast) {
   }
   EXPECT_EQ(onTheirPiece, one.size());
   EXPECT_GT(onFloor, one.size() / 2);
+  // The same events, in the same order, from the unfused pass and other block sizes (the
+  // fused pass takes a block's newborns after its old particles; the unfused one action by
+  // action): kept in particle order either way.
+  std::uint64_t droppedOther = 0;
+  for (const detail::PassOptions pass : {detail::PassOptions{.blockSize = 256, .fused = false},
+                                         detail::PassOptions{.blockSize = 96, .fused = true}}) {
+    const auto other = busy(2, 1000000, &droppedOther, pass);
+    ASSERT_EQ(other.size(), one.size());
+    EXPECT_EQ(std::memcmp(one.data(), other.data(), one.size() * sizeof(CollisionEvent)), 0)
+        << pass.blockSize << (pass.fused ? " fused" : " unfused");
+  }
+  // Newborns that hit the floor in their birth step, in blocks whose old particles hit a
+  // wall too: the fused pass meets the old particles' wall hits before the newborns' floor
+  // hits, the unfused pass the other way round; the events come out in particle order.
+  auto drizzle = [](detail::PassOptions pass) {
+    Context c;
+    detail::setPassOptions(c, pass);
+    Group& g = c.createGroup("drizzle", 20000);
+    Emitter e;
+    e.shape = Domain::disc(Vec3(0.0f, 0.03f, 0.0f), Vec3(0.0f, 1.0f, 0.0f), 0.5f);
+    e.rate = 60000;
+    e.types[0].velocity = Domain::sphere(Vec3(1.0f, -2.0f, 0.0f), 0.8f);
+    e.types[0].lifetime = 0.5f;
+    g.addEmitter(e);
+    g.setActions({Bounce{Domain::plane(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f)), 0.8f},
+                  Bounce{Domain::plane(Vec3(0.4f, 0.0f, 0.0f), Vec3(1.0f, 0.0f, 0.0f)), 0.8f},
+                  Move{}, KillOld{}});
+    g.recordCollisions(1000000);
+    std::vector<CollisionEvent> all;
+    for (int k = 0; k < 20; ++k) {
+      c.step();
+      all.insert(all.end(), g.collisions().begin(), g.collisions().end());
+    }
+    return all;
+  };
+  const auto fusedDrizzle = drizzle({});
+  ASSERT_GT(fusedDrizzle.size(), 1000u);
+  for (const detail::PassOptions pass : {detail::PassOptions{.blockSize = 256, .fused = false},
+                                         detail::PassOptions{.blockSize = 96, .fused = true}}) {
+    const auto other = drizzle(pass);
+    ASSERT_EQ(other.size(), fusedDrizzle.size());
+    EXPECT_EQ(std::memcmp(fusedDrizzle.data(), other.data(), other.size() * sizeof(CollisionEvent)),
+              0)
+        << pass.blockSize << (pass.fused ? " fused" : " unfused");
+  }
   const auto few = busy(2, 10, &droppedFew);
   EXPECT_LE(few.size(), 40u * 10u);
   EXPECT_EQ(few.size() + droppedFew, one.size());

@@ -79,8 +79,7 @@ Context::Context(ContextOptions options) : impl_(std::make_unique<Impl>()) {
     if (options.threads != 0)
       throw InvalidArgument("threads",
                             "must be 0 with a scheduler (its concurrency() counts them)");
-    impl_->pool = std::make_unique<detail::ThreadPool>(options.scheduler);
-    options.threads = impl_->pool->size();
+    impl_->pool = std::make_unique<detail::ThreadPool>(options.scheduler);  // threads stays 0
   } else {
     if (options.threads == 0) options.threads = std::max(1u, std::thread::hardware_concurrency());
     if (options.threads > 1024) throw InvalidArgument("threads", "must be <= 1024");
@@ -263,8 +262,9 @@ void Context::Impl::runDeathEmitters(std::span<Group* const> only) {
     auto& gi = *g->impl_;
     if (gi.deathEmitters.empty() || !in(g.get())) continue;
     for (std::size_t k = 0; k < gi.deathEmitters.size(); ++k) {
-      const Group* source = sourceOf(gi, k);  // feedDeathEmitters found it
-      if (in(source)) detail::emitFromDeaths(gi, k, *source->impl_, options.seed);
+      // feedDeathEmitters found it; a step's Callback may have destroyed it since.
+      const Group* source = sourceOf(gi, k);
+      if (source && in(source)) detail::emitFromDeaths(gi, k, *source->impl_, options.seed);
     }
   }
 }

@@ -606,16 +606,21 @@ void detail::GroupImpl::beginCollisions(std::size_t blocks) {
   for (std::size_t b = 0; b < blocks; ++b) blockCollisions[b].clear();
 }
 
-void detail::GroupImpl::addCollision(std::size_t block, const CollisionEvent& e) {
-  blockCollisions[block].push_back(e);
+void detail::GroupImpl::addCollision(std::size_t block, std::uint64_t key,
+                                     const CollisionEvent& e) {
+  blockCollisions[block].push_back({key, e});
 }
 
 void detail::GroupImpl::endCollisions(std::size_t blocks) {
   collisionEvents.clear();
   for (std::size_t b = 0; b < blocks; ++b) {
-    const auto& found = blockCollisions[b];
+    auto& found = blockCollisions[b];
+    // In particle order whichever way the pass ran the block (the fused pass takes a block's
+    // old particles through the list before its newborns; the unfused one action by action).
+    std::sort(found.begin(), found.end(),
+              [](const KeyedCollision& x, const KeyedCollision& y) { return x.key < y.key; });
     const std::size_t take = std::min(found.size(), collisionRoom() - collisionEvents.size());
-    collisionEvents.insert(collisionEvents.end(), found.begin(), found.begin() + take);
+    for (std::size_t k = 0; k < take; ++k) collisionEvents.push_back(found[k].event);
     stats.collisionEventsDropped += found.size() - take;
   }
 }

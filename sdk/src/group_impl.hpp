@@ -230,11 +230,15 @@ struct GroupImpl {
   std::vector<CollisionEvent> collisionEvents;  ///< the last step's, reserved up to the room
   /// Each block's collisions as the pass finds them (a block's in its own order), merged in
   /// block order after it: the same on any thread count. They only grow.
-  std::vector<std::vector<CollisionEvent>> blockCollisions;
+  struct KeyedCollision {
+    std::uint64_t key;  ///< particle index, sub-step, action: the order they are kept in
+    CollisionEvent event;
+  };
+  std::vector<std::vector<KeyedCollision>> blockCollisions;
   /// Out of line here (see assignFill): the pass clears `blocks` blocks' lists, adds to one,
   /// and takes the first collisionsPerStep of them in block order after.
   void beginCollisions(std::size_t blocks);
-  void addCollision(std::size_t block, const CollisionEvent& e);
+  void addCollision(std::size_t block, std::uint64_t key, const CollisionEvent& e);
   void endCollisions(std::size_t blocks);
   std::vector<DeathEvent> deathEvents;  ///< the last step's, reserved by recordDeaths
   std::vector<std::size_t> deathStart;  ///< scratch: each block's first event

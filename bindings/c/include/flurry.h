@@ -158,7 +158,6 @@ FLURRY_C_EXPORT flurry_status flurry_context_set_time_step(flurry_context* ctx, 
 /** The backend it runs (FLURRY_BACKEND_AUTO resolves to CPU or OpenCL). */
 FLURRY_C_EXPORT flurry_status flurry_context_backend(const flurry_context* ctx,
                                                      flurry_backend* backend);
-/** Why FLURRY_BACKEND_AUTO took the CPU ("" when it did not). */
 /** What a game's overlay shows, summed over the context's groups (flurry::ContextStats). */
 typedef struct flurry_context_stats {
   size_t groups;
@@ -174,6 +173,7 @@ typedef struct flurry_context_stats {
 
 FLURRY_C_EXPORT flurry_status flurry_context_stats_get(const flurry_context* ctx,
                                                        flurry_context_stats* stats);
+/** Why FLURRY_BACKEND_AUTO took the CPU ("" when it did not). */
 FLURRY_C_EXPORT flurry_status flurry_context_backend_fallback(const flurry_context* ctx,
                                                               const char** why);
 /** A new empty group of fixed capacity, owned by the context. */
@@ -419,8 +419,9 @@ typedef struct flurry_collision_event {
   float velocity[3]; /**< arriving there, before the bounce */
   float normal[3];
   uint32_t id;
-  uint32_t action; /**< index of the Bounce in the action list */
-  double time;     /**< the moment of impact */
+  uint32_t action;   /**< index of the Bounce in the action list */
+  uint32_t reserved; /**< 0 */
+  double time;       /**< the moment of impact */
 } flurry_collision_event;
 
 /** Records each step's collisions, at most `per_step` a step (the first in particle order; the

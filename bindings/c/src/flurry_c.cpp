@@ -1120,6 +1120,8 @@ flurry_status flurry_group_deaths(const flurry_group* g, const flurry_death_even
 static_assert(sizeof(flurry_collision_event) == sizeof(flurry::CollisionEvent));
 static_assert(offsetof(flurry_collision_event, normal) == offsetof(flurry::CollisionEvent, normal));
 static_assert(offsetof(flurry_collision_event, id) == offsetof(flurry::CollisionEvent, id));
+static_assert(offsetof(flurry_collision_event, reserved) ==
+              offsetof(flurry::CollisionEvent, reserved));
 static_assert(offsetof(flurry_collision_event, time) == offsetof(flurry::CollisionEvent, time));
 flurry_status flurry_group_record_collisions(flurry_group* g, size_t perStep) {
   return guard([&] {

@@ -117,8 +117,9 @@ struct CollisionEvent {
   Vec3 velocity{0.0f};  ///< arriving there (before the bounce)
   Vec3 normal{0.0f};    ///< the surface's unit normal there, on the side the particle came from
   std::uint32_t id = 0;
-  std::uint32_t action = 0;  ///< the index of the Bounce in the action list
-  double time = 0.0;         ///< the moment of impact
+  std::uint32_t action = 0;    ///< the index of the Bounce in the action list
+  std::uint32_t reserved = 0;  ///< 0: the layout has no padding (the C API hands it out)
+  double time = 0.0;           ///< the moment of impact
 };
 
 struct Bounds {
@@ -221,10 +222,13 @@ class Group {
   std::span<const DeathEvent> deaths() const;
   /// Records every step's collisions (each time a Bounce deflects a particle) as
   /// CollisionEvents for the game to read after the step (collisions()), at most `perStep`
-  /// a step: the first in particle order, the same on any thread count; the rest are counted
-  /// in GroupStats::collisionEventsDropped. 0 stops it; while off it costs nothing. A
-  /// particle resting on a floor is deflected, and reported, every step it rests (filter by
-  /// the speed). Stores ids. The CPU backend records them; a device backend throws Error.
+  /// a step: the first in particle order (a particle's own by sub-step, then by action), the
+  /// same on any thread count; the rest are counted in GroupStats::collisionEventsDropped
+  /// (while a collision emitter names the group, all of them are recorded for it). A
+  /// particle left NaN or infinite is not reported (the step kills it). 0 stops it; while off it
+  /// costs nothing. A particle resting on a floor is deflected, and reported, every step it rests
+  /// (filter by the speed). Stores ids. The CPU backend records them; a device backend throws
+  /// Error.
   Group& recordCollisions(std::size_t perStep);
   /// The collisions of the last step (empty when not recording), valid until the next step.
   std::span<const CollisionEvent> collisions() const;

@@ -28,7 +28,9 @@ class TaskScheduler {
   virtual unsigned concurrency() const = 0;
   /// Runs task(i) exactly once for every i in [0, count), on any threads and in any order,
   /// and returns when all have returned. The calling thread may run some of them itself
-  /// (it should: it would otherwise wait idle).
+  /// (it should: it would otherwise wait idle). The tasks refer to the caller's stack: a
+  /// parallelFor that returns or throws while one still runs is undefined behaviour (one
+  /// that returns having skipped some is caught: the call fails with an Error).
   virtual void parallelFor(std::size_t count, TaskRef task) = 0;
 };
 

@@ -101,9 +101,17 @@ inline void logCollisions(const Bounce& b, std::uint32_t action, const Lanes& L,
     e.velocity = v + a * tau;
     e.id = L.id ? L.id[i] : 0u;
     e.action = action;
-    // The particle's sub-step began (substeps - sub) of its sub-step lengths before the end.
-    e.time = log.t1 - double(dt) * double(log.substeps - log.sub) + double(tau);
-    log.group->addCollision(log.block, e);
+    // The particle's sub-step began at the block's time, or for a newborn of the batch
+    // (its own step length) (substeps - sub) of its sub-step lengths before the end.
+    const double start = c.ownDt ? log.t1 - double(dt) * double(log.substeps - log.sub) : c.time;
+    e.time = start + double(tau);
+    // A particle left NaN or infinite by the list is killed by the step, not reported.
+    const float sum = e.position.x + e.position.y + e.position.z + e.velocity.x + e.velocity.y +
+                      e.velocity.z + float(e.time);
+    if (!std::isfinite(sum)) return;
+    const std::uint64_t key = (std::uint64_t(c.base + i) << 32) | (std::uint64_t(log.sub) << 16) |
+                              std::uint64_t(action & 0xFFFFu);
+    log.group->addCollision(log.block, key, e);
   };
   const bool planar = withPlanarPiece(b, [&](Vec3 P, Vec3 N, auto) {
     each([&](std::size_t i) {
