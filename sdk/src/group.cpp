@@ -625,13 +625,20 @@ void detail::GroupImpl::endCollisions(std::size_t blocks) {
   }
 }
 
+namespace {
+// Events (deaths, collisions) are the CPU pass's, and carry the particles' ids.
+void startRecording(Group& g, const char* call, const char* what, std::size_t perStep) {
+  if (perStep == 0) return;
+  if (detail::GroupAccess::of(g).onDevice)
+    throw Error(std::string(call) + ": group '" + g.name() + "': " + what +
+                " events are recorded by the CPU backend only (this context runs on a device)");
+  g.require({Attribute::Id});
+}
+}  // namespace
+
 Group& Group::recordCollisions(std::size_t perStep) {
   auto& g = *impl_;
-  if (perStep > 0 && g.onDevice)
-    throw Error("recordCollisions: group '" + g.name +
-                "': collision events are recorded by the CPU backend only (this context runs "
-                "on a device)");
-  if (perStep > 0) require({Attribute::Id});
+  startRecording(*this, "recordCollisions", "collision", perStep);
   g.collisionEvents.clear();
   g.collisionEvents.reserve(std::min(perStep, g.capacity));
   g.collisionsPerStep = perStep;
@@ -650,11 +657,7 @@ void detail::GroupImpl::feedDeaths() {
 
 Group& Group::recordDeaths(std::size_t perStep) {
   auto& g = *impl_;
-  if (perStep > 0 && g.onDevice)
-    throw Error("recordDeaths: group '" + g.name +
-                "': death events are recorded by the CPU backend only (this context runs on "
-                "a device)");
-  if (perStep > 0) require({Attribute::Id});
+  startRecording(*this, "recordDeaths", "death", perStep);
   g.deathEvents.clear();
   g.deathEvents.reserve(std::min(std::max(perStep, g.deathRoom()), g.capacity));
   g.deathsPerStep = perStep;

@@ -174,6 +174,35 @@ nb::object owned(std::vector<T> values, std::initializer_list<std::size_t> shape
   return nb::ndarray<nb::numpy, T>(v->data(), shape.size(), shape.begin(), cap).cast();
 }
 
+// A step's events (deaths, collisions) as numpy arrays, copied: the next step replaces them.
+// Each has a position, a velocity, an id, an action and a time; a collision a normal too.
+template <class Event>
+nb::dict eventArrays(std::span<const Event> d) {
+  constexpr bool hasNormal = requires(const Event& e) {
+    e.normal;
+  };
+  const std::size_t n = d.size();
+  std::vector<float> pos(n * 3), vel(n * 3), nrm(hasNormal ? n * 3 : 0);
+  std::vector<std::uint32_t> id(n), action(n);
+  std::vector<double> time(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      pos[i * 3 + c] = d[i].position[c];
+      vel[i * 3 + c] = d[i].velocity[c];
+      if constexpr (hasNormal) nrm[i * 3 + c] = d[i].normal[c];
+    }
+    id[i] = d[i].id, action[i] = d[i].action, time[i] = d[i].time;
+  }
+  nb::dict out;
+  out["position"] = owned(std::move(pos), {n, 3});
+  out["velocity"] = owned(std::move(vel), {n, 3});
+  if constexpr (hasNormal) out["normal"] = owned(std::move(nrm), {n, 3});
+  out["id"] = owned(std::move(id), {n});
+  out["action"] = owned(std::move(action), {n});
+  out["time"] = owned(std::move(time), {n});
+  return out;
+}
+
 std::vector<std::string> attributeNames(flurry::AttributeSet set) {
   std::vector<std::string> out;
   for (int i = 0; i < int(flurry::Attribute::Count); ++i)
@@ -386,29 +415,7 @@ NB_MODULE(_flurry, m) {
           "Records each step's deaths, at most per_step a step (the first in particle order; "
           "the rest counted in stats.death_events_dropped); 0 stops. CPU backend only.")
       .def(
-          "deaths",
-          [](const GroupRef& pg) {
-            // Copies: the events are replaced by the next step.
-            const auto d = pg.g->deaths();
-            const std::size_t n = d.size();
-            std::vector<float> pos(n * 3), vel(n * 3);
-            std::vector<std::uint32_t> id(n), action(n);
-            std::vector<double> time(n);
-            for (std::size_t i = 0; i < n; ++i) {
-              for (int c = 0; c < 3; ++c) {
-                pos[i * 3 + c] = d[i].position[c];
-                vel[i * 3 + c] = d[i].velocity[c];
-              }
-              id[i] = d[i].id, action[i] = d[i].action, time[i] = d[i].time;
-            }
-            nb::dict out;
-            out["position"] = owned(std::move(pos), {n, 3});
-            out["velocity"] = owned(std::move(vel), {n, 3});
-            out["id"] = owned(std::move(id), {n});
-            out["action"] = owned(std::move(action), {n});
-            out["time"] = owned(std::move(time), {n});
-            return out;
-          },
+          "deaths", [](const GroupRef& pg) { return eventArrays(pg.g->deaths()); },
           "The last step's deaths (record_deaths), copied: position (n, 3), velocity (n, 3), "
           "id (n,), action (n,): the index in the action list of what killed it, or "
           "0xFFFFFFFF for a NaN or infinity, and time (n,): the end of the step.")
@@ -419,31 +426,7 @@ NB_MODULE(_flurry, m) {
           "per_step a step (the first in particle order; the rest counted in "
           "stats.collision_events_dropped); 0 stops. CPU backend only.")
       .def(
-          "collisions",
-          [](const GroupRef& pg) {
-            // Copies: the events are replaced by the next step.
-            const auto d = pg.g->collisions();
-            const std::size_t n = d.size();
-            std::vector<float> pos(n * 3), vel(n * 3), nrm(n * 3);
-            std::vector<std::uint32_t> id(n), action(n);
-            std::vector<double> time(n);
-            for (std::size_t i = 0; i < n; ++i) {
-              for (int c = 0; c < 3; ++c) {
-                pos[i * 3 + c] = d[i].position[c];
-                vel[i * 3 + c] = d[i].velocity[c];
-                nrm[i * 3 + c] = d[i].normal[c];
-              }
-              id[i] = d[i].id, action[i] = d[i].action, time[i] = d[i].time;
-            }
-            nb::dict out;
-            out["position"] = owned(std::move(pos), {n, 3});
-            out["velocity"] = owned(std::move(vel), {n, 3});
-            out["normal"] = owned(std::move(nrm), {n, 3});
-            out["id"] = owned(std::move(id), {n});
-            out["action"] = owned(std::move(action), {n});
-            out["time"] = owned(std::move(time), {n});
-            return out;
-          },
+          "collisions", [](const GroupRef& pg) { return eventArrays(pg.g->collisions()); },
           "The last step's collisions (record_collisions), copied: position (n, 3) of impact, "
           "velocity (n, 3) arriving, normal (n, 3) of the surface on the particle's side, id "
           "(n,), action (n,): the Bounce's index in the action list, and time (n,) of impact.")
