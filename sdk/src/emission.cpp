@@ -457,6 +457,7 @@ void emitFrom(GroupImpl& g, std::size_t k, std::span<const Event> events, std::u
       if (L.birthSize) L.birthSize[i] = p.size;
     }
   }
+  g.startTrails(before, g.size);
   // The step's box, kept by the pass, grows to hold them.
   if (g.boundsValid)
     for (std::size_t i = before; i < g.size; ++i) {
@@ -500,11 +501,15 @@ void compact(GroupImpl& g, const StepParams& sp) {
   }
   g.size = newSize;
   if (moves.empty()) return;
-  std::array<std::uint32_t*, std::size_t(Attribute::Count) * 4> stored;  // no allocation
+  // Every stored lane and the trails' (no allocation).
+  std::array<std::uint32_t*, std::size_t(Attribute::Count) * 4 + 3 * TrailOptions::kMaxLength + 1>
+      stored;
   std::size_t lanes = 0;
   for (auto& attr : g.lanes)
     for (auto& lane : attr)
       if (lane) stored[lanes++] = lane.u();
+  for (auto& lane : g.trailLanes) stored[lanes++] = lane.u();
+  if (g.trailCount) stored[lanes++] = g.trailCount.u();
   auto moveLane = [&](std::uint32_t* lane, std::size_t a, std::size_t b) {
     for (std::size_t k = a; k < b; ++k) lane[moves[k].second] = lane[moves[k].first];
   };

@@ -1,6 +1,7 @@
 #include <sys/mman.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
@@ -168,6 +169,37 @@ void GroupImpl::move(std::size_t from, std::size_t to) {
   for (auto& attr : lanes)
     for (auto& lane : attr)
       if (lane) lane.u()[to] = lane.u()[from];
+  for (auto& lane : trailLanes) lane.u()[to] = lane.u()[from];
+  if (trailCount) trailCount.u()[to] = trailCount.u()[from];
+}
+
+void GroupImpl::startTrails(std::size_t from, std::size_t to) {
+  if (trail.length == 0) return;
+  const Lanes L = lanePointers();
+  for (int c = 0; c < 3; ++c)
+    std::copy(L.p[c] + from, L.p[c] + to, trailLanes[3 * trailHead + c].f() + from);
+  std::fill(trailCount.u() + from, trailCount.u() + to, 1u);
+}
+
+void GroupImpl::recordTrails(ThreadPool& pool) {
+  if (trail.length == 0) return;
+  trailHead = (trailHead + 1) % trail.length;
+  const Lanes L = lanePointers();
+  float* const slot[3] = {trailLanes[3 * trailHead].f(), trailLanes[3 * trailHead + 1].f(),
+                          trailLanes[3 * trailHead + 2].f()};
+  std::uint32_t* const count = trailCount.u();
+  const std::uint32_t most = trail.length;
+  constexpr std::size_t kPerTask = 65536;
+  auto record = [&](std::size_t t) {
+    const std::size_t a = t * kPerTask, b = std::min(size, a + kPerTask);
+    for (int c = 0; c < 3; ++c) std::copy(L.p[c] + a, L.p[c] + b, slot[c] + a);
+    for (std::size_t i = a; i < b; ++i) count[i] = std::min(count[i] + 1u, most);
+  };
+  const std::size_t tasks = (size + kPerTask - 1) / kPerTask;
+  if (tasks > 1)
+    pool.parallelFor(tasks, record);
+  else if (tasks == 1)
+    record(0);
 }
 
 void GroupImpl::ensureStorage() {
@@ -296,6 +328,10 @@ void carryParticles(detail::GroupImpl& g, const Transform& from, const Transform
   points(L.p);
   points(L.prev);
   points(L.posB);
+  for (std::size_t k = 0; k < g.trailLanes.size(); k += 3) {
+    float* const slot[3] = {g.trailLanes[k].f(), g.trailLanes[k + 1].f(), g.trailLanes[k + 2].f()};
+    points(slot);
+  }
   vectors(L.v);
   vectors(L.velB);
   vectors(L.up);
@@ -487,6 +523,61 @@ void Group::clearStrands() {
   impl_->strands.clear();
 }
 
+Group& Group::setTrail(const TrailOptions& options) {
+  auto& g = *impl_;
+  if (options.length > TrailOptions::kMaxLength)
+    throw InvalidArgument("trail.length", std::to_string(options.length) + " is past the most, " +
+                                              std::to_string(TrailOptions::kMaxLength));
+  const std::pair<const char*, float> looks[] = {
+      {"trail.width", options.width}, {"trail.taper", options.taper}, {"trail.fade", options.fade}};
+  for (const auto& [field, value] : looks)
+    if (!(value >= 0.0f) || !std::isfinite(value))
+      throw InvalidArgument(field, "must be finite and >= 0");
+  if (options.length > 0 && g.onDevice)
+    throw Error("setTrail: group '" + g.name +
+                "': trails are kept by the CPU backend only (this context runs on a device)");
+  g.syncHost();
+  if (options.length != g.trail.length) {
+    g.trailLanes.clear();
+    g.trailCount = detail::LaneBuffer();
+    g.trailHead = 0;
+    if (options.length > 0) {
+      // Zeroed, so that no slot ever holds what the allocator left (a carry reads them all).
+      g.trailLanes.reserve(3 * std::size_t(options.length));
+      for (std::size_t k = 0; k < 3 * std::size_t(options.length); ++k) {
+        g.trailLanes.emplace_back(g.capacity);
+        std::memset(g.trailLanes.back().data(), 0, g.capacity * sizeof(float));
+      }
+      g.trailCount = detail::LaneBuffer(g.capacity);
+      std::memset(g.trailCount.data(), 0, g.capacity * sizeof(std::uint32_t));
+    }
+    g.trail = options;
+    g.startTrails(0, g.size);
+  }
+  g.trail = options;
+  return *this;
+}
+
+const TrailOptions& Group::trail() const {
+  return impl_->trail;
+}
+
+std::size_t Group::trail(std::size_t i, std::span<Vec3> out) const {
+  auto& g = *impl_;
+  g.syncCount();
+  if (i >= g.size)
+    throw InvalidArgument("index",
+                          std::to_string(i) + " is past the live count " + std::to_string(g.size));
+  if (g.trail.length == 0) return 0;
+  const std::uint32_t n = g.trailCount.u()[i], len = g.trail.length;
+  for (std::uint32_t k = 0; k < n && k < out.size(); ++k) {
+    const std::size_t slot = 3 * std::size_t((g.trailHead + len - k) % len);
+    out[k] = Vec3(g.trailLanes[slot].f()[i], g.trailLanes[slot + 1].f()[i],
+                  g.trailLanes[slot + 2].f()[i]);
+  }
+  return n;
+}
+
 bool Group::add(const Particle& p) {
   auto& g = *impl_;
   g.syncHost();
@@ -505,6 +596,7 @@ bool Group::add(const Particle& p) {
   for (int c = 0; c < 4; ++c)
     if (l.birthColor[c]) l.birthColor[c][i] = q.color[c];
   if (l.birthSize) l.birthSize[i] = q.size;
+  g.startTrails(i, i + 1);
   g.hostChanged();
   return true;
 }

@@ -196,6 +196,18 @@ struct GroupImpl {
   std::uint32_t nextEmitterId = 0;
   HairOptions hair;
   Strands strands;
+  TrailOptions trail;
+  /// The trails' ring (Group::setTrail): x, y, z lanes of slot k at 3k .. 3k + 2, length
+  /// slots; slot trailHead holds the positions at the end of the last step, the slots before
+  /// it (cyclically) the steps before. Moved with the particles by compaction.
+  std::vector<LaneBuffer> trailLanes;
+  LaneBuffer trailCount;  ///< per particle: the slots its trail fills, from trailHead back
+  std::uint32_t trailHead = 0;
+  /// Particles [from, to) start a trail where they are (newborns, added, alive when the
+  /// trail began): one point, in slot trailHead.
+  void startTrails(std::size_t from, std::size_t to);
+  /// After a step: the ring turns and every live particle's position goes into the new head.
+  void recordTrails(ThreadPool& pool);
   std::array<std::array<LaneBuffer, 4>, std::size_t(Attribute::Count)> lanes;
   GroupStats stats;
   std::uint32_t nextId = 0;

@@ -208,6 +208,48 @@ std::size_t packParticles(const Group& group, const PackLayout& layout, std::spa
   return n;
 }
 
+std::size_t trailStrands(const Group& group, Strands& out, const PackOptions& options) {
+  out.clear();
+  const TrailOptions& look = group.trail();
+  if (look.length == 0) return 0;
+  const std::size_t size = group.size();
+  const AttributeSet stored = group.attributes();
+  const bool hide = options.skipHidden && stored.has(Attribute::Visible);
+  AttributeSet reads{Attribute::Position};
+  if (hide) reads.insert(Attribute::Visible);
+  if (stored.has(Attribute::Color)) reads.insert(Attribute::Color);
+  if (look.width == 0.0f && stored.has(Attribute::Size)) reads.insert(Attribute::Size);
+  group.fetch(reads);
+  std::span<const float> color[4], radius;
+  if (stored.has(Attribute::Color))
+    for (int c = 0; c < 4; ++c) color[c] = group.lane(Attribute::Color, c);
+  if (look.width == 0.0f && stored.has(Attribute::Size)) radius = group.lane(Attribute::Size);
+  std::span<const std::uint32_t> vis;
+  if (hide) vis = group.visible();
+  const Particle defaults;
+  Vec3 points[TrailOptions::kMaxLength];
+  for (std::size_t i = 0; i < size; ++i) {
+    if (hide && vis[i] == 0) continue;
+    const std::size_t n = group.trail(i, points);
+    if (n < 2) continue;
+    bool blocked = false;
+    for (const Domain& b : options.blockers) blocked = blocked || b.contains(points[0]);
+    if (blocked) continue;
+    const Vec4 c = color[0].empty()
+                       ? defaults.color
+                       : Vec4(color[0][i], color[1][i], color[2][i], color[3][i]);
+    const float r = look.width > 0.0f ? look.width : radius.empty() ? defaults.size : radius[i];
+    for (std::size_t k = 0; k < n; ++k) {
+      const float along = float(k) / float(n - 1);  // 0 at the particle, 1 at the oldest
+      out.position.push_back(points[k]);
+      out.radius.push_back(r * (1.0f + (look.taper - 1.0f) * along));
+      out.color.emplace_back(Vec3(c), c.a * (1.0f + (look.fade - 1.0f) * along));
+    }
+    out.start.push_back(std::uint32_t(out.position.size()));
+  }
+  return out.size();
+}
+
 std::vector<std::byte> packParticles(const Group& group, const PackLayout& layout,
                                      const PackOptions& options) {
   std::vector<std::byte> bytes(std::size_t(group.size()) * layout.stride);

@@ -50,6 +50,20 @@ struct HairOptions {
   std::uint32_t maxVertices = 256;  ///< a strand ends here if the particle lives on
 };
 
+/// Trails (Group::setTrail): each live particle keeps where it was at the end of its last
+/// `length` steps (a ring of positions, filled after every step), for ribbons that follow
+/// fast particles (hair mode draws a dead particle's whole life instead). The
+/// look fields say how flurry::render and trailStrands() draw it: a ribbon `width` (a
+/// radius) at the particle, narrowing to `taper` times that and fading to `fade` times the
+/// particle's alpha at the trail's oldest point.
+struct TrailOptions {
+  std::uint32_t length = 0;  ///< positions kept per particle (0: no trail; at most kMaxLength)
+  float width = 0.0f;        ///< the ribbon's radius at the particle; 0: the particle's size
+  float taper = 1.0f;        ///< the radius at the oldest point, as a fraction of the first
+  float fade = 0.0f;         ///< the alpha at the oldest point, as a fraction of the first
+  static constexpr std::uint32_t kMaxLength = 256;
+};
+
 /// Where the particles went:
 /// emitted == size() + killedByAge + absorbed + droppedAtCapacity + killedNonFinite.
 struct GroupStats {
@@ -188,6 +202,19 @@ class Group {
   const HairOptions& hair() const;
   const Strands& strands() const;
   void clearStrands();
+
+  /// Keeps each particle's last `options.length` positions (TrailOptions), from the next
+  /// step on: particles alive now start their trail where they are. Throws InvalidArgument
+  /// naming the field ("trail.length" past kMaxLength, a width, taper or fade that is
+  /// negative or not finite), and Error in a device context (trails are the CPU backend's).
+  /// Costs one memory pass over the positions a step, and the trail's lanes in compaction.
+  Group& setTrail(const TrailOptions& options);
+  const TrailOptions& trail() const;
+  /// Particle i's trail, newest first: its position at the end of the last step, then of
+  /// each step before, back to where it was born (or where it was when the trail began).
+  /// Writes up to out.size() points and returns how many it has (at most length; 0 without a
+  /// trail). Throws InvalidArgument "index" past size().
+  std::size_t trail(std::size_t i, std::span<Vec3> out) const;
 
   /// Adds one particle now; returns false (and counts it dropped) when the group is full.
   bool add(const Particle& p);

@@ -79,6 +79,15 @@ struct PackOptions {
 std::size_t packParticles(const Group& group, const PackLayout& layout, std::span<std::byte> out,
                           const PackOptions& options = {});
 
+/// The live particles' trails (Group::setTrail) as ribbons for a renderer, into `out`
+/// (cleared; its storage is reused, so a game calling it every frame allocates nothing
+/// once it has grown): one strand per particle with two points or more, newest first. Each
+/// point's radius is the group's TrailOptions::width (0: the particle's size) narrowing to
+/// `taper` times it at the oldest point, and its colour the particle's, its alpha fading to
+/// `fade` times the particle's there (linearly along the points). Particles `options` leaves
+/// out (hidden, or inside a blocker at their own position) give none; sortFromEye is not
+/// used. Returns the number of strands; a group without a trail gives none.
+std::size_t trailStrands(const Group& group, Strands& out, const PackOptions& options = {});
 /// Same, into a vector sized to exactly the packed particles.
 std::vector<std::byte> packParticles(const Group& group, const PackLayout& layout,
                                      const PackOptions& options = {});

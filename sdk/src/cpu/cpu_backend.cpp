@@ -223,10 +223,13 @@ class CpuBackend final : public BackendImpl {
     };
     auto& parts = group.lastStepParts;
     emitNewborns(group, params);
+    // A newborn's trail starts where it was born, inside the step.
+    if (group.bornCount > 0) group.startTrails(group.bornFirst, group.bornFirst + group.bornCount);
     lap(group.stats.stepSeconds.emit, parts.emit);
     actFused(group, params);
     lap(group.stats.stepSeconds.act, parts.act);
     compact(group, params);
+    group.recordTrails(*params.pool);
     lap(group.stats.stepSeconds.compact, parts.compact);
     if (group.hair.enabled) simulateHair(group, params);
   }

@@ -269,6 +269,7 @@ struct Renderer::Impl {
   std::vector<float> strandVerts;
   std::vector<GLint> strandFirst;
   std::vector<GLsizei> strandCount;
+  Strands trails;  ///< scratch: a group's trails as ribbons (trailStrands)
 
   glm::mat4 view{1.0f}, proj{1.0f};
 
@@ -459,6 +460,10 @@ struct Renderer::Impl {
     glDepthFunc(GL_LEQUAL);
     glDepthMask(depthWrite ? GL_TRUE : GL_FALSE);
   }
+
+  /// Strands as ribbons or lines (settings.strandStyle). Hair writes depth (opaque strands
+  /// hide what is behind them); a particle's trail fades, so it blends as particles do.
+  void drawStrands(const Strands& strands, bool depthWrite, bool additive, bool shading);
 };
 
 Renderer::Renderer(RenderSettings settings) : impl_(std::make_unique<Impl>()) {
@@ -640,6 +645,8 @@ void Renderer::draw(const Group& group) {
   if (s.geometry.show) d.drawGeometry(group);
   if (!group.strands().position.empty()) draw(group.strands());
   const Impl::Look look = d.lookFor(group);
+  if (group.trail().length > 0 && trailStrands(group, d.trails) > 0)
+    d.drawStrands(d.trails, false, look.blend == BlendMode::Additive, look.shading);
   PackOptions opts;
   opts.blockers = s.blockers;
   if (look.blend == BlendMode::Alpha && look.sortForAlpha) opts.sortFromEye = s.camera.eye();
@@ -679,7 +686,13 @@ void Renderer::draw(const Group& group) {
 }
 
 void Renderer::draw(const Strands& strands) {
-  Impl& d = *impl_;
+  const RenderSettings& s = impl_->settings;
+  impl_->drawStrands(strands, true, s.blend == BlendMode::Additive, s.shading);
+}
+
+void Renderer::Impl::drawStrands(const Strands& strands, bool depthWrite, bool additive,
+                                 bool shading) {
+  Impl& d = *this;
   const RenderSettings& s = d.settings;
   const bool lines = s.strandStyle == StrandStyle::Line;
   d.strandVerts.clear();
@@ -732,9 +745,8 @@ void Renderer::draw(const Strands& strands) {
   const auto bytes = GLsizeiptr(d.strandVerts.size() * sizeof(float));
   glBufferData(GL_ARRAY_BUFFER, bytes, nullptr, GL_STREAM_DRAW);
   glBufferSubData(GL_ARRAY_BUFFER, 0, bytes, d.strandVerts.data());
-  // Opaque strands hide what is behind them, particles included; translucent ones blend.
-  d.setBlend(true, s.blend == BlendMode::Additive);
-  d.setCommon(d.strands, s.shading);
+  d.setBlend(depthWrite, additive);
+  d.setCommon(d.strands, shading);
   d.setLighting(d.strands);
   glUniform1i(loc(d.strands, "uLines"), lines ? 1 : 0);
   glBindVertexArray(d.strandVao);
