@@ -523,16 +523,20 @@ void Group::clearStrands() {
   impl_->strands.clear();
 }
 
-Group& Group::setTrail(const TrailOptions& options) {
-  auto& g = *impl_;
-  if (options.length > TrailOptions::kMaxLength)
-    throw InvalidArgument("trail.length", std::to_string(options.length) + " is past the most, " +
-                                              std::to_string(TrailOptions::kMaxLength));
+void TrailOptions::validate(const std::string& where) const {
+  if (length > kMaxLength)
+    throw InvalidArgument(where + ".length", std::to_string(length) + " is past the most, " +
+                                                 std::to_string(kMaxLength));
   const std::pair<const char*, float> looks[] = {
-      {"trail.width", options.width}, {"trail.taper", options.taper}, {"trail.fade", options.fade}};
+      {"width", width}, {"taper", taper}, {"fade", fade}};
   for (const auto& [field, value] : looks)
     if (!(value >= 0.0f) || !std::isfinite(value))
-      throw InvalidArgument(field, "must be finite and >= 0");
+      throw InvalidArgument(where + "." + field, "must be finite and >= 0");
+}
+
+Group& Group::setTrail(const TrailOptions& options) {
+  auto& g = *impl_;
+  options.validate();
   if (options.length > 0 && g.onDevice)
     throw Error("setTrail: group '" + g.name +
                 "': trails are kept by the CPU backend only (this context runs on a device)");

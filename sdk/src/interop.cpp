@@ -235,9 +235,8 @@ std::size_t trailStrands(const Group& group, Strands& out, const PackOptions& op
     bool blocked = false;
     for (const Domain& b : options.blockers) blocked = blocked || b.contains(points[0]);
     if (blocked) continue;
-    const Vec4 c = color[0].empty()
-                       ? defaults.color
-                       : Vec4(color[0][i], color[1][i], color[2][i], color[3][i]);
+    const Vec4 c = color[0].empty() ? defaults.color
+                                    : Vec4(color[0][i], color[1][i], color[2][i], color[3][i]);
     const float r = look.width > 0.0f ? look.width : radius.empty() ? defaults.size : radius[i];
     for (std::size_t k = 0; k < n; ++k) {
       const float along = float(k) / float(n - 1);  // 0 at the particle, 1 at the oldest

@@ -906,6 +906,58 @@ static void test_collisions(void) {
   OK(flurry_effect_destroy(fx));
 }
 
+/* Trails from an effect file, packed as ribbons: at most `length` points each, newest (the
+ * furthest along +x) first, the radius narrowing from `width` to taper·width, alpha to 0. */
+static void test_trails(void) {
+  const char* json =
+      "{\"name\": \"t\", \"dt\": 0.1, \"groups\": [{\"name\": \"g\", \"capacity\": 100,"
+      " \"emitters\": [{\"rate\": 20, \"types\": [{\"velocity\": [1, 0, 0]}]}],"
+      " \"actions\": [{\"type\": \"Move\"}],"
+      " \"trail\": {\"length\": 4, \"width\": 0.1, \"taper\": 0.5}}]}";
+  flurry_effect* fx = NULL;
+  flurry_context* ctx = NULL;
+  flurry_context_options o;
+  flurry_group* g = NULL;
+  float out[100 * 4 * 8];
+  uint32_t starts[101];
+  size_t vertices = 0, strands = 0, alive = 0, k, v, full = 0;
+  int step;
+  flurry_trail_options bad = {300, 0.0f, 1.0f, 0.0f};
+  OK(flurry_effect_parse(json, "t", &fx));
+  OK(flurry_effect_context_options(fx, &o));
+  OK(flurry_context_create(&o, &ctx));
+  OK(flurry_effect_build(fx, ctx, 0));
+  OK(flurry_context_group(ctx, "g", &g));
+  for (step = 0; step < 6; ++step) OK(flurry_context_step(ctx));
+  OK(flurry_group_size(g, &alive));
+  OK(flurry_group_pack_trails(g, out, alive * 4, starts, alive + 1, &vertices, &strands));
+  CHECK(strands >= 9 && strands <= alive && starts[0] == 0 && starts[strands] == vertices);
+  for (k = 0; k < strands; ++k) {
+    const size_t first = starts[k], n = starts[k + 1] - starts[k];
+    CHECK(n >= 2 && n <= 4);
+    if (n == 4) ++full;
+    CHECK(fabsf(out[8 * first + 3] - 0.1f) < 1e-6f && fabsf(out[8 * first + 7] - 1.0f) < 1e-6f);
+    CHECK(fabsf(out[8 * (first + n - 1) + 3] - 0.05f) < 1e-6f);
+    CHECK(out[8 * (first + n - 1) + 7] == 0.0f);
+    /* A particle born at the step's very end has not moved in it: its first two are equal. */
+    for (v = first + 1; v < first + n; ++v) CHECK(out[8 * v] <= out[8 * (v - 1)]);
+    if (n >= 3) CHECK(out[8 * (first + n - 1)] < out[8 * first]);
+  }
+  CHECK(full > 0);
+  FAILS(flurry_group_pack_trails(g, out, 1, starts, alive + 1, &vertices, &strands),
+        FLURRY_ERROR_INVALID_ARGUMENT, "capacity_vertices");
+  FAILS(flurry_group_pack_trails(g, out, alive * 4, starts, 1, &vertices, &strands),
+        FLURRY_ERROR_INVALID_ARGUMENT, "capacity_starts");
+  FAILS(flurry_group_set_trail(g, &bad), FLURRY_ERROR_INVALID_ARGUMENT, "trail.length");
+  FAILS(flurry_group_set_trail(g, NULL), FLURRY_ERROR_NULL_ARGUMENT, "options");
+  bad.length = 0;
+  OK(flurry_group_set_trail(g, &bad));
+  OK(flurry_group_pack_trails(g, NULL, 0, starts, 1, &vertices, &strands));
+  CHECK(vertices == 0 && strands == 0 && starts[0] == 0);
+  OK(flurry_context_destroy(ctx));
+  OK(flurry_effect_destroy(fx));
+}
+
 /* A job system in a few lines: every task on the calling thread, last first. */
 typedef struct reverse_scheduler {
   int calls;
@@ -1001,6 +1053,7 @@ int main(int argc, char** argv) {
   test_instances();
   test_scheduler();
   test_collisions();
+  test_trails();
   if (failures) {
     fprintf(stderr, "%d checks failed\n", failures);
     return 1;

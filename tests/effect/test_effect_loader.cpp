@@ -522,6 +522,30 @@ TEST(EffectLoader, HairAndRequire) {
   EXPECT_EQ(errorOf(withGroup(R"("hair": {"every": 0})")).path(), "groups[0].hair.every");
 }
 
+TEST(EffectLoader, Trail) {
+  const Effect fx = parseEffect(
+      withGroup(R"("trail": {"length": 12, "width": 0.02, "taper": 0.3, "fade": 0.1})"));
+  const TrailOptions& t = fx.groups[0].trail;
+  EXPECT_EQ(t.length, 12u);
+  EXPECT_EQ(t.width, 0.02f);
+  EXPECT_EQ(t.taper, 0.3f);
+  EXPECT_EQ(t.fade, 0.1f);
+  // Saved and loaded again, the same; built, the group keeps it.
+  const std::string saved = saveEffect(fx);
+  EXPECT_NE(saved.find("\"trail\""), std::string::npos);
+  EXPECT_EQ(saveEffect(parseEffect(saved, "saved.json")), saved);
+  Context ctx(fx.contextOptions());
+  fx.build(ctx);
+  EXPECT_EQ(ctx.groups()[0]->trail().length, 12u);
+  EXPECT_EQ(parseEffect(withGroup(R"("trail": {"length": 3})")).groups[0].trail.taper, 1.0f);
+  EXPECT_EQ(errorOf(withGroup(R"("trail": {"length": 300})")).path(), "groups[0].trail.length");
+  EXPECT_EQ(errorOf(withGroup(R"("trail": {"length": 3, "width": -1})")).path(),
+            "groups[0].trail.width");
+  const EffectError e = errorOf(withGroup(R"("trail": {"lenght": 3})"));
+  EXPECT_EQ(e.path(), "groups[0].trail.lenght");
+  EXPECT_NE(e.why().find("did you mean \"length\""), std::string::npos);
+}
+
 TEST(EffectLoader, DenseSampledField) {
   const Effect fx =
       parseEffect(withGroup(R"("actions": [{"type": "SampledField", "mode": "velocity",

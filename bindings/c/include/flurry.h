@@ -472,6 +472,28 @@ FLURRY_C_EXPORT flurry_status flurry_group_pack_instances(const flurry_group* gr
                                                           size_t capacity_bytes, const float eye[3],
                                                           size_t* written);
 
+/** Trails (flurry::TrailOptions): each particle keeps its last `length` positions (0: none;
+ * at most 256); the ribbons flurry_group_pack_trails makes are `width` in radius at the
+ * particle (0: its size), narrowing to `taper` times that and fading to `fade` times its
+ * alpha at the oldest point. */
+typedef struct flurry_trail_options {
+  uint32_t length;
+  float width, taper, fade;
+} flurry_trail_options;
+/** Sets the group's trail (FLURRY_ERROR_INVALID_ARGUMENT naming "trail.length", ...; on a
+ * device context FLURRY_ERROR). */
+FLURRY_C_EXPORT flurry_status flurry_group_set_trail(flurry_group* group,
+                                                     const flurry_trail_options* options);
+/** Packs the visible live particles' trails as ribbons: vertices of FLURRY_INSTANCE_STRIDE
+ * (x, y, z, radius, r, g, b, a, newest point first) into `out` (`capacity_vertices` of them:
+ * size * length always suffices), and where each strand starts into `starts`
+ * (`capacity_starts` entries: strands + 1, the last being the vertex count; size + 1
+ * suffices). *vertices and *strands get the counts; a particle with one point has none. */
+FLURRY_C_EXPORT flurry_status flurry_group_pack_trails(const flurry_group* group, float* out,
+                                                       size_t capacity_vertices, uint32_t* starts,
+                                                       size_t capacity_starts, size_t* vertices,
+                                                       size_t* strands);
+
 /* ---- OpenVDB export (flurry/vdb.hpp) ----------------------------------------------------- */
 
 /** Whether this library was built with the OpenVDB exporter. */

@@ -1208,6 +1208,49 @@ flurry_status flurry_group_pack_instances(const flurry_group* g, void* out, size
   });
 }
 
+flurry_status flurry_group_set_trail(flurry_group* g, const flurry_trail_options* o) {
+  return guard([&] {
+    need(g, "group");
+    need(o, "options");
+    group(g).setTrail({o->length, o->width, o->taper, o->fade});
+  });
+}
+
+flurry_status flurry_group_pack_trails(const flurry_group* g, float* out, size_t capacityVertices,
+                                       uint32_t* starts, size_t capacityStarts, size_t* vertices,
+                                       size_t* strands) {
+  return guard([&] {
+    need(g, "group");
+    need(vertices, "vertices");
+    need(strands, "strands");
+    *vertices = *strands = 0;
+    thread_local flurry::Strands scratch;  // grown once, reused every frame
+    flurry::trailStrands(group(g), scratch);
+    const std::size_t v = scratch.vertexCount(), s = scratch.size();
+    if (v > capacityVertices)
+      throw flurry::InvalidArgument(
+          "capacity_vertices",
+          "holds " + std::to_string(capacityVertices) + ", " + std::to_string(v) + " needed");
+    if (s + 1 > capacityStarts)
+      throw flurry::InvalidArgument(
+          "capacity_starts",
+          "holds " + std::to_string(capacityStarts) + ", " + std::to_string(s + 1) + " needed");
+    if (v > 0) need(out, "out");
+    need(starts, "starts");
+    static_assert(FLURRY_INSTANCE_STRIDE == 8 * sizeof(float));
+    for (std::size_t i = 0; i < v; ++i) {
+      float* r = out + 8 * i;
+      const flurry::Vec3 p = scratch.position[i];
+      const flurry::Vec4 c = scratch.color[i];
+      r[0] = p.x, r[1] = p.y, r[2] = p.z, r[3] = scratch.radius[i];
+      r[4] = c.r, r[5] = c.g, r[6] = c.b, r[7] = c.a;
+    }
+    std::copy(scratch.start.begin(), scratch.start.end(), starts);
+    *vertices = v;
+    *strands = s;
+  });
+}
+
 // ---- OpenVDB --------------------------------------------------------------------------------
 
 int flurry_has_vdb(void) {

@@ -174,6 +174,23 @@ nb::object owned(std::vector<T> values, std::initializer_list<std::size_t> shape
   return nb::ndarray<nb::numpy, T>(v->data(), shape.size(), shape.begin(), cap).cast();
 }
 
+// Strands (hair, trails) as numpy arrays, copied: position (v, 3), color (v, 4), radius (v,),
+// start (strands + 1,).
+nb::dict strandArrays(const flurry::Strands& s) {
+  const std::size_t n = s.vertexCount();
+  std::vector<float> pos(n * 3), col(s.color.size() * 4);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) pos[i * 3 + c] = s.position[i][c];
+  for (std::size_t i = 0; i < s.color.size(); ++i)
+    for (int c = 0; c < 4; ++c) col[i * 4 + c] = s.color[i][c];
+  nb::dict d;
+  d["position"] = owned(std::move(pos), {n, 3});
+  d["color"] = owned(std::move(col), {s.color.size(), 4});
+  d["radius"] = owned(s.radius, {s.radius.size()});
+  d["start"] = owned(s.start, {s.start.size()});
+  return d;
+}
+
 // A step's events (deaths, collisions) as numpy arrays, copied: the next step replaces them.
 // Each has a position, a velocity, an id, an action and a time; a collision a normal too.
 template <class Event>
@@ -387,24 +404,39 @@ NB_MODULE(_flurry, m) {
           "attributes"_a, "Asks the group to store these attributes too (for a reader).")
       .def(
           "strands",
-          [](const GroupRef& pg) {
-            // Copies: a strand store grows (and reallocates) as steps add strands.
-            const flurry::Strands& s = pg.g->strands();
-            const std::size_t n = s.vertexCount();
-            std::vector<float> pos(n * 3), col(s.color.size() * 4);
-            for (std::size_t i = 0; i < n; ++i)
-              for (int c = 0; c < 3; ++c) pos[i * 3 + c] = s.position[i][c];
-            for (std::size_t i = 0; i < s.color.size(); ++i)
-              for (int c = 0; c < 4; ++c) col[i * 4 + c] = s.color[i][c];
-            nb::dict d;
-            d["position"] = owned(std::move(pos), {n, 3});
-            d["color"] = owned(std::move(col), {s.color.size(), 4});
-            d["radius"] = owned(s.radius, {s.radius.size()});
-            d["start"] = owned(s.start, {s.start.size()});
-            return d;
-          },
+          // Copies: a strand store grows (and reallocates) as steps add strands.
+          [](const GroupRef& pg) { return strandArrays(pg.g->strands()); },
           "Hair mode's strands, copied: position (v, 3), color (v, 4), radius (v,), and start "
           "(strands + 1,): strand k is vertices start[k]:start[k+1].")
+      .def(
+          "set_trail",
+          [](GroupRef& pg, std::uint32_t length, float width, float taper, float fade) {
+            pg.g->setTrail({length, width, taper, fade});
+          },
+          "length"_a, "width"_a = 0.0f, "taper"_a = 1.0f, "fade"_a = 0.0f,
+          "Keeps each particle's last `length` positions (0: none; at most 256) for ribbons: "
+          "`width` their radius at the particle (0: its size), narrowing to `taper` times it "
+          "and fading to `fade` times its alpha at the oldest point. CPU backend only.")
+      .def(
+          "trail",
+          [](const GroupRef& pg, std::size_t i) {
+            std::vector<flurry::Vec3> points(flurry::TrailOptions::kMaxLength);
+            points.resize(pg.g->trail(i, points));
+            std::vector<float> xyz(points.size() * 3);
+            for (std::size_t k = 0; k < points.size(); ++k)
+              for (int c = 0; c < 3; ++c) xyz[k * 3 + c] = points[k][c];
+            return owned(std::move(xyz), {points.size(), 3});
+          },
+          "i"_a, "Particle i's trail (set_trail), newest first, as an (n, 3) array.")
+      .def(
+          "trails",
+          [](const GroupRef& pg) {
+            flurry::Strands s;
+            flurry::trailStrands(*pg.g, s);
+            return strandArrays(s);
+          },
+          "The live particles' trails as ribbons, copied as strands() gives hair: one strand "
+          "per particle with two points or more, newest first, radius and alpha along it.")
       .def(
           "bounds", [](const GroupRef& pg) { return boundsOf(pg.g->bounds()); },
           "The live particles' axis-aligned box, ((x, y, z), (x, y, z)), or None when none "

@@ -372,6 +372,35 @@ def test_collisions_say_where_when_and_how_fast():
     assert len(g.collisions()["id"]) == 0
 
 
+def test_trails_keep_each_particles_last_positions():
+    ctx = fountain()
+    g = ctx.groups[0]
+    g.set_trail(5, width=0.02, taper=0.25, fade=0.0)
+    history = []
+    for _ in range(8):
+        ctx.step()
+        history.append({int(i): (x, y, z) for i, x, y, z in zip(
+            g.lane("id"), g.lane("position", 0), g.lane("position", 1), g.lane("position", 2))})
+    ids = g.lane("id")
+    for i in range(0, len(g), 37):
+        t = g.trail(i)
+        assert t.shape[1] == 3 and 1 <= len(t) <= 5
+        # Newest first, the positions it had after each of the last steps (bitwise).
+        for k in range(min(len(t), len(history)) - 1):
+            if int(ids[i]) in history[-1 - k]:
+                assert tuple(t[k]) == history[-1 - k][int(ids[i])]
+    r = g.trails()
+    n = len(r["start"]) - 1
+    assert n > 0 and r["position"].shape == (r["start"][-1], 3)
+    first, last = r["start"][:-1], r["start"][1:] - 1
+    assert np.allclose(r["radius"][first], 0.02) and np.allclose(r["radius"][last], 0.005)
+    assert np.all(r["color"][last, 3] == 0)
+    with pytest.raises(flurry.InvalidArgument, match="trail.length"):
+        g.set_trail(1000)
+    g.set_trail(0)
+    assert len(g.trail(0)) == 0 and len(g.trails()["start"]) == 1
+
+
 def test_context_stats_sum_the_groups():
     ctx = fountain()
     for _ in range(20):

@@ -62,6 +62,9 @@ struct TrailOptions {
   float taper = 1.0f;        ///< the radius at the oldest point, as a fraction of the first
   float fade = 0.0f;         ///< the alpha at the oldest point, as a fraction of the first
   static constexpr std::uint32_t kMaxLength = 256;
+  /// Throws InvalidArgument naming the field ("trail.length", ...) of a length past
+  /// kMaxLength or a width, taper or fade that is negative or not finite.
+  void validate(const std::string& where = "trail") const;
 };
 
 /// Where the particles went:

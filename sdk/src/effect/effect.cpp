@@ -982,6 +982,21 @@ EffectGroup readGroup(const json& j, const std::string& path, const Loader& L,
       ho.finish();
     }
   }
+  if (const json* t = o.get("trail")) {
+    Obj to(*t, o.at("trail"), L);
+    if (const json* v = to.get("length"))
+      g.trail.length =
+          std::uint32_t(readInteger(*v, to.at("length"), L, 0, TrailOptions::kMaxLength));
+    to.opt("width", g.trail.width);
+    to.opt("taper", g.trail.taper);
+    to.opt("fade", g.trail.fade);
+    to.finish();
+    try {
+      g.trail.validate();
+    } catch (const InvalidArgument& e) {
+      L.rethrow(to.path(), e, "trail");
+    }
+  }
   if (const json* r = o.get("require")) {
     const std::string rp = o.at("require");
     arrayOf(*r, rp, L, 0, "an array of attribute names");
@@ -1109,6 +1124,7 @@ std::vector<Group*> Effect::build(Context& ctx, std::size_t maxCapacity,
           ctx.createGroup(instance.empty() ? eg.name : eg.name + "@" + std::string(instance), cap);
       g.setActions(eg.actions);
       if (eg.hair.enabled) g.setHair(eg.hair);
+      if (eg.trail.length > 0) g.setTrail(eg.trail);
       g.require(eg.require);
       if (space == Space::Local) g.setSpace(Space::Local);
       for (std::size_t k = 0; k < eg.emitters.size(); ++k) g.addEmitter(eg.emitters[k]);
@@ -1390,6 +1406,15 @@ ojson writeGroup(Writer w, const EffectGroup& g, const std::string& path) {
     if (g.hair.every != hairDefault.every) ho["every"] = g.hair.every;
     if (g.hair.maxVertices != hairDefault.maxVertices) ho["maxVertices"] = g.hair.maxVertices;
     o["hair"] = ho.empty() ? ojson(true) : std::move(ho);
+  }
+  if (g.trail.length > 0) {
+    const TrailOptions trailDefault;
+    ojson to = ojson::object();
+    to["length"] = g.trail.length;
+    if (g.trail.width != trailDefault.width) to["width"] = write(w, g.trail.width);
+    if (g.trail.taper != trailDefault.taper) to["taper"] = write(w, g.trail.taper);
+    if (g.trail.fade != trailDefault.fade) to["fade"] = write(w, g.trail.fade);
+    o["trail"] = std::move(to);
   }
   if (g.require.bits() != 0) {
     ojson r = ojson::array();

@@ -10,6 +10,7 @@
 
 #include "effect/effect_docs.hpp"
 #include "effect/json_writer.hpp"
+#include "flurry/group.hpp"
 
 namespace flurry::detail {
 
@@ -262,6 +263,11 @@ std::string effectSchema() {
   ojson hair = object(
       {{"enabled", {{"type", "boolean"}}}, {"every", integer(1)}, {"maxVertices", integer(2)}});
   g["hair"] = {{"anyOf", ojson::array({{{"type", "boolean"}}, hair})}};
+  g["trail"] = object({{"length", integer(0)},
+                       {"width", nonNegative},
+                       {"taper", nonNegative},
+                       {"fade", nonNegative}});
+  g["trail"]["properties"]["length"]["maximum"] = flurry::TrailOptions::kMaxLength;
   g["require"] = arrayOf({{"enum", attributes}});
   defs["group"] = object(std::move(g));
   defs["group"]["required"] = {"capacity"};
@@ -435,7 +441,8 @@ std::string fuzzDictionary() {
       "maxDistance",   "maxSubsteps", "hair",        "enabled",    "every",    "maxVertices",
       "require",       "type",        "center",      "spread",     "percent",  "distribution",
       "origin",        "voxelSize",   "dims",        "data",       "vdb",      "grid",
-      "normal",        "point"};
+      "normal",        "point",       "trail",       "length",     "width",    "taper",
+      "fade"};
   std::set<std::string> values = {"world", "local", "uniform", "normal", "inf",
                                   "-inf",  "true",  "false",   "null"};
   for (const DomainKind& k : domainKinds()) {
