@@ -539,7 +539,7 @@ Group& Group::setTrail(const TrailOptions& options) {
   options.validate();
   if (options.length > 0 && g.onDevice)
     throw Error("setTrail: group '" + g.name +
-                "': trails are kept by the CPU backend only (this context runs on a device)");
+                "': a trail does not run on the device yet (the CPU backend keeps it)");
   g.syncHost();
   if (options.length != g.trail.length) {
     g.trailLanes.clear();
