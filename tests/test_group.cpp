@@ -1104,6 +1104,57 @@ TEST(DeathEmitter, FollowsItsSourceByName) {
 
 // On collision: each deflection gives `count` newborns at the point of impact, with the
 // arriving velocity inherited; bitwise on any thread count.
+// A sub-emitter on birth: each newborn of the source's emitters gives `count` newborns at the
+// place it was born, with inheritVelocity times its velocity then, whatever the source's list
+// does to it afterwards.
+TEST(DeathEmitter, OnBirthEmitsWhereEachParticleIsBorn) {
+  Context ctx({.seed = 4, .dt = 0.1, .threads = 1});
+  Group& tracers = ctx.createGroup("tracers", 1000);
+  Emitter gun;
+  gun.shape = Domain::line(Vec3(0, 1, 0), Vec3(4, 1, 0));
+  gun.rate = 50.0;
+  gun.types[0].velocity = Domain::box(Vec3(1, 0, -1), Vec3(3, 2, 1));
+  tracers.addEmitter(gun);
+  tracers.setActions({Gravity{Vec3(0, -9.81f, 0)}, Move{}});
+  tracers.require({Attribute::Age});  // to find each one's birth place below
+  Group& flashes = ctx.createGroup("flashes", 4000);
+  flashes.require({Attribute::Velocity, Attribute::Age});
+  DeathEmitter de;
+  de.source = "tracers";
+  de.on = DeathEmitter::Trigger::Birth;
+  de.count = 2.0f;
+  de.inheritVelocity = 0.5f;
+  de.types[0].velocity = Domain::point(Vec3(0.0f));
+  flashes.addDeathEmitter(de);
+  std::uint64_t born = 0;
+  for (int step = 0; step < 6; ++step) {
+    const std::size_t before = flashes.size();
+    ctx.step();
+    const std::uint64_t now = tracers.stats().emitted - born;
+    born = tracers.stats().emitted;
+    ASSERT_EQ(flashes.size() - before, 2 * now);  // exactly two a birth
+    // The step's newborns (the tail), each the place and half the velocity of a tracer's
+    // birth: that tracer is now where the flash is plus its path since (p - v·age - g·age²/2
+    // back), the flashes in the tracers' order.
+    for (std::size_t k = 0; k < now; ++k) {
+      const Particle t = tracers.particle(tracers.size() - now + k);
+      const float a = t.age;
+      const Vec3 v0 = t.velocity - Vec3(0, -9.81f, 0) * a;
+      for (std::size_t j = 0; j < 2; ++j) {
+        const Particle f = flashes.particle(before + 2 * k + j);
+        EXPECT_LT(glm::length(f.velocity - 0.5f * v0), 1e-4f);
+        EXPECT_LT(glm::length(f.position - (t.position - t.velocity * a)), 2e-3f);
+        EXPECT_NEAR(f.position.y, 1.0f, 2e-3f);  // on the gun's line
+        EXPECT_EQ(f.age, 0.0f);
+      }
+    }
+  }
+  EXPECT_GT(born, 20u);
+  // A birth has no cause.
+  de.cause = 0;
+  EXPECT_THROW(flashes.addDeathEmitter(de), InvalidArgument);
+}
+
 TEST(DeathEmitter, OnCollisionEmitsAtEachImpact) {
   ContextOptions o;
   o.dt = 0.125;

@@ -199,6 +199,7 @@ void stepGroup(detail::BackendImpl& backend, detail::GroupImpl& gi, const detail
   gi.boundsValid = false;  // the CPU pass takes them again
   gi.deathEvents.clear();
   gi.collisionEvents.clear();
+  gi.birthEvents.clear();
   if (gi.stats.killedByAction.size() != gi.actions.size())
     gi.stats.killedByAction.assign(gi.actions.size(), 0);
   backend.step(gi, sp);
@@ -234,7 +235,8 @@ Group* Context::Impl::sourceOf(detail::GroupImpl& gi, std::size_t k) {
 
 void Context::Impl::feedDeathEmitters() {
   if (deathEmitters == 0 && !deathsFed) return;
-  for (auto& g : groups) g->impl_->deathsFeed = g->impl_->collisionsFeed = false;
+  for (auto& g : groups)
+    g->impl_->deathsFeed = g->impl_->collisionsFeed = g->impl_->birthsFeed = false;
   deathsFed = false;
   if (deathEmitters == 0) return;
   for (auto& g : groups) {
@@ -246,6 +248,8 @@ void Context::Impl::feedDeathEmitters() {
                     "].source: no group named '" + gi.deathEmitters[k].source + "' in the context");
       if (gi.deathEmitters[k].on == DeathEmitter::Trigger::Collision)
         source->impl_->collisionsFeed = true;  // records them all for it
+      else if (gi.deathEmitters[k].on == DeathEmitter::Trigger::Birth)
+        source->impl_->birthsFeed = true;
       else
         source->impl_->feedDeaths();
       deathsFed = true;

@@ -474,6 +474,8 @@ void emitFrom(GroupImpl& g, std::size_t k, std::span<const Event> events, std::u
 void emitFromDeaths(GroupImpl& g, std::size_t k, const GroupImpl& source, std::uint64_t seed) {
   if (g.deathEmitters[k].on == DeathEmitter::Trigger::Collision)
     emitFrom<CollisionEvent>(g, k, source.collisionEvents, seed);
+  else if (g.deathEmitters[k].on == DeathEmitter::Trigger::Birth)
+    emitFrom<DeathEvent>(g, k, source.birthEvents, seed);
   else
     emitFrom<DeathEvent>(g, k, source.deathEvents, seed);
 }

@@ -60,6 +60,9 @@ void DeathEmitter::validate(const std::string& where) const {
   if (!std::isfinite(inheritVelocity))
     throw InvalidArgument(where + ".inheritVelocity", "not finite");
   if (cause < -1) throw InvalidArgument(where + ".cause", "must be an action's index or -1");
+  if (on == Trigger::Birth && cause != -1)
+    throw InvalidArgument(where + ".cause",
+                          "a birth has no cause: -1 (births emit whatever kills)");
   Emitter e;  // the types are an emitter's
   e.types = types;
   e.validate(where);

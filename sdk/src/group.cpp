@@ -745,6 +745,22 @@ std::span<const CollisionEvent> Group::collisions() const {
   return impl_->collisionEvents;
 }
 
+void detail::GroupImpl::recordBirths(double t1) {
+  birthEvents.clear();
+  if (birthEvents.capacity() < capacity) birthEvents.reserve(capacity);  // once
+  const Lanes L = lanePointers();
+  for (std::size_t r = 0; r < bornCount; ++r) {
+    const std::size_t i = bornFirst + r;
+    DeathEvent e;
+    e.position = Vec3(L.p[0][i], L.p[1][i], L.p[2][i]);
+    if (L.v[0]) e.velocity = Vec3(L.v[0][i], L.v[1][i], L.v[2][i]);
+    e.id = L.id[i];
+    e.action = 0;
+    e.time = t1 - double(bornRemaining[r]);
+    birthEvents.push_back(e);
+  }
+}
+
 void detail::GroupImpl::feedDeaths() {
   if (deathsFeed) return;
   deathEvents.reserve(capacity);  // no step has more deaths than the group holds particles

@@ -253,6 +253,13 @@ struct GroupImpl {
   void addCollision(std::size_t block, std::uint64_t key, const CollisionEvent& e);
   void endCollisions(std::size_t blocks);
   std::vector<DeathEvent> deathEvents;  ///< the last step's, reserved by recordDeaths
+  /// A birth emitter names this group (set by Context::step): each step's newborns are kept
+  /// as events (where and when born, the velocity then, the id; action 0) in birthEvents.
+  bool birthsFeed = false;
+  std::vector<DeathEvent> birthEvents;  ///< the last step's, reserved up to the capacity
+  /// Keeps the step's newborns [bornFirst, bornFirst + bornCount) as birthEvents, before the
+  /// pass moves them (t1: the step's end; each was born bornRemaining[r] before it).
+  void recordBirths(double t1);
   std::vector<std::size_t> deathStart;  ///< scratch: each block's first event
   bool onDevice = false;                ///< its context runs a device backend
   /// Group::bounds() was asked: from then on the CPU pass takes the live particles' box

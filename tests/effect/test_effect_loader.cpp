@@ -418,6 +418,12 @@ TEST(EffectLoader, DeathEmitters) {
   const std::string savedOnHit = saveEffect(onHit);
   EXPECT_NE(savedOnHit.find(R"("on": "collision")"), std::string::npos) << savedOnHit;
   EXPECT_EQ(saveEffect(parseEffect(savedOnHit, "saved.json")), savedOnHit);
+  // On birth: no cause.
+  const Effect onBirth = parseEffect(withDeath(R"("source": "g", "on": "birth")"), "t.json");
+  EXPECT_EQ(onBirth.groups[0].deathEmitters[0].on, DeathEmitter::Trigger::Birth);
+  EXPECT_NE(saveEffect(onBirth).find(R"("on": "birth")"), std::string::npos);
+  const EffectError birthCause = errorOf(withDeath(R"("source": "g", "on": "birth", "cause": 0)"));
+  EXPECT_EQ(birthCause.path(), "groups[0].deathEmitters[0].cause") << birthCause.what();
 }
 
 TEST(EffectLoader, EmittersAndPrimeEmitters) {

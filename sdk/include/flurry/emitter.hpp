@@ -149,9 +149,14 @@ struct PrimeEmitter {
 /// each deflection (see Group::collisions) gives `count` newborns at the point of impact, with
 /// `inheritVelocity` times the velocity the particle arrived with; `cause` is then the index
 /// of a Bounce in the source's list (-1: all its Bounces).
+///
+/// With `on` = Trigger::Birth it emits where the source's emitters give birth (a sub-emitter
+/// on birth: a muzzle flash for each tracer, a puff where each spark leaves the wheel): each
+/// newborn of the source gives `count` newborns at the place it was born, with
+/// `inheritVelocity` times its velocity at birth; `cause` must be -1 (a birth has none).
 struct DeathEmitter {
   /// What of the source's particles emits.
-  enum class Trigger { Death, Collision };
+  enum class Trigger { Death, Collision, Birth };
   std::string name;
   /// The group whose deaths emit, by name (it may be this group); it must exist when the
   /// context steps, which records its deaths from then on (all of them: room for its

@@ -225,6 +225,7 @@ class CpuBackend final : public BackendImpl {
     emitNewborns(group, params);
     // A newborn's trail starts where it was born, inside the step.
     if (group.bornCount > 0) group.startTrails(group.bornFirst, group.bornFirst + group.bornCount);
+    if (group.birthsFeed) group.recordBirths(params.time + params.dt);
     lap(group.stats.stepSeconds.emit, parts.emit);
     actFused(group, params);
     lap(group.stats.stepSeconds.act, parts.act);

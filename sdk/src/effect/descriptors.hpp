@@ -130,7 +130,9 @@ struct EnumNames<Sink::Mode> {
 template <>
 struct EnumNames<DeathEmitter::Trigger> {
   static constexpr std::pair<const char*, DeathEmitter::Trigger> values[] = {
-      {"death", DeathEmitter::Trigger::Death}, {"collision", DeathEmitter::Trigger::Collision}};
+      {"death", DeathEmitter::Trigger::Death},
+      {"collision", DeathEmitter::Trigger::Collision},
+      {"birth", DeathEmitter::Trigger::Birth}};
 };
 
 // ---- parts shared by actions ----------------------------------------------------------------
@@ -678,7 +680,7 @@ struct Describe<DeathEmitter> {
             "only deaths by this action of the source's list, or collisions with this Bounce "
             "(-1: all)"),
       field("on", &DeathEmitter::on, "", kAny,
-            "what emits: the source's deaths or its collisions (Bounce deflections)"),
+            "what emits: the source's deaths, its collisions (Bounce deflections) or its births"),
   };
 };
 
