@@ -59,7 +59,51 @@ struct Context::Impl {
   /// After the step: the death emitters of `only` (all groups when empty) whose source is
   /// in `only` too emit, group by group in creation order.
   void runDeathEmitters(std::span<Group* const> only);
+  std::size_t budget = 0;     // Context::setParticleBudget; 0: none
+  bool budgetShared = false;  // the groups hold allowances from shareBudget
+  /// Before a step: shares the room under the budget among the groups that emit (see
+  /// Context::setParticleBudget), or lifts the allowances when there is no budget.
+  void shareBudget();
 };
+
+void Context::Impl::shareBudget() {
+  if (budget == 0) {
+    if (!budgetShared) return;
+    for (auto& g : groups) {
+      g->impl_->birthAllowance = ~std::uint64_t(0);
+      g->impl_->keepAtMost = ~std::size_t(0);
+    }
+    budgetShared = false;
+    return;
+  }
+  budgetShared = true;
+  std::size_t live = 0;
+  double asked = 0.0;
+  auto emits = [](const detail::GroupImpl& gi) {
+    return !gi.emitters.empty() || !gi.primes.empty() || !gi.live.empty() ||
+           !gi.deathEmitters.empty();
+  };
+  for (auto& g : groups) {
+    live += g->impl_->size;
+    if (emits(*g->impl_)) asked += double(g->impl_->lastDemand) + 1.0;
+  }
+  const std::size_t room = budget > live ? budget - live : 0;
+  const std::size_t over = live > budget ? live - budget : 0;
+  std::size_t given = 0;
+  for (auto& g : groups) {
+    auto& gi = *g->impl_;
+    const std::uint64_t share =
+        emits(gi) ? std::uint64_t(double(room) * ((double(gi.lastDemand) + 1.0) / asked)) : 0;
+    gi.birthAllowance = std::min<std::uint64_t>(share, room - given);
+    given += std::size_t(gi.birthAllowance);
+    // Over the budget (it was lowered): a DropOldest group gives up its share of the excess.
+    const std::size_t cut =
+        over > 0 ? std::size_t(std::ceil(double(over) * double(gi.size) / double(live))) : 0;
+    gi.keepAtMost = gi.budgetPolicy == BudgetPolicy::DropOldest
+                        ? gi.size - std::min(cut, gi.size) + std::size_t(gi.birthAllowance)
+                        : ~std::size_t(0);
+  }
+}
 
 namespace {
 // A group that can hold no more than this many particles steps inline (its act pass is one
@@ -273,9 +317,21 @@ void Context::Impl::runDeathEmitters(std::span<Group* const> only) {
   }
 }
 
+void Context::setParticleBudget(std::size_t particles) {
+  if (particles > 0 && impl_->backendKind != Backend::Cpu)
+    throw Error(
+        "setParticleBudget: a particle budget does not run on the device yet (the CPU "
+        "backend keeps it)");
+  impl_->budget = particles;
+}
+std::size_t Context::particleBudget() const {
+  return impl_->budget;
+}
+
 void Context::step() {
   const auto started = std::chrono::steady_clock::now();
   impl_->feedDeathEmitters();
+  impl_->shareBudget();
   const detail::StepParams sp = impl_->params();
   auto& small = impl_->smallGroups;
   small.clear();
@@ -327,6 +383,7 @@ std::uint64_t Context::prewarm(std::span<Group* const> groups, double seconds) {
   const detail::StepParams sp = impl_->params();
   if (n > 0) impl_->feedDeathEmitters();
   for (std::uint64_t i = 0; i < n; ++i) {
+    impl_->shareBudget();
     for (Group* g : groups) {
       auto& gi = *g->impl_;
       stepGroup(*impl_->backend, gi,
@@ -378,6 +435,8 @@ ContextStats Context::stats() const {
     const GroupStats& gs = g->stats();
     s.emitted += gs.emitted;
     s.droppedAtCapacity += gs.droppedAtCapacity;
+    s.droppedAtBudget += gs.droppedAtBudget;
+    s.killedByBudget += gs.killedByBudget;
     s.deathEventsDropped += gs.deathEventsDropped;
     s.collisionEventsDropped += gs.collisionEventsDropped;
     s.idleSteps += gs.idleSteps;

@@ -353,6 +353,25 @@ void retireDead(GroupImpl& g, double t1) {
   });
 }
 
+namespace {
+// Keeps `fit` of the runs' births, the same fraction of each run (BudgetPolicy::ScaleEmission):
+// run r keeps the births between the rounded shares of the counts before it and with it.
+void thinRuns(std::vector<BirthRun>& runs, std::uint64_t fit) {
+  std::uint64_t total = 0;
+  for (const BirthRun& r : runs) total += r.count;
+  if (total <= fit) return;
+  const double scale = double(fit) / double(total);
+  std::uint64_t before = 0, keptBefore = 0;
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    before += runs[k].count;
+    const std::uint64_t keptTo =
+        k + 1 == runs.size() ? fit : std::min(fit, std::uint64_t(double(before) * scale));
+    runs[k].count = keptTo - keptBefore;
+    keptBefore = keptTo;
+  }
+}
+}  // namespace
+
 void emitNewborns(GroupImpl& g, const StepParams& sp) {
   const double t1 = sp.time + sp.dt;
   g.bornFirst = g.size;
@@ -368,8 +387,19 @@ void emitNewborns(GroupImpl& g, const StepParams& sp) {
   runs.clear();
   const std::uint64_t total = planBirths(g, sp, runs);
   g.stats.emitted += total;
-  const std::size_t accepted = std::size_t(std::min<std::uint64_t>(total, g.capacity - g.size));
+  g.lastDemand = total;
+  std::size_t accepted = std::size_t(std::min<std::uint64_t>(total, g.capacity - g.size));
   g.stats.droppedAtCapacity += total - accepted;
+  // Past the group's share of the context's budget (DropOldest makes them all and trims
+  // after the step).
+  if (g.budgetPolicy != BudgetPolicy::DropOldest && accepted > g.birthAllowance) {
+    const std::size_t fit = std::size_t(g.birthAllowance);
+    g.stats.droppedAtBudget += accepted - fit;
+    if (g.budgetPolicy == BudgetPolicy::ScaleEmission) thinRuns(runs, fit);
+    accepted = fit;
+  }
+  if (g.birthAllowance != ~std::uint64_t(0))
+    g.birthAllowance -= std::min<std::uint64_t>(accepted, g.birthAllowance);
 
   // 2. The newborns, in parallel: each one's attributes depend only on its id.
   if (accepted > 0) {
@@ -430,6 +460,11 @@ void emitFrom(GroupImpl& g, std::size_t k, std::span<const Event> events, std::u
       g.stats.droppedAtCapacity += n - room;
       n = room;
     }
+    if (g.budgetPolicy != BudgetPolicy::DropOldest && n > g.birthAllowance) {
+      g.stats.droppedAtBudget += n - g.birthAllowance;
+      n = g.birthAllowance;
+    }
+    if (g.birthAllowance != ~std::uint64_t(0)) g.birthAllowance -= std::min(n, g.birthAllowance);
     for (std::uint64_t j = 0; j < n; ++j) {
       // A newborn's own stream, as an emitter's newborn has (ids never repeat in a group).
       const std::uint32_t id = g.nextId++;

@@ -8,6 +8,7 @@
 #include <new>
 
 #include "action_traits.hpp"
+#include "backend.hpp"
 #include "flurry/error.hpp"
 #include "group_impl.hpp"
 #include "thread_pool.hpp"
@@ -532,6 +533,34 @@ void TrailOptions::validate(const std::string& where) const {
   for (const auto& [field, value] : looks)
     if (!(value >= 0.0f) || !std::isfinite(value))
       throw InvalidArgument(where + "." + field, "must be finite and >= 0");
+}
+
+Group& Group::setBudgetPolicy(BudgetPolicy policy) {
+  if (policy != BudgetPolicy::DropNewest && policy != BudgetPolicy::DropOldest &&
+      policy != BudgetPolicy::ScaleEmission)
+    throw InvalidArgument("policy", "not a BudgetPolicy");
+  impl_->budgetPolicy = policy;
+  return *this;
+}
+BudgetPolicy Group::budgetPolicy() const {
+  return impl_->budgetPolicy;
+}
+
+void detail::GroupImpl::dropOldest(std::size_t excess, const StepParams& params) {
+  // Ids grow with birth: the smallest are the first born. Only while over budget; the
+  // scratch grows once.
+  thread_local std::vector<std::uint64_t> byIdStore;
+  auto& byId = byIdStore;
+  byId.resize(size);
+  const std::uint32_t* id = lanePointers().id;
+  for (std::size_t i = 0; i < size; ++i) byId[i] = std::uint64_t(id[i]) << 32 | i;
+  std::nth_element(byId.begin(), byId.begin() + std::ptrdiff_t(excess), byId.end());
+  holes.clear();
+  for (std::size_t k = 0; k < excess; ++k) holes.push_back(std::uint32_t(byId[k]));
+  std::sort(holes.begin(), holes.end());
+  stats.killedByBudget += excess;
+  boundsValid = false;  // the box kept by the pass may hold the dead
+  compact(*this, params);
 }
 
 Group& Group::setTrail(const TrailOptions& options) {

@@ -15,6 +15,7 @@
 namespace flurry::detail {
 
 class ThreadPool;
+struct StepParams;
 
 /// One 64-byte aligned array of 32-bit values. Large arrays ask for transparent huge pages:
 /// the update is bandwidth-bound, and huge pages measurably raise the bandwidth reached.
@@ -197,6 +198,15 @@ struct GroupImpl {
   HairOptions hair;
   Strands strands;
   TrailOptions trail;
+  BudgetPolicy budgetPolicy = BudgetPolicy::DropNewest;
+  /// Set by Context::step under a particle budget (Context::Impl::shareBudget), else
+  /// unlimited: the births this step may still make, and (DropOldest) the most particles
+  /// the group keeps after it.
+  std::uint64_t birthAllowance = ~std::uint64_t(0);
+  std::size_t keepAtMost = ~std::size_t(0);
+  std::uint64_t lastDemand = 0;  ///< births the emitters planned in the last step
+  /// Kills the `excess` first-born particles (smallest ids) and closes their holes.
+  void dropOldest(std::size_t excess, const StepParams& params);
   /// The trails' ring (Group::setTrail): x, y, z lanes of slot k at 3k .. 3k + 2, length
   /// slots; slot trailHead holds the positions at the end of the last step, the slots before
   /// it (cyclically) the steps before. Moved with the particles by compaction.

@@ -958,6 +958,43 @@ static void test_trails(void) {
   OK(flurry_effect_destroy(fx));
 }
 
+/* A particle budget: the context stays within it; a group dropping its oldest kills them. */
+static void test_budget(void) {
+  const char* json =
+      "{\"name\": \"t\", \"dt\": 0.1, \"groups\": [{\"name\": \"g\", \"capacity\": 1000,"
+      " \"emitters\": [{\"rate\": 100, \"types\": [{\"lifetime\": 50}]}],"
+      " \"actions\": [{\"type\": \"Move\"}, {\"type\": \"KillOld\"}],"
+      " \"budget\": \"dropOldest\"}]}";
+  flurry_effect* fx = NULL;
+  flurry_context* ctx = NULL;
+  flurry_context_options o;
+  flurry_group* g = NULL;
+  flurry_group_stats gs;
+  flurry_context_stats cs;
+  size_t alive = 0;
+  OK(flurry_effect_parse(json, "t", &fx));
+  OK(flurry_effect_context_options(fx, &o));
+  OK(flurry_context_create(&o, &ctx));
+  OK(flurry_effect_build(fx, ctx, 0));
+  OK(flurry_context_group(ctx, "g", &g));
+  OK(flurry_context_set_particle_budget(ctx, 25));
+  OK(flurry_context_run(ctx, 10));
+  OK(flurry_group_size(g, &alive));
+  OK(flurry_group_stats_get(g, &gs));
+  OK(flurry_context_stats_get(ctx, &cs));
+  CHECK(alive == 25 && gs.killed_by_budget == 75 && gs.dropped_at_budget == 0);
+  CHECK(cs.killed_by_budget == 75 && cs.particles == 25);
+  OK(flurry_group_set_budget_policy(g, FLURRY_BUDGET_DROP_NEWEST));
+  OK(flurry_context_run(ctx, 10));
+  OK(flurry_group_stats_get(g, &gs));
+  CHECK(gs.dropped_at_budget == 100 && gs.killed_by_budget == 75);
+  FAILS(flurry_group_set_budget_policy(g, (flurry_budget_policy)9), FLURRY_ERROR_INVALID_ARGUMENT,
+        "policy");
+  FAILS(flurry_context_set_particle_budget(NULL, 1), FLURRY_ERROR_NULL_ARGUMENT, "ctx");
+  OK(flurry_context_destroy(ctx));
+  OK(flurry_effect_destroy(fx));
+}
+
 /* A job system in a few lines: every task on the calling thread, last first. */
 typedef struct reverse_scheduler {
   int calls;
@@ -1054,6 +1091,7 @@ int main(int argc, char** argv) {
   test_scheduler();
   test_collisions();
   test_trails();
+  test_budget();
   if (failures) {
     fprintf(stderr, "%d checks failed\n", failures);
     return 1;

@@ -552,6 +552,20 @@ TEST(EffectLoader, Trail) {
   EXPECT_NE(e.why().find("did you mean \"length\""), std::string::npos);
 }
 
+TEST(EffectLoader, BudgetPolicy) {
+  const Effect fx = parseEffect(withGroup(R"("budget": "scaleEmission")"));
+  EXPECT_EQ(fx.groups[0].budget, BudgetPolicy::ScaleEmission);
+  const std::string saved = saveEffect(fx);
+  EXPECT_NE(saved.find(R"("budget": "scaleEmission")"), std::string::npos) << saved;
+  EXPECT_EQ(saveEffect(parseEffect(saved, "saved.json")), saved);
+  Context ctx(fx.contextOptions());
+  fx.build(ctx);
+  EXPECT_EQ(ctx.groups()[0]->budgetPolicy(), BudgetPolicy::ScaleEmission);
+  const EffectError e = errorOf(withGroup(R"("budget": "dropOlder")"));
+  EXPECT_EQ(e.path(), "groups[0].budget");
+  EXPECT_NE(e.why().find("did you mean \"dropOldest\""), std::string::npos) << e.what();
+}
+
 TEST(EffectLoader, DenseSampledField) {
   const Effect fx =
       parseEffect(withGroup(R"("actions": [{"type": "SampledField", "mode": "velocity",

@@ -240,8 +240,10 @@ TEST(OpenCLBackend, DeathEventsAreAClearErrorOnTheDevice) {
     EXPECT_NE(std::string(e.what()).find("CPU backend only"), std::string::npos) << e.what();
   }
   EXPECT_THROW(g.recordCollisions(100), Error);
-  EXPECT_THROW(g.setTrail({.length = 8}), Error);  // trails are the CPU pass's too
-  g.setTrail({});                                  // none is fine
+  EXPECT_THROW(g.setTrail({.length = 8}), Error);   // trails are the CPU pass's too
+  g.setTrail({});                                   // none is fine
+  EXPECT_THROW(ctx.setParticleBudget(100), Error);  // the budget's shares are the CPU's
+  ctx.setParticleBudget(0);
   DeathEmitter de;
   de.source = g.name();
   EXPECT_THROW(ctx.createGroup("splash", 100).addDeathEmitter(de), Error);

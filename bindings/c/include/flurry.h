@@ -30,7 +30,7 @@ extern "C" {
 #endif
 
 /** The C interface's ABI number: raised when a struct, enum value or signature changes. */
-#define FLURRY_C_ABI_VERSION 1
+#define FLURRY_C_ABI_VERSION 2 /* 2: the stats structs count budget drops */
 
 typedef enum flurry_status {
   FLURRY_OK = 0,
@@ -169,10 +169,25 @@ typedef struct flurry_context_stats {
   double last_emit_seconds, last_act_seconds, last_compact_seconds;
   uint64_t emitted, dropped_at_capacity, death_events_dropped, collision_events_dropped;
   uint64_t idle_steps;
+  uint64_t dropped_at_budget, killed_by_budget; /**< flurry_context_set_particle_budget */
 } flurry_context_stats;
 
 FLURRY_C_EXPORT flurry_status flurry_context_stats_get(const flurry_context* ctx,
                                                        flurry_context_stats* stats);
+
+/** What a group gives up past its share of the context's particle budget
+ * (flurry::BudgetPolicy). */
+typedef enum flurry_budget_policy {
+  FLURRY_BUDGET_DROP_NEWEST = 0,    /**< births past the share are not made (the default) */
+  FLURRY_BUDGET_DROP_OLDEST = 1,    /**< births are made; the first-born die to make room */
+  FLURRY_BUDGET_SCALE_EMISSION = 2, /**< every emitter keeps the same fraction of its births */
+} flurry_budget_policy;
+/** The most particles all groups together hold (0: none); the room under it is shared each
+ * step among the groups that emit (flurry::Context::setParticleBudget). CPU backend only. */
+FLURRY_C_EXPORT flurry_status flurry_context_set_particle_budget(flurry_context* ctx,
+                                                                 size_t particles);
+FLURRY_C_EXPORT flurry_status flurry_group_set_budget_policy(flurry_group* group,
+                                                             flurry_budget_policy policy);
 /** Why FLURRY_BACKEND_AUTO took the CPU ("" when it did not). */
 FLURRY_C_EXPORT flurry_status flurry_context_backend_fallback(const flurry_context* ctx,
                                                               const char** why);
@@ -435,7 +450,8 @@ FLURRY_C_EXPORT flurry_status flurry_group_collisions(const flurry_group* group,
                                                       size_t* count, uint64_t* dropped);
 
 /** Where the particles went (flurry::GroupStats):
- * emitted == size + killed_by_age + absorbed + dropped_at_capacity + killed_non_finite. */
+ * emitted == size + killed_by_age + absorbed + dropped_at_capacity + dropped_at_budget +
+ * killed_by_budget + killed_non_finite. */
 typedef struct flurry_group_stats {
   uint64_t emitted;
   uint64_t killed_by_age;
@@ -447,6 +463,7 @@ typedef struct flurry_group_stats {
   uint64_t idle_steps;
   uint64_t block_actions_culled;
   double emit_seconds, act_seconds, compact_seconds; /**< CPU backend's cumulative times */
+  uint64_t dropped_at_budget, killed_by_budget;      /**< past its share of the budget */
 } flurry_group_stats;
 
 FLURRY_C_EXPORT flurry_status flurry_group_stats_get(const flurry_group* group,

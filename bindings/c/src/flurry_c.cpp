@@ -457,6 +457,24 @@ flurry_status flurry_context_stats_get(const flurry_context* ctx, flurry_context
     out->death_events_dropped = s.deathEventsDropped;
     out->collision_events_dropped = s.collisionEventsDropped;
     out->idle_steps = s.idleSteps;
+    out->dropped_at_budget = s.droppedAtBudget;
+    out->killed_by_budget = s.killedByBudget;
+  });
+}
+
+flurry_status flurry_context_set_particle_budget(flurry_context* ctx, size_t particles) {
+  return guard([&] {
+    need(ctx, "ctx");
+    ctx->ctx.setParticleBudget(particles);
+  });
+}
+
+flurry_status flurry_group_set_budget_policy(flurry_group* g, flurry_budget_policy policy) {
+  return guard([&] {
+    need(g, "group");
+    static_assert(int(flurry::BudgetPolicy::DropOldest) == FLURRY_BUDGET_DROP_OLDEST &&
+                  int(flurry::BudgetPolicy::ScaleEmission) == FLURRY_BUDGET_SCALE_EMISSION);
+    group(g).setBudgetPolicy(flurry::BudgetPolicy(policy));
   });
 }
 
@@ -1158,6 +1176,8 @@ flurry_status flurry_group_stats_get(const flurry_group* g, flurry_group_stats* 
     out->emit_seconds = s.stepSeconds.emit;
     out->act_seconds = s.stepSeconds.act;
     out->compact_seconds = s.stepSeconds.compact;
+    out->dropped_at_budget = s.droppedAtBudget;
+    out->killed_by_budget = s.killedByBudget;
   });
 }
 flurry_status flurry_group_killed_by_action(const flurry_group* g, const uint64_t** data,

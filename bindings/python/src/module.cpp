@@ -338,6 +338,8 @@ NB_MODULE(_flurry, m) {
       .def_ro("block_actions_culled", &flurry::GroupStats::blockActionsCulled)
       .def_ro("death_events_dropped", &flurry::GroupStats::deathEventsDropped)
       .def_ro("collision_events_dropped", &flurry::GroupStats::collisionEventsDropped)
+      .def_ro("dropped_at_budget", &flurry::GroupStats::droppedAtBudget)
+      .def_ro("killed_by_budget", &flurry::GroupStats::killedByBudget)
       .def("__repr__", [](const flurry::GroupStats& s) {
         return "GroupStats(emitted=" + std::to_string(s.emitted) +
                ", killed_by_age=" + std::to_string(s.killedByAge) +
@@ -364,7 +366,9 @@ NB_MODULE(_flurry, m) {
       .def_ro("dropped_at_capacity", &flurry::ContextStats::droppedAtCapacity)
       .def_ro("death_events_dropped", &flurry::ContextStats::deathEventsDropped)
       .def_ro("collision_events_dropped", &flurry::ContextStats::collisionEventsDropped)
-      .def_ro("idle_steps", &flurry::ContextStats::idleSteps);
+      .def_ro("idle_steps", &flurry::ContextStats::idleSteps)
+      .def_ro("dropped_at_budget", &flurry::ContextStats::droppedAtBudget)
+      .def_ro("killed_by_budget", &flurry::ContextStats::killedByBudget);
 
   nb::class_<GroupRef>(m, "Group", "A particle group of a Context (it keeps its Context alive).")
       .def_prop_ro("name", [](const GroupRef& g) { return g.g->name(); })
@@ -478,6 +482,25 @@ NB_MODULE(_flurry, m) {
           "transform", [](const GroupRef& pg) { return transformDict(pg.g->transform()); },
           "The group's transform: position, rotation (w, x, y, z), scale.")
       .def_prop_rw(
+          "budget_policy",
+          [](const GroupRef& pg) {
+            const char* names[] = {"drop_newest", "drop_oldest", "scale_emission"};
+            return std::string(names[int(pg.g->budgetPolicy())]);
+          },
+          [](GroupRef& pg, const std::string& name) {
+            const char* names[] = {"drop_newest", "drop_oldest", "scale_emission"};
+            for (int k = 0; k < 3; ++k)
+              if (name == names[k]) {
+                pg.g->setBudgetPolicy(flurry::BudgetPolicy(k));
+                return;
+              }
+            throw flurry::InvalidArgument("budget_policy", "\"" + name +
+                                                               "\" is not drop_newest, drop_oldest "
+                                                               "or scale_emission");
+          },
+          "What the group gives up past its share of the context's particle_budget: "
+          "\"drop_newest\" (the default), \"drop_oldest\" or \"scale_emission\".")
+      .def_prop_rw(
           "space",
           [](const GroupRef& pg) {
             return std::string(pg.g->space() == flurry::Space::Local ? "local" : "world");
@@ -543,6 +566,11 @@ NB_MODULE(_flurry, m) {
           "dt", [](const ContextBox& pc) { return pc.ctx->timeStep(); },
           [](ContextBox& pc, double dt) { pc.ctx->setTimeStep(dt); })
       .def_prop_ro("seed", [](const ContextBox& pc) { return pc.ctx->seed(); })
+      .def_prop_rw(
+          "particle_budget", [](const ContextBox& pc) { return pc.ctx->particleBudget(); },
+          [](ContextBox& pc, std::size_t n) { pc.ctx->setParticleBudget(n); },
+          "The most particles all groups together hold (0: none); each group's budget_policy "
+          "says what it gives up past its share. CPU backend only.")
       .def_prop_ro("threads", [](const ContextBox& pc) { return pc.ctx->threads(); })
       .def_prop_ro(
           "stats", [](const ContextBox& pc) { return pc.ctx->stats(); },

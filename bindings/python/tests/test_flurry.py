@@ -401,6 +401,23 @@ def test_trails_keep_each_particles_last_positions():
     assert len(g.trail(0)) == 0 and len(g.trails()["start"]) == 1
 
 
+def test_a_particle_budget_holds_the_context_and_each_policy_gives_up_its_own():
+    ctx = fountain()
+    ctx.particle_budget = 500
+    assert ctx.particle_budget == 500
+    for _ in range(40):
+        ctx.step()
+        assert ctx.stats.particles <= 500
+    g = ctx.groups[0]
+    assert g.budget_policy == "drop_newest" and g.stats.dropped_at_budget > 0
+    g.budget_policy = "drop_oldest"
+    ctx.particle_budget = 200
+    ctx.step()
+    assert ctx.stats.particles <= 200 and ctx.stats.killed_by_budget > 0
+    with pytest.raises(flurry.InvalidArgument, match="budget_policy"):
+        g.budget_policy = "drop_everything"
+
+
 def test_context_stats_sum_the_groups():
     ctx = fountain()
     for _ in range(20):

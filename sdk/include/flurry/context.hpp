@@ -53,6 +53,8 @@ struct ContextStats {
   /// Over the groups' lives, all groups together (see GroupStats).
   std::uint64_t emitted = 0;
   std::uint64_t droppedAtCapacity = 0;
+  std::uint64_t droppedAtBudget = 0;
+  std::uint64_t killedByBudget = 0;
   std::uint64_t deathEventsDropped = 0;
   std::uint64_t collisionEventsDropped = 0;
   std::uint64_t idleSteps = 0;
@@ -64,6 +66,16 @@ class Context {
   ~Context();
   Context(const Context&) = delete;
   Context& operator=(const Context&) = delete;
+
+  /// The most particles all groups together should hold (0: no budget, the default). Before
+  /// each step the room left under it is shared among the groups that emit, in proportion
+  /// to what each asked for the step before (alike at first); a group's BudgetPolicy says
+  /// what it gives up past its share. When the budget is lowered below the particles alive,
+  /// DropOldest groups shrink at once (by their share of the excess), the others by not
+  /// emitting until deaths bring the context under it. Deterministic: the same on any
+  /// thread count. The CPU backend keeps it (a device context throws Error).
+  void setParticleBudget(std::size_t particles);
+  std::size_t particleBudget() const;
 
   /// Creates a group of fixed capacity (> 0; throws InvalidArgument "capacity").
   Group& createGroup(std::string name, std::size_t capacity);

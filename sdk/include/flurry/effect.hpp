@@ -58,7 +58,8 @@ struct EffectGroup {
   /// The action list, with the 2-D constraint already inserted for a `mode2d` group.
   ActionList actions;
   HairOptions hair;
-  TrailOptions trail;  ///< kept when trail.length > 0 (Group::setTrail)
+  TrailOptions trail;                              ///< kept when trail.length > 0 (Group::setTrail)
+  BudgetPolicy budget = BudgetPolicy::DropNewest;  ///< past its share of a context's budget
   /// Attributes stored although no action reads them (a renderer or exporter will).
   AttributeSet require;
 };

@@ -67,8 +67,23 @@ struct TrailOptions {
   void validate(const std::string& where = "trail") const;
 };
 
-/// Where the particles went:
-/// emitted == size() + killedByAge + absorbed + droppedAtCapacity + killedNonFinite.
+/// What a group gives up while its context is short of particles (Context::setParticleBudget):
+/// the room left under the budget is shared each step among the groups that emit, in
+/// proportion to what each asked for the step before.
+enum class BudgetPolicy {
+  /// Births past the group's share are not made (GroupStats::droppedAtBudget): the first
+  /// planned are kept, emitter by emitter. The default.
+  DropNewest,
+  /// Every birth is made, and the group's first-born particles die to make room
+  /// (GroupStats::killedByBudget; no death event): an effect that must look alive now.
+  DropOldest,
+  /// Every emitter keeps the same fraction of its births, so that the whole effect thins
+  /// evenly instead of its last emitters going quiet (droppedAtBudget).
+  ScaleEmission,
+};
+
+/// Where the particles went: emitted == size() + killedByAge + absorbed + droppedAtCapacity +
+/// droppedAtBudget + killedByBudget + killedNonFinite.
 struct GroupStats {
   /// Created by emitters or add(), dropped ones included. A step counts at most 2^40 births
   /// of a group's emitters together: a rate of 1e25/s or a spacing of 1e-30 asks for more
@@ -79,6 +94,10 @@ struct GroupStats {
   std::uint64_t absorbed = 0;     ///< by Sink (and other absorbers)
   /// Counted in `emitted` but not created: the group was full (within the 2^40 a step).
   std::uint64_t droppedAtCapacity = 0;
+  /// Counted in `emitted` but not created: past the group's share of the context's budget.
+  std::uint64_t droppedAtBudget = 0;
+  /// Killed to keep the context within its budget (BudgetPolicy::DropOldest).
+  std::uint64_t killedByBudget = 0;
   /// Killed because a step left their position or velocity NaN or infinite (an extreme
   /// input, a user callback): counted, never propagated.
   std::uint64_t killedNonFinite = 0;
@@ -218,6 +237,11 @@ class Group {
   /// Writes up to out.size() points and returns how many it has (at most length; 0 without a
   /// trail). Throws InvalidArgument "index" past size().
   std::size_t trail(std::size_t i, std::span<Vec3> out) const;
+
+  /// What this group gives up while the context is over its particle budget (default
+  /// DropNewest).
+  Group& setBudgetPolicy(BudgetPolicy policy);
+  BudgetPolicy budgetPolicy() const;
 
   /// Adds one particle now; returns false (and counts it dropped) when the group is full.
   bool add(const Particle& p);

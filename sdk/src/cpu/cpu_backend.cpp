@@ -230,6 +230,7 @@ class CpuBackend final : public BackendImpl {
     actFused(group, params);
     lap(group.stats.stepSeconds.act, parts.act);
     compact(group, params);
+    if (group.size > group.keepAtMost) group.dropOldest(group.size - group.keepAtMost, params);
     group.recordTrails(*params.pool);
     lap(group.stats.stepSeconds.compact, parts.compact);
     if (group.hair.enabled) simulateHair(group, params);

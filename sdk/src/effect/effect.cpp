@@ -982,6 +982,15 @@ EffectGroup readGroup(const json& j, const std::string& path, const Loader& L,
       ho.finish();
     }
   }
+  if (const json* b = o.get("budget")) {
+    std::string name;
+    read(*b, o.at("budget"), L, name);
+    const std::vector<std::string> names = {"dropNewest", "dropOldest", "scaleEmission"};
+    const auto it = std::find(names.begin(), names.end(), name);
+    if (it == names.end())
+      L.fail(o.at("budget"), "unknown budget policy \"" + name + "\"" + suggestion(name, names));
+    g.budget = BudgetPolicy(it - names.begin());
+  }
   if (const json* t = o.get("trail")) {
     Obj to(*t, o.at("trail"), L);
     if (const json* v = to.get("length"))
@@ -1125,6 +1134,7 @@ std::vector<Group*> Effect::build(Context& ctx, std::size_t maxCapacity,
       g.setActions(eg.actions);
       if (eg.hair.enabled) g.setHair(eg.hair);
       if (eg.trail.length > 0) g.setTrail(eg.trail);
+      g.setBudgetPolicy(eg.budget);
       g.require(eg.require);
       if (space == Space::Local) g.setSpace(Space::Local);
       for (std::size_t k = 0; k < eg.emitters.size(); ++k) g.addEmitter(eg.emitters[k]);
@@ -1407,6 +1417,8 @@ ojson writeGroup(Writer w, const EffectGroup& g, const std::string& path) {
     if (g.hair.maxVertices != hairDefault.maxVertices) ho["maxVertices"] = g.hair.maxVertices;
     o["hair"] = ho.empty() ? ojson(true) : std::move(ho);
   }
+  if (g.budget != BudgetPolicy::DropNewest)
+    o["budget"] = g.budget == BudgetPolicy::DropOldest ? "dropOldest" : "scaleEmission";
   if (g.trail.length > 0) {
     const TrailOptions trailDefault;
     ojson to = ojson::object();

@@ -263,6 +263,7 @@ std::string effectSchema() {
   ojson hair = object(
       {{"enabled", {{"type", "boolean"}}}, {"every", integer(1)}, {"maxVertices", integer(2)}});
   g["hair"] = {{"anyOf", ojson::array({{{"type", "boolean"}}, hair})}};
+  g["budget"] = {{"enum", {"dropNewest", "dropOldest", "scaleEmission"}}};
   g["trail"] = object({{"length", integer(0)},
                        {"width", nonNegative},
                        {"taper", nonNegative},
@@ -435,14 +436,14 @@ std::string effectReference() {
 std::string fuzzDictionary() {
   std::set<std::string> keys = {
       // the effect, groups, fuzzy values, sampled fields: no descriptors yet
-      "version",       "name",        "description", "dt",         "seed",     "frames",
-      "space",         "groups",      "render",      "capacity",   "emitters", "primeEmitters",
-      "deathEmitters", "actions",     "mode2d",      "integrator", "substeps", "maxStep",
-      "maxDistance",   "maxSubsteps", "hair",        "enabled",    "every",    "maxVertices",
-      "require",       "type",        "center",      "spread",     "percent",  "distribution",
-      "origin",        "voxelSize",   "dims",        "data",       "vdb",      "grid",
-      "normal",        "point",       "trail",       "length",     "width",    "taper",
-      "fade"};
+      "version",       "name",        "description", "dt",         "seed",         "frames",
+      "space",         "groups",      "render",      "capacity",   "emitters",     "primeEmitters",
+      "deathEmitters", "actions",     "mode2d",      "integrator", "substeps",     "maxStep",
+      "maxDistance",   "maxSubsteps", "hair",        "enabled",    "every",        "maxVertices",
+      "require",       "type",        "center",      "spread",     "percent",      "distribution",
+      "origin",        "voxelSize",   "dims",        "data",       "vdb",          "grid",
+      "normal",        "point",       "trail",       "length",     "width",        "taper",
+      "fade",          "budget",      "dropNewest",  "dropOldest", "scaleEmission"};
   std::set<std::string> values = {"world", "local", "uniform", "normal", "inf",
                                   "-inf",  "true",  "false",   "null"};
   for (const DomainKind& k : domainKinds()) {
