@@ -136,3 +136,37 @@ TEST(Budget, BitwiseTheSameOnAnyThreadCount) {
   ASSERT_EQ(one.size(), two.size());
   EXPECT_EQ(std::memcmp(one.data(), two.data(), one.size() * sizeof(float)), 0);
 }
+
+// Many small groups and little room: the rounding's remainders are handed out, so the room
+// is used to the last particle.
+TEST(Budget, ThousandsOfSmallSharesUseAllTheRoom) {
+  Context ctx({.seed = 13, .dt = 1.0 / 30, .threads = 2});
+  for (int k = 0; k < 100; ++k) spray(ctx, "g" + std::to_string(k), 64, 100.0f, {0.0f}, 300.0);
+  ctx.setParticleBudget(50);
+  ctx.step();
+  EXPECT_EQ(live(ctx), 50u);  // 100 groups each asking 10: 50 of them get one
+  ctx.run(5);
+  EXPECT_EQ(live(ctx), 50u);
+}
+
+// A DropOldest group fed by a death emitter makes room for those newborns too: the context is
+// within its budget after every step.
+TEST(Budget, DeathEmittersNewbornsAreHeldToItToo) {
+  Context ctx({.seed = 17, .dt = 1.0 / 30, .threads = 1});
+  spray(ctx, "shells", 1000, 0.2f, {0.0f}, 600.0);
+  Group& sparks = ctx.createGroup("sparks", 20000);
+  sparks.setActions({Move{}, KillOld{}});
+  sparks.setBudgetPolicy(BudgetPolicy::DropOldest);
+  DeathEmitter de;
+  de.source = "shells";
+  de.count = 10.0f;
+  de.types[0].lifetime = 100.0f;
+  sparks.addDeathEmitter(de);
+  ctx.setParticleBudget(800);
+  for (int s = 0; s < 60; ++s) {
+    ctx.step();
+    ASSERT_LE(live(ctx), 800u) << "step " << s;
+  }
+  EXPECT_GT(sparks.stats().killedByBudget, 1000u);
+  expectAccounted(sparks);
+}

@@ -1102,8 +1102,6 @@ TEST(DeathEmitter, FollowsItsSourceByName) {
   EXPECT_GT(b.size(), fedAgain);
 }
 
-// On collision: each deflection gives `count` newborns at the point of impact, with the
-// arriving velocity inherited; bitwise on any thread count.
 // A sub-emitter on birth: each newborn of the source's emitters gives `count` newborns at the
 // place it was born, with inheritVelocity times its velocity then, whatever the source's list
 // does to it afterwards.
@@ -1155,6 +1153,8 @@ TEST(DeathEmitter, OnBirthEmitsWhereEachParticleIsBorn) {
   EXPECT_THROW(flashes.addDeathEmitter(de), InvalidArgument);
 }
 
+// On collision: each deflection gives `count` newborns at the point of impact, with the
+// arriving velocity inherited; bitwise on any thread count.
 TEST(DeathEmitter, OnCollisionEmitsAtEachImpact) {
   ContextOptions o;
   o.dt = 0.125;

@@ -61,6 +61,7 @@ struct Context::Impl {
   void runDeathEmitters(std::span<Group* const> only);
   std::size_t budget = 0;     // Context::setParticleBudget; 0: none
   bool budgetShared = false;  // the groups hold allowances from shareBudget
+  std::vector<std::pair<double, std::size_t>> leftovers;  // shareBudget's scratch
   /// Before a step: shares the room under the budget among the groups that emit (see
   /// Context::setParticleBudget), or lifts the allowances when there is no budget.
   void shareBudget();
@@ -89,13 +90,26 @@ void Context::Impl::shareBudget() {
   }
   const std::size_t room = budget > live ? budget - live : 0;
   const std::size_t over = live > budget ? live - budget : 0;
+  // Each group's exact share, rounded down; what the rounding left is handed out one by one
+  // by the largest remainders (then creation order), so that no room is left unused.
   std::size_t given = 0;
+  leftovers.clear();
+  for (std::size_t k = 0; k < groups.size(); ++k) {
+    auto& gi = *groups[k]->impl_;
+    double exact = 0.0;
+    if (emits(gi)) exact = double(room) * ((double(gi.lastDemand) + 1.0) / asked);
+    // Compared as doubles first: a share of all the room may round past it.
+    const std::size_t left = room - given;
+    gi.birthAllowance = exact >= double(left) ? left : std::uint64_t(exact);
+    given += std::size_t(gi.birthAllowance);
+    if (emits(gi)) leftovers.emplace_back(exact - double(gi.birthAllowance), k);
+  }
+  std::stable_sort(leftovers.begin(), leftovers.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  for (std::size_t r = 0; r < leftovers.size() && given < room; ++r, ++given)
+    ++groups[leftovers[r].second]->impl_->birthAllowance;
   for (auto& g : groups) {
     auto& gi = *g->impl_;
-    const std::uint64_t share =
-        emits(gi) ? std::uint64_t(double(room) * ((double(gi.lastDemand) + 1.0) / asked)) : 0;
-    gi.birthAllowance = std::min<std::uint64_t>(share, room - given);
-    given += std::size_t(gi.birthAllowance);
     // Over the budget (it was lowered): a DropOldest group gives up its share of the excess.
     const std::size_t cut =
         over > 0 ? std::size_t(std::ceil(double(over) * double(gi.size) / double(live))) : 0;
@@ -314,6 +328,8 @@ void Context::Impl::runDeathEmitters(std::span<Group* const> only) {
       const Group* source = sourceOf(gi, k);
       if (source && in(source)) detail::emitFromDeaths(gi, k, *source->impl_, options.seed);
     }
+    // Under a budget, a DropOldest group makes room for these newborns too.
+    if (gi.size > gi.keepAtMost) gi.dropOldest(gi.size - gi.keepAtMost, params());
   }
 }
 

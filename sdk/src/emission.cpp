@@ -387,8 +387,8 @@ void emitNewborns(GroupImpl& g, const StepParams& sp) {
   runs.clear();
   const std::uint64_t total = planBirths(g, sp, runs);
   g.stats.emitted += total;
-  g.lastDemand = total;
   std::size_t accepted = std::size_t(std::min<std::uint64_t>(total, g.capacity - g.size));
+  g.lastDemand = accepted;  // what a budget's share could be used for (death emitters add)
   g.stats.droppedAtCapacity += total - accepted;
   // Past the group's share of the context's budget (DropOldest makes them all and trims
   // after the step).
@@ -456,6 +456,7 @@ void emitFrom(GroupImpl& g, std::size_t k, std::span<const Event> events, std::u
     if (counter.uniform() < c - float(n)) ++n;
     g.stats.emitted += n;
     const std::uint64_t room = g.capacity - g.size;
+    g.lastDemand += std::min(n, room);
     if (n > room) {
       g.stats.droppedAtCapacity += n - room;
       n = room;

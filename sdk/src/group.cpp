@@ -547,13 +547,13 @@ BudgetPolicy Group::budgetPolicy() const {
 }
 
 void detail::GroupImpl::dropOldest(std::size_t excess, const StepParams& params) {
-  // Ids grow with birth: the smallest are the first born. Only while over budget; the
-  // scratch grows once.
+  // Ids grow with birth (modulo 2^32): the first born are the smallest id - nextId. Only
+  // while over budget; the scratch grows once.
   thread_local std::vector<std::uint64_t> byIdStore;
   auto& byId = byIdStore;
   byId.resize(size);
   const std::uint32_t* id = lanePointers().id;
-  for (std::size_t i = 0; i < size; ++i) byId[i] = std::uint64_t(id[i]) << 32 | i;
+  for (std::size_t i = 0; i < size; ++i) byId[i] = std::uint64_t(id[i] - nextId) << 32 | i;
   std::nth_element(byId.begin(), byId.begin() + std::ptrdiff_t(excess), byId.end());
   holes.clear();
   for (std::size_t k = 0; k < excess; ++k) holes.push_back(std::uint32_t(byId[k]));
@@ -571,19 +571,22 @@ Group& Group::setTrail(const TrailOptions& options) {
                 "': a trail does not run on the device yet (the CPU backend keeps it)");
   g.syncHost();
   if (options.length != g.trail.length) {
-    g.trailLanes.clear();
-    g.trailCount = detail::LaneBuffer();
-    g.trailHead = 0;
+    // Built aside and swapped in: a failed allocation leaves the old trail as it was.
+    std::vector<detail::LaneBuffer> lanes;
+    detail::LaneBuffer count;
     if (options.length > 0) {
       // Zeroed, so that no slot ever holds what the allocator left (a carry reads them all).
-      g.trailLanes.reserve(3 * std::size_t(options.length));
+      lanes.reserve(3 * std::size_t(options.length));
       for (std::size_t k = 0; k < 3 * std::size_t(options.length); ++k) {
-        g.trailLanes.emplace_back(g.capacity);
-        std::memset(g.trailLanes.back().data(), 0, g.capacity * sizeof(float));
+        lanes.emplace_back(g.capacity);
+        std::memset(lanes.back().data(), 0, g.capacity * sizeof(float));
       }
-      g.trailCount = detail::LaneBuffer(g.capacity);
-      std::memset(g.trailCount.data(), 0, g.capacity * sizeof(std::uint32_t));
+      count = detail::LaneBuffer(g.capacity);
+      std::memset(count.data(), 0, g.capacity * sizeof(std::uint32_t));
     }
+    g.trailLanes = std::move(lanes);
+    g.trailCount = std::move(count);
+    g.trailHead = 0;
     g.trail = options;
     g.startTrails(0, g.size);
   }
