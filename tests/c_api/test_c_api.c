@@ -988,8 +988,7 @@ static void test_budget(void) {
   OK(flurry_context_run(ctx, 10));
   OK(flurry_group_stats_get(g, &gs));
   CHECK(gs.dropped_at_budget == 100 && gs.killed_by_budget == 75);
-  FAILS(flurry_group_set_budget_policy(g, (flurry_budget_policy)9), FLURRY_ERROR_INVALID_ARGUMENT,
-        "policy");
+  FAILS(flurry_group_set_budget_policy(g, 9), FLURRY_ERROR_INVALID_ARGUMENT, "policy");
   FAILS(flurry_context_set_particle_budget(NULL, 1), FLURRY_ERROR_NULL_ARGUMENT, "ctx");
   OK(flurry_context_destroy(ctx));
   OK(flurry_effect_destroy(fx));

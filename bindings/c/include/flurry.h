@@ -186,8 +186,9 @@ typedef enum flurry_budget_policy {
  * step among the groups that emit (flurry::Context::setParticleBudget). CPU backend only. */
 FLURRY_C_EXPORT flurry_status flurry_context_set_particle_budget(flurry_context* ctx,
                                                                  size_t particles);
-FLURRY_C_EXPORT flurry_status flurry_group_set_budget_policy(flurry_group* group,
-                                                             flurry_budget_policy policy);
+/** `policy`: a flurry_budget_policy (an int, so that a value outside it is an error, not
+ * undefined behaviour). */
+FLURRY_C_EXPORT flurry_status flurry_group_set_budget_policy(flurry_group* group, int policy);
 /** Why FLURRY_BACKEND_AUTO took the CPU ("" when it did not). */
 FLURRY_C_EXPORT flurry_status flurry_context_backend_fallback(const flurry_context* ctx,
                                                               const char** why);

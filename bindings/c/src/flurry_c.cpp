@@ -469,7 +469,7 @@ flurry_status flurry_context_set_particle_budget(flurry_context* ctx, size_t par
   });
 }
 
-flurry_status flurry_group_set_budget_policy(flurry_group* g, flurry_budget_policy policy) {
+flurry_status flurry_group_set_budget_policy(flurry_group* g, int policy) {
   return guard([&] {
     need(g, "group");
     static_assert(int(flurry::BudgetPolicy::DropOldest) == FLURRY_BUDGET_DROP_OLDEST &&
