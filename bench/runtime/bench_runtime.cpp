@@ -8,8 +8,8 @@
 // (one command line).
 //
 // After the runs it prints the ratio of the medians, per thread count, what bounds every step
-// cost, and what a recorded death or collision event costs (Deaths, Collisions: recording on
-// against off).
+// cost, what a recorded death or collision event costs (Deaths, Collisions: recording on
+// against off), and what a trail of 8 positions costs a particle (Trails).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -171,6 +171,29 @@ void Collisions(benchmark::State& state) {
   if (state.range(0) != 0) collisionsPerStep_[state.range(1)] = events / double(state.iterations());
 }
 
+std::map<std::int64_t, double> trailParticles_;  // Trails' mean live particles, by threads
+
+// Trails: the same 1M sparks keeping their last 8 positions (range 0 = 8) or none (0): the
+// difference over the live particles is a trail's cost per particle and step (the ring's copy
+// and, in compaction, its 24 lanes moved).
+void Trails(benchmark::State& state) {
+  ContextOptions o;
+  o.threads = unsigned(state.range(1));
+  Context ctx(o);
+  const Effect effect = parseEffect(sparks(kPerInstance * 10000));
+  EffectInstance one = effect.instantiate(ctx, "all");
+  Group& g = *one.groups()[0];
+  g.setTrail({.length = std::uint32_t(state.range(0))});
+  ctx.run(45);
+  double live = 0;
+  for (auto _ : state) {
+    ctx.step();
+    live += double(g.size());
+  }
+  state.counters["live"] = live / double(state.iterations());
+  if (state.range(0) != 0) trailParticles_[state.range(1)] = live / double(state.iterations());
+}
+
 void args(benchmark::internal::Benchmark* b) {
   const auto cores = int(std::max(1u, std::thread::hardware_concurrency()));
   for (int t : {1, cores}) {
@@ -198,6 +221,15 @@ BENCHMARK(Collisions)->Apply([](benchmark::internal::Benchmark* b) {
     if (cores == 1) break;
   }
   b->ArgNames({"record", "threads"})->Unit(benchmark::kMillisecond)->UseRealTime();
+});
+
+BENCHMARK(Trails)->Apply([](benchmark::internal::Benchmark* b) {
+  const auto cores = int(std::max(1u, std::thread::hardware_concurrency()));
+  for (int t : {1, cores}) {
+    for (int length : {0, 8}) b->Args({length, t});
+    if (cores == 1) break;
+  }
+  b->ArgNames({"length", "threads"})->Unit(benchmark::kMillisecond)->UseRealTime();
 });
 
 // Prints the ratio of the medians (or single runs) of the two, per thread count.
@@ -257,6 +289,18 @@ class RatioReporter : public benchmark::ConsoleReporter {
           "  collision events, threads:%s: %.0f a step, recorded %.3f ms, off %.3f ms: "
           "%.1f ns an event\n",
           threads.c_str(), hits->second, ms, off->second, (ms - off->second) * 1e6 / hits->second);
+    }
+    for (const auto& [name, ms] : ms_) {
+      const std::string on = "Trails/length:8/threads:";
+      if (name.rfind(on, 0) != 0) continue;
+      const std::string threads = name.substr(on.size());
+      const auto off = ms_.find("Trails/length:0/threads:" + threads);
+      const auto live = trailParticles_.find(std::stoll(threads));
+      if (off == ms_.end() || live == trailParticles_.end() || live->second <= 0) continue;
+      std::printf(
+          "  trails of 8, threads:%s: %.0f live, %.3f ms a step, none %.3f ms: %.2f ns a "
+          "particle\n",
+          threads.c_str(), live->second, ms, off->second, (ms - off->second) * 1e6 / live->second);
     }
   }
 
