@@ -182,9 +182,21 @@ void GroupImpl::startTrails(std::size_t from, std::size_t to) {
   std::fill(trailCount.u() + from, trailCount.u() + to, 1u);
 }
 
+std::uint32_t* GroupImpl::nextTrailSlot(float** slot) {
+  if (trail.length == 0) return nullptr;
+  const std::size_t next = 3 * std::size_t((trailHead + 1) % trail.length);
+  for (std::size_t c = 0; c < 3; ++c) slot[c] = trailLanes[next + c].f();
+  trailRecorded = true;
+  return trailCount.u();
+}
+
 void GroupImpl::recordTrails(ThreadPool& pool) {
   if (trail.length == 0) return;
   trailHead = (trailHead + 1) % trail.length;
+  if (trailRecorded) {  // by the fused pass, block by block
+    trailRecorded = false;
+    return;
+  }
   const Lanes L = lanePointers();
   float* const slot[3] = {trailLanes[3 * trailHead].f(), trailLanes[3 * trailHead + 1].f(),
                           trailLanes[3 * trailHead + 2].f()};

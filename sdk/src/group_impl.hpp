@@ -213,11 +213,17 @@ struct GroupImpl {
   std::vector<LaneBuffer> trailLanes;
   LaneBuffer trailCount;  ///< per particle: the slots its trail fills, from trailHead back
   std::uint32_t trailHead = 0;
+  /// The CPU fused pass wrote this step's positions into the ring's next slot itself.
+  bool trailRecorded = false;
   /// Particles [from, to) start a trail where they are (newborns, added, alive when the
   /// trail began): one point, in slot trailHead.
   void startTrails(std::size_t from, std::size_t to);
   /// After a step: the ring turns and every live particle's position goes into the new head.
   void recordTrails(ThreadPool& pool);
+  /// For the fused pass: the ring's next slot (x, y, z into `slot`) and the counts, or null
+  /// without a trail; marks the step's positions as recorded by the pass. Out of line for
+  /// the reason of assignFill.
+  std::uint32_t* nextTrailSlot(float** slot);
   std::array<std::array<LaneBuffer, 4>, std::size_t(Attribute::Count)> lanes;
   GroupStats stats;
   std::uint32_t nextId = 0;

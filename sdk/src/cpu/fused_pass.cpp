@@ -479,6 +479,7 @@ std::uint32_t collectDead(GroupImpl& g, std::size_t base, std::size_t n,
 
 void actFusedImpl(GroupImpl& g, const StepParams& sp) {
   g.holes.clear();
+  g.trailRecorded = false;  // until the pass below records them
   const std::size_t n = g.size;
   // At most n die: room for all of them, grown geometrically, so that a step that kills
   // more than any before does not allocate.
@@ -561,6 +562,11 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
   const bool cull = sp.cull && plan.list.cullable && lanes.v[0];
   const bool logHits = g.collisionRoom() > 0 && lanes.v[0];
   if (logHits) g.beginCollisions(blocks);
+  // Trails: each block's positions go into the ring's next slot while the block is in cache
+  // (recordTrails then only turns the ring; compaction moves the slot with the rest).
+  float* trailSlot[3] = {};
+  std::uint32_t* const trailCount = sp.fused ? g.nextTrailSlot(trailSlot) : nullptr;
+  const std::uint32_t trailMost = g.trail.length;
   if (sp.fused) {
     sp.pool->parallelFor(tasks, [&](std::size_t t) {
       // The dead flags, all zero between blocks (collectDead clears what it takes); filled
@@ -593,6 +599,11 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
           g.culledCount[b] += culler.culled;
         }
         guardFinite(blockLanes, m, dead.data(), plan.list.guardVelocity);
+        if (trailCount) {
+          for (int c = 0; c < 3; ++c) std::copy_n(blockLanes.p[c], m, trailSlot[c] + first);
+          std::uint32_t* __restrict count = trailCount + first;
+          for (std::size_t i = 0; i < m; ++i) count[i] = std::min(count[i] + 1u, trailMost);
+        }
         if (bounds) liveBounds(blockLanes, m, dead.data(), g.blockBounds.data() + 6 * b);
         g.deadCount[b] = collectDead(g, first, m, dead.data());
         tally(b, g.deadCount[b]);
