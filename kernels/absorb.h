@@ -31,11 +31,36 @@ FL_INLINE uint fl_dead_sink_motion(int now, int next, int enter, uint code, uint
   return fl_dead_if(k, code, dead);
 }
 
+/* Sink (Hit): the coming Move's path crosses the piece's plane at h (fl_path_crosses), at
+ * `distance` from the piece: on it, within the rounding of the crossing, it is absorbed. */
+FL_INLINE uint fl_dead_sink_hit(float distance, float3 h, uint code, uint dead) {
+  return fl_dead_if(distance <= 1e-5f * (1.0f + fl_lengthv(h)), code, dead);
+}
+
+/* Block: a particle inside the region is hidden (the list's first blocker starts from 1). */
+FL_INLINE uint fl_visible_after_block(int inside, uint visible) {
+  return visible & (1u - (uint)(inside != 0));
+}
+
 /* The particles an absorber with a pass-through fraction kills survive if this holds: u is
- * the first word of their pass-through Philox block (kernels.hpp sinkPasses), as a uniform in
- * [0, 1). */
+ * the first word of their pass-through Philox block, as a uniform in [0, 1). */
 FL_INLINE int fl_passes(uint u, float fraction) {
-  return (float)(u >> 8) * (1.0f / 16777216.0f) < fraction;
+  return fl_uniform_bits(u) < fraction;
+}
+
+/* The stream of the pass-through draws (flurry::stream::kPassThrough). */
+#define FL_STREAM_PASS_THROUGH 0xFFFF0002u
+
+/* After an absorber with action code `code` and a pass-through fraction: the particles it
+ * took pass if one Philox word of (id, key, FL_STREAM_PASS_THROUGH, 0) says so. The same word
+ * every step, so the decision is made once per particle and absorber (key: the group's stream
+ * base + the absorber's index in the list). */
+FL_INLINE uint fl_dead_after_pass(uint dead, uint code, uint id, uint key, uint seedLo,
+                                  uint seedHi, float fraction) {
+  uint w0 = id, w1 = key, w2 = FL_STREAM_PASS_THROUGH, w3 = 0u;
+  if (dead != code) return dead;
+  fl_philox_rounds(&w0, &w1, &w2, &w3, seedLo, seedHi);
+  return fl_passes(w0, fraction) ? 0u : dead;
 }
 
 #endif /* FLURRY_KERNELS_ABSORB_H */

@@ -108,7 +108,7 @@ FL_INLINE float fl_cull_gap(const float* box, __global const float* r) {
 
 /* Whether no particle of the work-group can reach the action's reach box r (FL_REACH_FLOATS):
  * the bounds, widened by grow on every side, are apart from it by more than the rounding of
- * the action's own tests. The CPU's Culler::apart, the same margin. */
+ * the action's own tests (math.h, as the CPU's Culler::apart). */
 FL_INLINE uint fl_cull_apart(const float* box, float grow, __global const float* r) {
   float lo[3], hi[3], scale = 0.0f;
   for (int c = 0; c < 3; ++c) {
@@ -117,9 +117,5 @@ FL_INLINE uint fl_cull_apart(const float* box, float grow, __global const float*
     scale = fmax(scale, fmax(fabs(lo[c]), fabs(hi[c])));
   }
   if (!(scale < INFINITY)) return 0u; /* unbounded (or empty, or NaN): the bounds say nothing */
-  const float s = scale + r[6];
-  const float margin = 1e-4f * (1.0f + s) + r[7] * s * s;
-  int out = 0;
-  for (int c = 0; c < 3; ++c) out |= (lo[c] - margin > r[3 + c]) | (hi[c] + margin < r[c]);
-  return out ? 1u : 0u;
+  return fl_reach_apart(lo, hi, scale, r, r + 3, r[6], r[7]) ? 1u : 0u;
 }

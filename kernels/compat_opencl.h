@@ -12,5 +12,7 @@
 #define make_float3(x, y, z) ((float3)((x), (y), (z)))
 /* A pointer into a buffer the host wrote (a group's lanes, its start-of-step snapshot). */
 #define FL_GLOBAL __global
+/* Unrolls the loop that follows (Philox's rounds). */
+#define FL_UNROLL _Pragma("unroll")
 
 #endif /* FLURRY_KERNELS_COMPAT_OPENCL_H */

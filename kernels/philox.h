@@ -1,28 +1,47 @@
-/* Philox4x32-10 (Salmon et al., SC'11) in OpenCL C: the same function as flurry::Philox4x32
- * and flurry::Random in <flurry/random.hpp>, so the two backends draw the same numbers for
- * the same (seed, id, step, stream). */
+/* Philox4x32-10 (Salmon et al., SC'11), written once for both backends in the kernels' shared
+ * C subset (compat_opencl.h, sdk/src/kernel_compat.hpp). The CPU's flurry::Philox4x32 and
+ * flurry::Random (sdk/src/domain.cpp) compute these rounds, its vectorised batches
+ * (sampling.cpp) use these constants, and the device's streams below call them: both backends
+ * draw the same numbers for the same (seed, id, step, stream). */
 #ifndef FLURRY_KERNELS_PHILOX_H
 #define FLURRY_KERNELS_PHILOX_H
 
-FL_INLINE uint4 fl_philox(uint4 c, uint k0, uint k1) {
-  /* Defined by the generated source from flurry::Philox4x32 (codegen.cpp). */
-  const uint M0 = FL_PHILOX_M0, M1 = FL_PHILOX_M1;
-  const uint W0 = FL_PHILOX_W0, W1 = FL_PHILOX_W1;
-  uint c0 = c.x, c1 = c.y, c2 = c.z, c3 = c.w;
-  /* 64-bit products rather than mul_hi: PoCL's mul_hi made this ~10x slower. */
-#pragma unroll
+/* The round multipliers and the key's increments (a Weyl sequence). */
+#define FL_PHILOX_M0 0xD2511F53u
+#define FL_PHILOX_M1 0xCD9E8D57u
+#define FL_PHILOX_W0 0x9E3779B9u
+#define FL_PHILOX_W1 0xBB67AE85u
+
+/* The ten rounds on the counter (c0, c1, c2, c3) with the key (k0, k1), in place. 64-bit
+ * products rather than mul_hi: PoCL's mul_hi made this ~10x slower. */
+FL_INLINE void fl_philox_rounds(uint* c0, uint* c1, uint* c2, uint* c3, uint k0, uint k1) {
+  uint a = *c0, b = *c1, c = *c2, d = *c3;
+  FL_UNROLL
   for (int r = 0; r < 10; ++r) {
-    const ulong p0 = (ulong)M0 * c0, p1 = (ulong)M1 * c2;
-    const uint hi0 = (uint)(p0 >> 32), lo0 = (uint)p0;
-    const uint hi1 = (uint)(p1 >> 32), lo1 = (uint)p1;
-    c0 = hi1 ^ c1 ^ k0;
-    c1 = lo1;
-    c2 = hi0 ^ c3 ^ k1;
-    c3 = lo0;
-    k0 += W0;
-    k1 += W1;
+    const ulong p0 = (ulong)FL_PHILOX_M0 * a, p1 = (ulong)FL_PHILOX_M1 * c;
+    a = (uint)(p1 >> 32) ^ b ^ k0;
+    b = (uint)p1;
+    c = (uint)(p0 >> 32) ^ d ^ k1;
+    d = (uint)p0;
+    k0 += FL_PHILOX_W0;
+    k1 += FL_PHILOX_W1;
   }
-  return (uint4)(c0, c1, c2, c3);
+  *c0 = a;
+  *c1 = b;
+  *c2 = c;
+  *c3 = d;
+}
+
+/* 32 random bits as a float in [0, 1) with 24 bits of resolution (flurry::uniformFloat). */
+FL_INLINE float fl_uniform_bits(uint u) {
+  return (float)(u >> 8) * (1.0f / 16777216.0f);
+}
+
+#ifdef __OPENCL_VERSION__
+FL_INLINE uint4 fl_philox(uint4 c, uint k0, uint k1) {
+  uint a = c.x, b = c.y, d = c.z, e = c.w;
+  fl_philox_rounds(&a, &b, &d, &e, k0, k1);
+  return (uint4)(a, b, d, e);
 }
 
 /* One particle's stream, drawn four words at a time (flurry::Random). */
@@ -56,7 +75,7 @@ FL_INLINE uint fl_bits(FlRandom* r) {
   return w;
 }
 
-/* Uniform in [0, 1) with 24 bits (flurry::uniformFloat). */
-FL_INLINE float fl_uniform(FlRandom* r) { return (float)(fl_bits(r) >> 8) * (1.0f / 16777216.0f); }
+FL_INLINE float fl_uniform(FlRandom* r) { return fl_uniform_bits(fl_bits(r)); }
+#endif /* __OPENCL_VERSION__ */
 
 #endif /* FLURRY_KERNELS_PHILOX_H */

@@ -155,10 +155,6 @@ FL_INLINE void fl_bounce_guard(__global const FlActionParams* a, uint kind, int 
 
 /* ---- Sink, SinkVelocity, Block ----------------------------------------------------------- */
 
-FL_INLINE void fl_kill(uint code, uint* dead) {
-  *dead = *dead != 0u ? *dead : code;
-}
-
 /* Inside or Outside (absorb.h). */
 FL_INLINE void fl_sink(__global const FlActionParams* a, uint kind, int killInside, float x,
                        float y, float z, uint code, uint* dead, __global const float* shapes) {
@@ -184,25 +180,20 @@ FL_INLINE void fl_sink_hit(__global const FlActionParams* a, uint kind, float dt
   if (!fl_path_crosses(p, p + v * dt, fl_closest(d, kind, p, shapes),
                        fl_normal_leaf(d, kind, p, shapes), &h))
     return;
-  if (fl_surf_distance(a, kind, h, shapes) <= 1e-5f * (1.0f + fl_lengthv(h))) fl_kill(code, dead);
+  *dead = fl_dead_sink_hit(fl_surf_distance(a, kind, h, shapes), h, code, *dead);
 }
 
-/* The particles this absorber just took survive if they pass it, decided once per particle
- * and absorber (actions_more.hpp passThrough, kernels.hpp sinkPasses): key is the group's
- * stream base + the Sink's index; the stream is flurry::stream::kPassThrough. f[0] passThrough. */
+/* The particles this absorber just took survive if they pass it (absorb.h). f[0] passThrough. */
 FL_INLINE void fl_sink_pass(__global const FlActionParams* a, uint id, uint code, uint* dead,
                             uint seedLo, uint seedHi, uint key) {
-  if (*dead != code) return;
-  const uint4 w = fl_philox((uint4)(id, key, 0xFFFF0002u, 0u), seedLo, seedHi);
-  if (fl_passes(w.x, a->f[0])) *dead = 0u;
+  *dead = fl_dead_after_pass(*dead, code, id, key, seedLo, seedHi, a->f[0]);
 }
 
-/* Hides the particles inside the region (actions_more.hpp apply(Block)); the list's first
- * blocker has set vis to 1 before. */
+/* Hides the particles inside the region (absorb.h); the list's first blocker has set vis to 1
+ * before. */
 FL_INLINE void fl_block(__global const FlActionParams* a, uint kind, float x, float y, float z,
                         uint* vis, __global const float* shapes) {
-  const uint in = fl_inside_any(a->domain.v, kind, x, y, z, shapes) ? 1u : 0u;
-  *vis &= 1u - in;
+  *vis = fl_visible_after_block(fl_inside_any(a->domain.v, kind, x, y, z, shapes), *vis);
 }
 
 /* ---- Avoid, Constrain2D ------------------------------------------------------------------ */

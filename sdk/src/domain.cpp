@@ -416,6 +416,17 @@ float detail::standardNormal(float ua, float ub) noexcept {
   return kern::fl_normal_from(ua, ub);
 }
 
+Philox4x32::Block Philox4x32::generate(std::uint32_t c0, std::uint32_t c1, std::uint32_t c2,
+                                       std::uint32_t c3, std::uint32_t k0,
+                                       std::uint32_t k1) noexcept {
+  kern::fl_philox_rounds(&c0, &c1, &c2, &c3, k0, k1);
+  return {{c0, c1, c2, c3}};
+}
+
+float uniformFloat(std::uint32_t bits) noexcept {
+  return kern::fl_uniform_bits(bits);
+}
+
 Vec3 Domain::sample(Random& rng) const {
   // A batch of one through the emitters' batch samplers: the same formulas either way.
   float u[detail::kMaxDomainDraws];

@@ -19,12 +19,16 @@
 #ifndef FL_GLOBAL
 #define FL_GLOBAL  // the device's __global: one address space here
 #endif
+#ifndef FL_UNROLL
+#define FL_UNROLL  // the device's unroll pragma (GCC is left to decide)
+#endif
 
 namespace flurry::detail {
 inline namespace FLURRY_ISA_NAMESPACE {
 namespace kernel {
 
 using uint = std::uint32_t;
+using ulong = std::uint64_t;
 using fl_real = double;  // the device's too where it has doubles (domain.cl)
 using float3 = Vec3;
 inline float3 make_float3(float x, float y, float z) {
@@ -47,6 +51,7 @@ using std::sin;
 using std::sqrt;
 
 #include "../../kernels/math.h"
+#include "../../kernels/philox.h"
 
 }  // namespace kernel
 }  // namespace FLURRY_ISA_NAMESPACE

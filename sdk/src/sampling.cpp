@@ -204,7 +204,7 @@ void sampleBatch(const Fuzzy& f, const float* const* u, std::size_t n, float* ou
 namespace {
 
 // Philox4x32-10 on W counters at once, for this translation unit's instruction set (it is
-// compiled once per set, sdk/CMakeLists.txt): the same function as Philox4x32::generate, bit
+// compiled once per set, sdk/CMakeLists.txt): the same function as kernels/philox.h, bit
 // for bit. GCC vectorises the scalar loop but packs the 32x32->64-bit products with
 // cross-lane shuffles. Here the even and the odd lanes of a vector run apart, each word in the
 // low half of a 64-bit slot: an unsigned 32-bit multiply (which reads only the low halves)
@@ -288,8 +288,8 @@ struct Lanes {
 };
 #endif
 
-constexpr std::uint32_t kM0 = Philox4x32::kM0, kM1 = Philox4x32::kM1;
-constexpr std::uint32_t kW0 = Philox4x32::kW0, kW1 = Philox4x32::kW1;
+constexpr std::uint32_t kM0 = FL_PHILOX_M0, kM1 = FL_PHILOX_M1;  // kernels/philox.h
+constexpr std::uint32_t kW0 = FL_PHILOX_W0, kW1 = FL_PHILOX_W1;
 
 // Counter word 0 of particle i: firstId + i, or id[i].
 struct Consecutive {
@@ -389,11 +389,12 @@ void philoxUniforms(Ids ids, std::uint32_t c1, std::uint32_t c2, std::uint32_t c
                     std::uint32_t k1, std::size_t n, float* __restrict u0, float* __restrict u1,
                     float* __restrict u2, float* __restrict u3) {
   for (std::size_t i = 0; i < n; ++i) {
-    const Philox4x32::Block b = Philox4x32::generate(ids[i], c1, c2, c3, k0, k1);
-    u0[i] = uniformFloat(b.v[0]);
-    u1[i] = uniformFloat(b.v[1]);
-    u2[i] = uniformFloat(b.v[2]);
-    u3[i] = uniformFloat(b.v[3]);
+    std::uint32_t w0 = ids[i], w1 = c1, w2 = c2, w3 = c3;
+    kernel::fl_philox_rounds(&w0, &w1, &w2, &w3, k0, k1);
+    u0[i] = kernel::fl_uniform_bits(w0);
+    u1[i] = kernel::fl_uniform_bits(w1);
+    u2[i] = kernel::fl_uniform_bits(w2);
+    u3[i] = kernel::fl_uniform_bits(w3);
   }
 }
 #endif

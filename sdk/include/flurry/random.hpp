@@ -2,7 +2,7 @@
 //
 // A draw is a pure function of (seed, counter), so every particle has its own stream keyed
 // by (particle id, step, stream) and a run is the same on 1 thread or 16, and on the CPU
-// and OpenCL backends (kernels/philox.h computes the identical function).
+// and OpenCL backends (both compute kernels/philox.h).
 #pragma once
 
 #include <cmath>
@@ -12,36 +12,16 @@ namespace flurry {
 
 /// One Philox4x32-10 block: 4 random 32-bit words for a 128-bit counter and 64-bit key.
 struct Philox4x32 {
-  /// The round multipliers and the key's increments (a Weyl sequence), the generator's one
-  /// definition: the CPU's vectorised batches use these, and the OpenCL programs are given
-  /// them as macros (FL_PHILOX_M0 ...) when their source is generated.
-  static constexpr std::uint32_t kM0 = 0xD2511F53u, kM1 = 0xCD9E8D57u;
-  static constexpr std::uint32_t kW0 = 0x9E3779B9u, kW1 = 0xBB67AE85u;
   struct Block {
     std::uint32_t v[4];
   };
-  static inline Block generate(std::uint32_t c0, std::uint32_t c1, std::uint32_t c2,
-                               std::uint32_t c3, std::uint32_t k0, std::uint32_t k1) noexcept {
-    for (int r = 0; r < 10; ++r) {
-      const std::uint64_t p0 = std::uint64_t(kM0) * c0;
-      const std::uint64_t p1 = std::uint64_t(kM1) * c2;
-      const std::uint32_t hi0 = std::uint32_t(p0 >> 32), lo0 = std::uint32_t(p0);
-      const std::uint32_t hi1 = std::uint32_t(p1 >> 32), lo1 = std::uint32_t(p1);
-      c0 = hi1 ^ c1 ^ k0;
-      c1 = lo1;
-      c2 = hi0 ^ c3 ^ k1;
-      c3 = lo0;
-      k0 += kW0;
-      k1 += kW1;
-    }
-    return {{c0, c1, c2, c3}};
-  }
+  /// The rounds are written once for both backends (kernels/philox.h, with the constants).
+  static Block generate(std::uint32_t c0, std::uint32_t c1, std::uint32_t c2, std::uint32_t c3,
+                        std::uint32_t k0, std::uint32_t k1) noexcept;
 };
 
 /// Maps 32 random bits to a float in [0, 1) with 24 bits of resolution.
-inline float uniformFloat(std::uint32_t bits) noexcept {
-  return float(bits >> 8) * (1.0f / 16777216.0f);
-}
+float uniformFloat(std::uint32_t bits) noexcept;
 
 namespace detail {
 /// A standard normal from two uniforms in [0, 1) (kernels/domain.h fl_normal_from, the

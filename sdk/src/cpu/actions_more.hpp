@@ -59,19 +59,19 @@ inline void onLocals(float* const* lane, std::size_t i, F f) {
   lane[1][i] = y;
   lane[2][i] = z;
 }
-inline void kill(const BlockContext& c, std::size_t i) {
-  if (c.dead[i] == 0u) c.dead[i] = c.action + 1;
-}
 // The particles this absorber would kill survive if they pass it: decided once per particle
-// and absorber (sinkPasses), so a fraction passThrough of them passes in every mode.
+// and absorber (kernels/absorb.h), so a fraction passThrough of them passes in every mode.
 inline void passThrough(const BlockContext& c, const Lanes& L, std::size_t n, float fraction) {
+  static_assert(stream::kPassThrough == FL_STREAM_PASS_THROUGH);
   if (fraction <= 0.0f) return;
   const std::uint32_t code = c.action + 1;
   // The group's part of the stream base, without the sub-step's (fused_pass.cpp: s << 8).
-  const std::uint32_t group = c.streamBase & 0xFFFF0000u;
+  const std::uint32_t key = (c.streamBase & 0xFFFF0000u) + c.action;
+  const auto lo = std::uint32_t(c.seed), hi = std::uint32_t(c.seed >> 32);
+  // Drawn for the particles taken only (a branch, not a vectorised draw for every particle).
   for (std::size_t i = 0; i < n; ++i)
-    if (c.dead[i] == code && sinkPasses(c.seed, L.id[i], group + c.action, fraction))
-      c.dead[i] = 0u;
+    if (c.dead[i] == code) [[unlikely]]
+      c.dead[i] = kernel::fl_dead_after_pass(code, code, L.id[i], key, lo, hi, fraction);
 }
 inline Random actionRandom(const BlockContext& c, const Lanes& L, std::size_t i) {
   return Random(c.seed, L.id[i], c.step, c.streamBase + c.action);
@@ -167,7 +167,7 @@ inline void apply(const Sink& a, const Lanes& L, std::size_t n, const BlockConte
       if (!kernel::fl_path_crosses(p, p + v * c.dtAt(i), a.region.closestPoint(p),
                                    a.region.normal(p), &h))
         continue;
-      if (a.region.distance(h) <= 1e-5f * (1.0f + glm::length(h))) kill(c, i);
+      c.dead[i] = kernel::fl_dead_sink_hit(a.region.distance(h), h, c.action + 1, c.dead[i]);
     }
   }
   passThrough(c, L, n, a.passThrough);
@@ -190,10 +190,9 @@ inline void apply(const Block& a, const Lanes& L, std::size_t n, const BlockCont
         const float* __restrict px = L.p[0];
         const float* __restrict py = L.p[1];
         const float* __restrict pz = L.p[2];
-        for (std::size_t i = 0; i < n; ++i) {
-          const std::uint32_t in = detail::inside(shape, Vec3(px[i], py[i], pz[i])) ? 1u : 0u;
-          vis[i] &= 1u - in;
-        }
+        for (std::size_t i = 0; i < n; ++i)
+          vis[i] = kernel::fl_visible_after_block(detail::inside(shape, Vec3(px[i], py[i], pz[i])),
+                                                  vis[i]);
       },
       a.region.shape());
 }

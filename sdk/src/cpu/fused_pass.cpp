@@ -202,15 +202,9 @@ struct Culler {
     valid = true;
   }
 
-  // Whether no particle of the block can reach `r`: the boxes are apart by more than the
-  // rounding of the action's own tests, which is far below this margin.
+  // Whether no particle of the block can reach `r` (kernels/math.h, the device's test too).
   bool apart(const ActionPlan::Reach& r) const {
-    if (!finite) return false;
-    const float s = scale + r.scale;
-    const float margin = 1e-4f * (1.0f + s) + r.quadratic * s * s;
-    bool out = false;
-    for (int c = 0; c < 3; ++c) out |= (lo[c] - margin > r.hi[c]) || (hi[c] + margin < r.lo[c]);
-    return out;
+    return finite && kernel::fl_reach_apart(lo, hi, scale, r.lo, r.hi, r.scale, r.quadratic);
   }
 };
 

@@ -164,10 +164,8 @@ inline void integrate(Integrator integrator, const std::vector<Action>& acts,
     case Integrator::ExplicitEuler: {
       evaluate(L.p, L.v, a0, t);
       for (int d = 0; d < 3; ++d)
-        for (std::size_t i = 0; i < n; ++i) {
-          L.p[d][i] += L.v[d][i] * dt[i];  // with the velocity at the start of the step
-          L.v[d][i] += a0[d][i] * dt[i];
-        }
+        for (std::size_t i = 0; i < n; ++i)
+          kernel::fl_euler_explicit(a0[d][i], dt[i], &L.p[d][i], &L.v[d][i]);
       break;
     }
     case Integrator::VelocityVerlet: {
@@ -177,16 +175,12 @@ inline void integrate(Integrator integrator, const std::vector<Action>& acts,
       arrays3(v1);
       evaluate(L.p, L.v, a0, t);
       for (int d = 0; d < 3; ++d)
-        for (std::size_t i = 0; i < n; ++i) {
-          p1[d][i] = L.p[d][i] + L.v[d][i] * dt[i] + 0.5f * a0[d][i] * dt[i] * dt[i];
-          v1[d][i] = L.v[d][i] + a0[d][i] * dt[i];  // predicted, for velocity-dependent forces
-        }
+        for (std::size_t i = 0; i < n; ++i)
+          kernel::fl_verlet_predict(L.p[d][i], L.v[d][i], a0[d][i], dt[i], &p1[d][i], &v1[d][i]);
       evaluate(p1, v1, a1, t + h0);
       for (int d = 0; d < 3; ++d)
-        for (std::size_t i = 0; i < n; ++i) {
-          L.p[d][i] = p1[d][i];
-          L.v[d][i] += 0.5f * (a0[d][i] + a1[d][i]) * dt[i];
-        }
+        for (std::size_t i = 0; i < n; ++i)
+          kernel::fl_verlet_finish(p1[d][i], a0[d][i], a1[d][i], dt[i], &L.p[d][i], &L.v[d][i]);
       break;
     }
     case Integrator::RK4: {
@@ -208,20 +202,13 @@ inline void integrate(Integrator integrator, const std::vector<Action>& acts,
         evaluate(ps, vs, a1, t + h[k] * h0);
         const float hn = k < 3 ? h[k + 1] : 0.0f;
         for (int d = 0; d < 3; ++d)
-          for (std::size_t i = 0; i < n; ++i) {
-            const float kp = vs[d][i], kv = a1[d][i];
-            sp[d][i] += w[k] * kp;
-            sv[d][i] += w[k] * kv;
-            const float next = hn * dt[i];     // 0 after the last stage, as h·dt was
-            ps[d][i] = L.p[d][i] + kp * next;  // the next stage's state
-            vs[d][i] = L.v[d][i] + kv * next;
-          }
+          for (std::size_t i = 0; i < n; ++i)
+            kernel::fl_rk4_stage(L.p[d][i], L.v[d][i], vs[d][i], a1[d][i], w[k], hn * dt[i],
+                                 &sp[d][i], &sv[d][i], &ps[d][i], &vs[d][i]);
       }
       for (int d = 0; d < 3; ++d)
-        for (std::size_t i = 0; i < n; ++i) {
-          L.p[d][i] += sp[d][i] * (dt[i] / 6.0f);
-          L.v[d][i] += sv[d][i] * (dt[i] / 6.0f);
-        }
+        for (std::size_t i = 0; i < n; ++i)
+          kernel::fl_rk4_finish(sp[d][i], sv[d][i], dt[i], &L.p[d][i], &L.v[d][i]);
       break;
     }
     case Integrator::Exact: {
@@ -243,17 +230,8 @@ inline void integrate(Integrator integrator, const std::vector<Action>& acts,
         }
       }
       for (int d = 0; d < 3; ++d)
-        for (std::size_t i = 0; i < n; ++i) {
-          const float g = a0[d][i], k = a1[d][i], v0 = L.v[d][i], h = dt[i];
-          if (k > 0.0f) {
-            const float e = std::exp(-k * h), term = g / k;
-            L.p[d][i] += term * h + (v0 - term) * (1.0f - e) / k;
-            L.v[d][i] = term + (v0 - term) * e;
-          } else {
-            L.p[d][i] += v0 * h + 0.5f * g * h * h;
-            L.v[d][i] = v0 + g * h;
-          }
-        }
+        for (std::size_t i = 0; i < n; ++i)
+          kernel::fl_exact_step(a0[d][i], a1[d][i], dt[i], &L.p[d][i], &L.v[d][i]);
       break;
     }
     case Integrator::SemiImplicitEuler:

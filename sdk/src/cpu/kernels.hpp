@@ -25,6 +25,7 @@ namespace kernel {
 #include "../../kernels/absorb.h"
 #include "../../kernels/deflect.h"
 #include "../../kernels/forces.h"
+#include "../../kernels/integrate.h"
 }  // namespace kernel
 }  // namespace FLURRY_ISA_NAMESPACE
 }  // namespace flurry::detail
@@ -189,16 +190,6 @@ inline void sinkLoop(const Shape& shape, const float* __restrict px, const float
     const int in = detail::inside(shape, Vec3(px[i], py[i], pz[i]));
     dead[i] = kernel::fl_dead_sink(in, killInside, code, dead[i]);
   }
-}
-
-/// Whether particle `id` passes the absorber `key` (the group's stream base + the Sink's index
-/// in the list): one Philox word of (id, key, stream::kPassThrough, 0), the same for every
-/// step, so the decision is made once per particle and absorber. surfaces.cl fl_sink_pass
-/// is the same function.
-inline bool sinkPasses(std::uint64_t seed, std::uint32_t id, std::uint32_t key, float fraction) {
-  const auto b = Philox4x32::generate(id, key, stream::kPassThrough, 0u, std::uint32_t(seed),
-                                      std::uint32_t(seed >> 32));
-  return kernel::fl_passes(b.v[0], fraction);
 }
 
 inline void applyWeighted(const Gravity& a, const Lanes& L, std::size_t n, const BlockContext& c);

@@ -201,7 +201,7 @@ std::string evaluate(const std::vector<std::string>& accels, const std::string& 
 }
 
 // Move by an integrator other than semi-implicit Euler over the forces `accels` (in list
-// order), as integrate.hpp integrate() does it, operation by operation.
+// order), as integrate.hpp integrate() does it: the per-axis updates are kernels/integrate.h.
 // dampingParams[j]: the params of force j when it is a Damping (Exact takes its rates), else "".
 std::string integrateMove(Integrator integrator, const std::vector<std::string>& accels,
                           const std::vector<std::string>& dampingParams, bool prev, bool age) {
@@ -214,19 +214,19 @@ std::string integrateMove(Integrator integrator, const std::vector<std::string>&
   switch (integrator) {
     case Integrator::ExplicitEuler:
       c << evaluate(accels, "c_", "time", "a0");
-      c << "px += vx * dt; py += vy * dt; pz += vz * dt;\n"
-           "vx += a0ax * dt; vy += a0ay * dt; vz += a0az * dt;\n";
+      for (const char* d : {"x", "y", "z"})
+        c << "fl_euler_explicit(a0a" << d << ", dt, &p" << d << ", &v" << d << ");\n";
       break;
     case Integrator::VelocityVerlet:
       c << evaluate(accels, "c_", "time", "a0");
-      c << "const float p1px = px + vx * dt + 0.5f * a0ax * dt * dt, p1py = py + vy * dt + 0.5f * "
-           "a0ay * dt * dt, p1pz = pz + vz * dt + 0.5f * a0az * dt * dt;\n"
-           "const float p1vx = vx + a0ax * dt, p1vy = vy + a0ay * dt, p1vz = vz + a0az * dt;\n"
-           "float a1ax, a1ay, a1az;\n"
-        << evaluate(accels, "p1", "time + (fl_real)dt", "a1")
-        << "px = p1px; py = p1py; pz = p1pz;\n"
-           "vx += 0.5f * (a0ax + a1ax) * dt; vy += 0.5f * (a0ay + a1ay) * dt; vz += 0.5f * (a0az "
-           "+ a1az) * dt;\n";
+      c << "float p1px, p1py, p1pz, p1vx, p1vy, p1vz, a1ax, a1ay, a1az;\n";
+      for (const char* d : {"x", "y", "z"})
+        c << "fl_verlet_predict(p" << d << ", v" << d << ", a0a" << d << ", dt, &p1p" << d
+          << ", &p1v" << d << ");\n";
+      c << evaluate(accels, "p1", "time + (fl_real)dt", "a1");
+      for (const char* d : {"x", "y", "z"})
+        c << "fl_verlet_finish(p1p" << d << ", a0a" << d << ", a1a" << d << ", dt, &p" << d
+          << ", &v" << d << ");\n";
       break;
     case Integrator::RK4: {
       c << "float sppx = 0.0f, sppy = 0.0f, sppz = 0.0f, spvx = 0.0f, spvy = 0.0f, spvz = "
@@ -239,13 +239,12 @@ std::string integrateMove(Integrator integrator, const std::vector<std::string>&
           << evaluate(accels, "st", std::string("time + (fl_real)(") + h[k] + " * dt)", "a1")
           << "const float next = " << (k < 3 ? std::string(h[k + 1]) + " * dt" : "0.0f") << ";\n";
         for (const char* d : {"x", "y", "z"})
-          c << "{ const float kp = stv" << d << ", kv = a1a" << d << "; spp" << d << " += " << w[k]
-            << " * kp; spv" << d << " += " << w[k] << " * kv; stp" << d << " = p" << d
-            << " + kp * next; stv" << d << " = v" << d << " + kv * next; }\n";
+          c << "fl_rk4_stage(p" << d << ", v" << d << ", stv" << d << ", a1a" << d << ", " << w[k]
+            << ", next, &spp" << d << ", &spv" << d << ", &stp" << d << ", &stv" << d << ");\n";
         c << "}\n";
       }
-      c << "px += sppx * (dt / 6.0f); py += sppy * (dt / 6.0f); pz += sppz * (dt / 6.0f);\n"
-           "vx += spvx * (dt / 6.0f); vy += spvy * (dt / 6.0f); vz += spvz * (dt / 6.0f);\n";
+      for (const char* d : {"x", "y", "z"})
+        c << "fl_rk4_finish(spp" << d << ", spv" << d << ", dt, &p" << d << ", &v" << d << ");\n";
       break;
     }
     case Integrator::Exact: {
@@ -261,12 +260,7 @@ std::string integrateMove(Integrator integrator, const std::vector<std::string>&
           c << "kx += " << d << "->f[3]; ky += " << d << "->f[4]; kz += " << d << "->f[5];\n";
         }
       for (const char* d : {"x", "y", "z"})
-        c << "{ const float g = a0a" << d << ", k = k" << d << ", v0 = v" << d << ";\n"
-          << "  if (k > 0.0f) { const float e = exp(-k * dt), term = g / k; p" << d
-          << " += term * dt + (v0 - term) * (1.0f - e) / k; v" << d
-          << " = term + (v0 - term) * e; }\n"
-          << "  else { p" << d << " += v0 * dt + 0.5f * g * dt * dt; v" << d
-          << " = v0 + g * dt; } }\n";
+        c << "fl_exact_step(a0a" << d << ", k" << d << ", dt, &p" << d << ", &v" << d << ");\n";
       break;
     }
     case Integrator::SemiImplicitEuler:
@@ -698,12 +692,9 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   s << " } while (0)\n#define FL_LANE_ARGS ";
   for (std::size_t k = 0; k < all.size(); ++k) s << (k ? ", " : "") << "l_" << all[k].name;
   s << "\n";
-  s << "#define FL_PHILOX_M0 " << Philox4x32::kM0 << "u\n#define FL_PHILOX_M1 " << Philox4x32::kM1
-    << "u\n#define FL_PHILOX_W0 " << Philox4x32::kW0 << "u\n#define FL_PHILOX_W1 "
-    << Philox4x32::kW1 << "u\n";
   for (const char* f : {"compat_opencl.h", "math.h", "params.h", "philox.h", "noise.h", "deflect.h",
-                        "domain.h", "domain.cl", "forces.h", "absorb.h", "actions.cl", "forces.cl",
-                        "surfaces.cl", "compact.cl", "emit.cl"})
+                        "domain.h", "domain.cl", "forces.h", "integrate.h", "absorb.h",
+                        "actions.cl", "forces.cl", "surfaces.cl", "compact.cl", "emit.cl"})
     s << "/* ---- " << f << " */\n" << embeddedKernel(f) << "\n";
 
   s << "/* ---- generated: emission */\n" << emitSource;
