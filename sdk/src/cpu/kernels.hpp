@@ -391,16 +391,35 @@ inline void bouncePlanarAccelLoop(float* __restrict px, float* __restrict py, fl
                                   std::size_t n, Dt dts, Vec3 P, Vec3 N, OnPiece onPiece,
                                   const Bounce& b) {
   const kernel::FlReflect rf{b.restitution, 1.0f - b.friction, b.cutoff * b.cutoff};
-  for (std::size_t i = 0; i < n; ++i) {
-    const float dt = dts[i], ax = axs[i], ay = ays[i], az = azs[i];
-    float side, tau, hx, hy, hz;
-    const int hit =
-        kernel::fl_planar_accel_hit(px[i], py[i], pz[i], vxs[i], vys[i], vzs[i], ax, ay, az, dt,
-                                    P.x, P.y, P.z, N.x, N.y, N.z, &side, &tau, &hx, &hy, &hz) &
-        int(onPiece(hx, hy, hz));
-    if (!hit) continue;
-    kernel::fl_planar_accel_bounce(rf, side, tau, hx, hy, hz, dt, ax, ay, az, P.x, P.y, P.z, N.x,
-                                   N.y, N.z, &px[i], &py[i], &pz[i], &vxs[i], &vys[i], &vzs[i]);
+  // The test, branch-free, as a vectorised loop over a chunk; then the bounce of the hits only
+  // (the test again for each, for its impact: the same function, the same values).
+  constexpr std::size_t kChunk = 256;
+  std::uint8_t hits[kChunk];
+  for (std::size_t c0 = 0; c0 < n; c0 += kChunk) {
+    const std::size_t m = std::min(kChunk, n - c0);
+    float *x = px + c0, *y = py + c0, *z = pz + c0, *vx = vxs + c0, *vy = vys + c0, *vz = vzs + c0;
+    const float *ax = axs + c0, *ay = ays + c0, *az = azs + c0;
+    std::size_t any = 0;
+    for (std::size_t i = 0; i < m; ++i) {
+      float side, tau, hx, hy, hz;
+      const int hit = kernel::fl_planar_accel_hit(x[i], y[i], z[i], vx[i], vy[i], vz[i], ax[i],
+                                                  ay[i], az[i], dts[c0 + i], P.x, P.y, P.z, N.x,
+                                                  N.y, N.z, &side, &tau, &hx, &hy, &hz) &
+                      int(onPiece(hx, hy, hz));
+      hits[i] = std::uint8_t(hit);
+      any += std::size_t(hit);
+    }
+    if (any == 0) continue;
+    for (std::size_t i = 0; i < m; ++i) {
+      if (!hits[i]) continue;
+      const float dt = dts[c0 + i];
+      float side, tau, hx, hy, hz;
+      kernel::fl_planar_accel_hit(x[i], y[i], z[i], vx[i], vy[i], vz[i], ax[i], ay[i], az[i], dt,
+                                  P.x, P.y, P.z, N.x, N.y, N.z, &side, &tau, &hx, &hy, &hz);
+      kernel::fl_planar_accel_bounce(rf, side, tau, hx, hy, hz, dt, ax[i], ay[i], az[i], P.x, P.y,
+                                     P.z, N.x, N.y, N.z, &x[i], &y[i], &z[i], &vx[i], &vy[i],
+                                     &vz[i]);
+    }
   }
 }
 
