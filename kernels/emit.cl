@@ -24,17 +24,15 @@ FL_INLINE float fl_fuzzy_nonneg(__global const FlFuzzy* f, uint mode, FlRandom* 
   return x < 0.0f ? 0.0f : x; /* std::max(x, 0.0f) */
 }
 
-/* Emitter::positionAt. */
+/* Emitter::positionAt (path.h). */
 FL_INLINE float3 fl_emitter_at(__global const FlEmitter* e, __global const FlKeyframe* keys,
                                fl_real t) {
   if (e->pathCount == 0)
-    return fl_v3(e->position) + fl_v3(e->velocity) * (float)(t - fl_real_from_bits(e->start));
+    return fl_path_linear(fl_v3(e->position), fl_v3(e->velocity), fl_real_from_bits(e->start), t);
   __global const FlKeyframe* k = keys + e->pathFirst;
   const uint last = e->pathCount - 1;
-  if (e->pathLoop != 0 && t > fl_real_from_bits(k[last].time)) {
-    const fl_real t0 = fl_real_from_bits(k[0].time);
-    t = t0 + fmod(t - t0, fl_real_from_bits(k[last].time) - t0);
-  }
+  if (e->pathLoop != 0 && t > fl_real_from_bits(k[last].time))
+    t = fl_path_wrap(t, fl_real_from_bits(k[0].time), fl_real_from_bits(k[last].time));
   if (t <= fl_real_from_bits(k[0].time)) return fl_v3(k[0].position);
   if (t >= fl_real_from_bits(k[last].time)) return fl_v3(k[last].position);
   /* The first key later than t (1 <= b <= last, as t is inside the path): a binary search,
@@ -48,11 +46,8 @@ FL_INLINE float3 fl_emitter_at(__global const FlEmitter* e, __global const FlKey
     else
       lo = mid + 1u;
   }
-  const uint b = lo;
-  const fl_real ta = fl_real_from_bits(k[b - 1].time), tb = fl_real_from_bits(k[b].time);
-  const fl_real w = (t - ta) / (tb - ta);
-  const float3 a = fl_v3(k[b - 1].position);
-  return a + (fl_v3(k[b].position) - a) * (float)w;
+  return fl_path_between(t, fl_real_from_bits(k[lo - 1].time), fl_v3(k[lo - 1].position),
+                         fl_real_from_bits(k[lo].time), fl_v3(k[lo].position));
 }
 
 

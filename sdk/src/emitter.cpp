@@ -4,6 +4,7 @@
 #include "emission_plan.hpp"
 #include "flurry/emitter.hpp"
 #include "flurry/error.hpp"
+#include "kernel_compat.hpp"
 
 namespace flurry {
 
@@ -16,12 +17,10 @@ bool finite(Vec3 v) {
 namespace detail {
 Vec3 pathPositionAt(Vec3 position, Vec3 velocity, double start, const std::vector<Keyframe>& path,
                     bool loop, double t, std::size_t& key) {
-  if (path.empty()) return position + velocity * float(t - start);
-  if (loop && t > path.back().time) {
-    // fmod is exact, so the device (kernels/emit.cl fl_emitter_at) wraps to the same time.
-    const double t0 = path.front().time;
-    t = t0 + std::fmod(t - t0, path.back().time - t0);
-  }
+  // kernels/path.h: the device's motion too.
+  if (path.empty()) return kernel::fl_path_linear(position, velocity, start, t);
+  if (loop && t > path.back().time)
+    t = kernel::fl_path_wrap(t, path.front().time, path.back().time);
   if (t <= path.front().time) return path.front().position;
   if (t >= path.back().time) return path.back().position;
   // The first key later than t (1 <= key < size, as t is inside the path): a short walk on
@@ -40,9 +39,8 @@ Vec3 pathPositionAt(Vec3 position, Vec3 velocity, double start, const std::vecto
       }
   }
   key = b;
-  const Keyframe& a = path[b - 1];
-  const double w = (t - a.time) / (path[b].time - a.time);
-  return a.position + (path[b].position - a.position) * float(w);
+  return kernel::fl_path_between(t, path[b - 1].time, path[b - 1].position, path[b].time,
+                                 path[b].position);
 }
 }  // namespace detail
 

@@ -45,6 +45,7 @@ using std::cos;
 using std::exp;
 using std::fabs;
 using std::floor;
+using std::fmod;
 using std::log;
 using std::pow;
 using std::sin;
@@ -52,6 +53,7 @@ using std::sqrt;
 
 #include "../../kernels/math.h"
 #include "../../kernels/philox.h"
+#include "../../kernels/path.h"
 
 }  // namespace kernel
 }  // namespace FLURRY_ISA_NAMESPACE

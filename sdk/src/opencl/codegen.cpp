@@ -693,7 +693,7 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   for (std::size_t k = 0; k < all.size(); ++k) s << (k ? ", " : "") << "l_" << all[k].name;
   s << "\n";
   for (const char* f : {"compat_opencl.h", "math.h", "params.h", "philox.h", "noise.h", "deflect.h",
-                        "domain.h", "domain.cl", "forces.h", "integrate.h", "absorb.h",
+                        "domain.h", "domain.cl", "path.h", "forces.h", "integrate.h", "absorb.h",
                         "actions.cl", "forces.cl", "surfaces.cl", "compact.cl", "emit.cl"})
     s << "/* ---- " << f << " */\n" << embeddedKernel(f) << "\n";
 
