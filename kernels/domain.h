@@ -123,6 +123,15 @@ FL_INLINE float fl_normal_from(float ua, float ub) {
   return sqrt(-2.0f * fl_logf(1.0f - ua)) * c;
 }
 
+/* A fuzzy value (flurry::Fuzzy) from its draws: uniform in center +- spread from one uniform,
+ * or normal with standard deviation spread from two. */
+FL_INLINE float fl_fuzzy_uniform(float center, float spread, float ua) {
+  return center + spread * (2.0f * ua - 1.0f);
+}
+FL_INLINE float fl_fuzzy_normal(float center, float spread, float ua, float ub) {
+  return center + spread * fl_normal_from(ua, ub);
+}
+
 /* Uniforms a domain of kind FL_DOMAIN_* draws per sample; a union's depend on its parts
  * (1 + the most any part draws). */
 FL_INLINE uint fl_draw_count(uint kind) {

@@ -14,9 +14,9 @@ FL_INLINE float fl_fuzzy(__global const FlFuzzy* f, uint mode, FlRandom* rng) {
   if (mode == 0) return f->center;
   if (mode == 2) {
     const float ua = fl_uniform(rng), ub = fl_uniform(rng);
-    return f->center + f->spread * fl_normal_from(ua, ub);
+    return fl_fuzzy_normal(f->center, f->spread, ua, ub);
   }
-  return f->center + f->spread * (2.0f * fl_uniform(rng) - 1.0f);
+  return fl_fuzzy_uniform(f->center, f->spread, fl_uniform(rng));
 }
 
 FL_INLINE float fl_fuzzy_nonneg(__global const FlFuzzy* f, uint mode, FlRandom* rng) {

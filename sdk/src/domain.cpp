@@ -1,6 +1,7 @@
 // Domain factories (validation) and the per-shape sampling, nearest-point, normal and measure
 // code. Containment lives in shape_math.hpp so that the backends' loops share it.
 #include "flurry/domain.hpp"
+#include "flurry/fuzzy.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -425,6 +426,14 @@ Philox4x32::Block Philox4x32::generate(std::uint32_t c0, std::uint32_t c1, std::
 
 float uniformFloat(std::uint32_t bits) noexcept {
   return kern::fl_uniform_bits(bits);
+}
+
+float Fuzzy::sample(Random& rng) const {
+  if (spread == 0.0f) return center;
+  const float ua = rng.uniform();
+  if (distribution == Distribution::Normal)
+    return kern::fl_fuzzy_normal(center, spread, ua, rng.uniform());
+  return kern::fl_fuzzy_uniform(center, spread, ua);
 }
 
 Vec3 Domain::sample(Random& rng) const {

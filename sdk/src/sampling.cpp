@@ -90,7 +90,7 @@ FL_LOOP void blob(C u0, C u1, C u2, C u3, C u4, C u5, F x, F y, F z, std::size_t
 }
 
 FL_LOOP void normal(C u0, C u1, F out, std::size_t n, float center, float spread) {
-  for (std::size_t i = 0; i < n; ++i) out[i] = center + spread * k::fl_normal_from(u0[i], u1[i]);
+  for (std::size_t i = 0; i < n; ++i) out[i] = k::fl_fuzzy_normal(center, spread, u0[i], u1[i]);
 }
 
 #undef FL_LOOP
@@ -197,7 +197,7 @@ void sampleBatch(const Fuzzy& f, const float* const* u, std::size_t n, float* ou
     normal(u[0], u[1], out, n, f.center, f.spread);
   } else {
     const float* __restrict a = u[0];
-    for (std::size_t i = 0; i < n; ++i) out[i] = f.center + f.spread * (2.0f * a[i] - 1.0f);
+    for (std::size_t i = 0; i < n; ++i) out[i] = kernel::fl_fuzzy_uniform(f.center, f.spread, a[i]);
   }
 }
 

@@ -28,11 +28,8 @@ struct Fuzzy {
 
   bool constant() const { return spread == 0.0f; }
 
-  float sample(Random& rng) const {
-    if (spread == 0.0f) return center;
-    if (distribution == Distribution::Normal) return center + spread * rng.normal();
-    return center + spread * (2.0f * rng.uniform() - 1.0f);
-  }
+  /// One draw from `rng` (the uniforms in the order the device draws them, kernels/domain.h).
+  float sample(Random& rng) const;
 
   /// Throws InvalidArgument naming `name` if the value is not finite or the spread negative.
   void validate(const char* name) const {
