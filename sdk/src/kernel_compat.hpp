@@ -52,8 +52,8 @@ using std::sin;
 using std::sqrt;
 
 #include "../../kernels/math.h"
-#include "../../kernels/philox.h"
 #include "../../kernels/path.h"
+#include "../../kernels/philox.h"
 
 }  // namespace kernel
 }  // namespace FLURRY_ISA_NAMESPACE
