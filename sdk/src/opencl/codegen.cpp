@@ -10,7 +10,6 @@
 #include "../action_traits.hpp"
 #include "../shape_math.hpp"
 #include "flurry/error.hpp"
-#include "flurry/random.hpp"
 
 namespace flurry::detail::ocl {
 
