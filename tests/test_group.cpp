@@ -463,6 +463,38 @@ TEST(Context, EffectInstancesAndDestroyedGroups) {
   EXPECT_EQ(ctx.groups().size(), 3u);
 }
 
+// A Callback may not create, destroy or step groups of the context stepping it (the step
+// holds them): a clear error, and the context steps on afterwards.
+TEST(Context, ACallbackCannotChangeTheGroupsOfItsStep) {
+  for (unsigned threads : {1u, 2u}) {
+    ContextOptions o;
+    o.threads = threads;
+    Context ctx(o);
+    Group& other = ctx.createGroup("other", 10);
+    Group& g = ctx.createGroup("g", 10);
+    g.add(Particle{});
+    int what = 0;
+    g.setActions({Callback{[&](Particle&, const CallbackContext&) {
+      if (what == 1) ctx.destroyGroup(other);
+      if (what == 2) ctx.createGroup("new", 10);
+      if (what == 3) ctx.step();
+    }}});
+    for (what = 1; what <= 3; ++what) {
+      try {
+        ctx.step();
+        ADD_FAILURE() << what << ": the callback changed the context's groups in its step";
+      } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("not while the context steps"), std::string::npos)
+            << e.what();
+      }
+    }
+    what = 0;
+    ctx.run(2);
+    EXPECT_EQ(ctx.groups().size(), 2u);
+    EXPECT_NO_THROW(ctx.destroyGroup(other));
+  }
+}
+
 // Small groups (instances) are stepped side by side on the threads, each inline: every
 // particle of every instance is bitwise what one thread gives, big groups beside them too.
 TEST(Context, ManySmallGroupsStepTheSameOnAnyThreadCount) {

@@ -34,7 +34,25 @@ struct Context::Impl {
   std::unique_ptr<detail::ThreadPool> pool;
   // Small groups (effect instances) are stepped many at once, one per thread, each inline.
   detail::ThreadPool inlinePool{1};
-  std::vector<detail::GroupImpl*> smallGroups;  // this step's, kept for its storage
+  // The groups as Context::step takes them, found again only when a group is created or
+  // destroyed (groupsVersion): a large one steps on all threads, the small ones (effect
+  // instances) many at once, one per thread, each inline.
+  std::vector<detail::GroupImpl*> largeGroups, smallGroups;
+  std::uint64_t splitVersion = ~std::uint64_t(0);
+  void splitGroups();
+  // Context::step or prewarm is running: a Callback may not create or destroy groups (the
+  // step holds them) nor step again.
+  bool stepping = false;
+  void checkNotStepping(const char* what) const {
+    if (stepping)
+      throw Error(std::string("Context::") + what +
+                  ": not while the context steps (called from a Callback?)");
+  }
+  struct Stepping {
+    bool& flag;
+    explicit Stepping(bool& f) : flag(f) { flag = true; }
+    ~Stepping() { flag = false; }
+  };
   std::unique_ptr<detail::BackendImpl> backend;
   Backend backendKind = Backend::Cpu;
   std::string backendFallback;  // why Backend::Auto took the CPU
@@ -177,6 +195,7 @@ Context::Context(ContextOptions options) : impl_(std::make_unique<Impl>()) {
 Context::~Context() = default;
 
 Group& Context::createGroup(std::string name, std::size_t capacity) {
+  impl_->checkNotStepping("createGroup");
   if (capacity == 0) throw InvalidArgument("capacity", "a group needs a capacity > 0");
   if (capacity > std::size_t(0xFFFFFFF0u))
     throw InvalidArgument("capacity", "at most 4294967280 particles per group");
@@ -210,6 +229,7 @@ Group& Context::createGroup(std::string name, std::size_t capacity) {
 }
 
 void Context::destroyGroup(Group& group) {
+  impl_->checkNotStepping("destroyGroup");
   auto& all = impl_->groups;
   const auto it =
       std::find_if(all.begin(), all.end(), [&](const auto& g) { return g.get() == &group; });
@@ -264,6 +284,21 @@ void stepGroup(detail::BackendImpl& backend, detail::GroupImpl& gi, const detail
 }
 
 }  // namespace
+
+void Context::Impl::splitGroups() {
+  if (splitVersion == groupsVersion) return;
+  // On the CPU a group is independent of every other and its result does not depend on the
+  // thread that steps it: a group too small to share out its own pass steps inline on one
+  // thread while others step theirs, a large one on all.
+  const bool spread = backendKind == Backend::Cpu && pool->size() > 1;
+  largeGroups.clear();
+  smallGroups.clear();
+  for (const auto& g : groups) {
+    detail::GroupImpl* gi = g->impl_.get();
+    (spread && gi->capacity <= kSmallGroupCapacity ? smallGroups : largeGroups).push_back(gi);
+  }
+  splitVersion = groupsVersion;
+}
 
 detail::StepParams Context::Impl::params() const {
   detail::StepParams sp;
@@ -345,34 +380,33 @@ std::size_t Context::particleBudget() const {
 }
 
 void Context::step() {
+  impl_->checkNotStepping("step");
+  const Impl::Stepping stepping(impl_->stepping);
   const auto started = std::chrono::steady_clock::now();
   impl_->feedDeathEmitters();
   impl_->shareBudget();
   const detail::StepParams sp = impl_->params();
-  auto& small = impl_->smallGroups;
-  small.clear();
-  // On the CPU a group is independent of every other and its result does not depend on the
-  // thread that steps it: a group too small to share out its own pass steps inline on one
-  // thread while others step theirs (a game's hundreds of instances), a large one on all.
-  const bool spread = impl_->backendKind == Backend::Cpu && impl_->pool->size() > 1;
-  for (auto& g : impl_->groups) {
-    auto& gi = *g->impl_;
-    if (spread && gi.capacity <= kSmallGroupCapacity) {
-      small.push_back(&gi);
-      continue;
+  impl_->splitGroups();
+  // Steps `list[from, to)` in order, asking the memory for a group's state two groups before
+  // its step and for what that points to one group before: a game's thousands of groups are
+  // each out of cache by their next step, and would otherwise wait on one miss after another.
+  auto stepInOrder = [&](const std::vector<detail::GroupImpl*>& list, std::size_t from,
+                         std::size_t to, const detail::StepParams& params) {
+    for (std::size_t i = from; i < to; ++i) {
+      if (i + 2 < to) list[i + 2]->prefetchSelf();
+      if (i + 1 < to) list[i + 1]->prefetchData();
+      stepGroup(*impl_->backend, *list[i],
+                groupStep(params, *list[i], impl_->timeAtDtChange, impl_->stepsSinceDtChange, 0));
     }
-    stepGroup(*impl_->backend, gi,
-              groupStep(sp, gi, impl_->timeAtDtChange, impl_->stepsSinceDtChange, 0));
-  }
+  };
+  stepInOrder(impl_->largeGroups, 0, impl_->largeGroups.size(), sp);
+  const auto& small = impl_->smallGroups;
   if (!small.empty()) {
     detail::StepParams alone = sp;
     alone.pool = &impl_->inlinePool;
-    constexpr std::size_t kPerTask = 8;  // groups a task takes: fewer hand-outs
+    constexpr std::size_t kPerTask = 16;  // groups a task takes: fewer hand-outs
     impl_->pool->parallelFor((small.size() + kPerTask - 1) / kPerTask, [&](std::size_t t) {
-      const std::size_t end = std::min(small.size(), (t + 1) * kPerTask);
-      for (std::size_t i = t * kPerTask; i < end; ++i)
-        stepGroup(*impl_->backend, *small[i],
-                  groupStep(alone, *small[i], impl_->timeAtDtChange, impl_->stepsSinceDtChange, 0));
+      stepInOrder(small, t * kPerTask, std::min(small.size(), (t + 1) * kPerTask), alone);
     });
   }
   impl_->runDeathEmitters({});
@@ -384,6 +418,7 @@ void Context::step() {
 }
 
 std::uint64_t Context::prewarm(std::span<Group* const> groups, double seconds) {
+  impl_->checkNotStepping("prewarm");
   if (!(seconds >= 0.0) || !std::isfinite(seconds))
     throw InvalidArgument("seconds", "must be finite and >= 0");
   for (Group* g : groups) {
@@ -391,6 +426,7 @@ std::uint64_t Context::prewarm(std::span<Group* const> groups, double seconds) {
     if (!g || std::none_of(all.begin(), all.end(), [&](const auto& o) { return o.get() == g; }))
       throw InvalidArgument("groups", "not a group of this context");
   }
+  const Impl::Stepping stepping(impl_->stepping);
   const double dt = impl_->options.dt;
   // The fewest whole steps that cover `seconds` (a hair's rounding of seconds/dt forgiven).
   const double q = seconds / dt;

@@ -11,6 +11,7 @@
 #include "backend.hpp"
 #include "flurry/error.hpp"
 #include "group_impl.hpp"
+#include "page_arena.hpp"
 #include "thread_pool.hpp"
 #include "transform.hpp"
 
@@ -31,8 +32,19 @@ namespace {
 constexpr std::size_t kHugePage = std::size_t(2) << 20;
 }
 
+namespace {
+// A lane's bytes before rounding: at least 16 elements (a vector's tail may read them).
+std::size_t laneBytes(std::size_t count) {
+  return std::max<std::size_t>(count, 16) * 4;
+}
+}  // namespace
+
 LaneBuffer::LaneBuffer(std::size_t count) : count_(count) {
-  std::size_t bytes = std::max<std::size_t>(count, 16) * 4;
+  std::size_t bytes = laneBytes(count);
+  if (bytes <= kArenaMostBytes) {
+    data_ = arenaAllocate(bytes);  // a small group's: beside its neighbours', in huge pages
+    return;
+  }
   const bool huge = bytes >= 4 * kHugePage;
   const std::size_t align = huge ? kHugePage : 64;
   bytes = (bytes + align - 1) / align * align;
@@ -44,13 +56,24 @@ LaneBuffer::LaneBuffer(std::size_t count) : count_(count) {
 #endif
 }
 
+namespace {
+void freeLane(void* data, std::size_t count) {
+  if (!data) return;
+  const std::size_t bytes = laneBytes(count);
+  if (bytes <= kArenaMostBytes)
+    arenaFree(data, bytes);
+  else
+    std::free(data);
+}
+}  // namespace
+
 LaneBuffer::~LaneBuffer() {
-  std::free(data_);
+  freeLane(data_, count_);
 }
 
 LaneBuffer& LaneBuffer::operator=(LaneBuffer&& o) noexcept {
   if (this != &o) {
-    std::free(data_);
+    freeLane(data_, count_);
     data_ = o.data_;
     count_ = o.count_;
     o.data_ = nullptr;
@@ -441,6 +464,47 @@ Space Group::space() const {
   return impl_->frame ? impl_->frame->space : Space::World;
 }
 
+namespace {
+// Prefetches [p, p + bytes), at most kMostPrefetched of it: the head of a large buffer (its
+// rest streams in by the hardware's own prefetch).
+constexpr std::size_t kMostPrefetched = 4096;
+void prefetchBytes(const void* p, std::size_t bytes) {
+  const auto* c = static_cast<const char*>(p);
+  bytes = std::min(bytes, kMostPrefetched);
+  for (std::size_t o = 0; o < bytes; o += 64) __builtin_prefetch(c + o);
+}
+template <class T>
+void prefetchVector(const std::vector<T>& v) {
+  if (!v.empty()) prefetchBytes(v.data(), v.size() * sizeof(T));
+}
+}  // namespace
+
+void* detail::GroupImpl::operator new(std::size_t bytes) {
+  return arenaAllocate(bytes);
+}
+void detail::GroupImpl::operator delete(void* group, std::size_t bytes) noexcept {
+  arenaFree(group, bytes);
+}
+
+void detail::GroupImpl::prefetchSelf() const {
+  prefetchBytes(this, sizeof(*this));
+}
+
+void detail::GroupImpl::prefetchData() const {
+  for (const auto& attribute : lanes)
+    for (const LaneBuffer& lane : attribute)
+      if (lane) prefetchBytes(lane.data(), size * sizeof(float) + 64);
+  prefetchVector(actions.actions());
+  prefetchVector(emitters);
+  prefetchVector(emitterState);
+  prefetchVector(stats.killedByAction);
+  prefetchVector(plan.reach);
+  prefetchVector(plan.timeFree);
+  prefetchVector(plan.moves);
+  prefetchVector(plan.gathered);
+  if (frame) prefetchBytes(frame.get(), sizeof(Frame));
+}
+
 void detail::GroupImpl::placeEmitters() {
   if (!frame || frame->emittersDerived == emittersVersion) return;
   deriveEmitters(*this, frame->transform);
@@ -705,8 +769,28 @@ const GroupStats& Group::stats() const {
   return impl_->stats;
 }
 
-void detail::GroupImpl::recordDeaths(std::size_t B, std::size_t blocks, double t1,
-                                     ThreadPool& pool) {
+detail::PassScratchUse::PassScratchUse(GroupImpl& group) {
+  thread_local PassScratch mine;
+  threads_ = !mine.busy;
+  if (threads_) {
+    mine.busy = true;
+    scratch_ = &mine;
+  } else {
+    if (!group.ownScratch) group.ownScratch = std::make_unique<PassScratch>();
+    scratch_ = group.ownScratch.get();
+  }
+}
+
+detail::PassScratchUse::~PassScratchUse() {
+  if (threads_) scratch_->busy = false;
+}
+
+void detail::GroupImpl::recordDeaths(PassScratch& pass, std::size_t B, std::size_t blocks,
+                                     double t1, ThreadPool& pool) {
+  auto& deathStart = pass.deathStart;
+  const auto& deadCount = pass.deadCount;
+  const auto& deadIndex = pass.deadIndex;
+  const auto& deadCode = pass.deadCode;
   // Where each block's events start: the first in particle order are kept, up to the room.
   if (deathStart.size() < blocks + 1) deathStart.resize(blocks + 1);  // grows once
   std::size_t total = 0;

@@ -164,12 +164,51 @@ struct Frame {
 void assignFill(std::vector<std::uint32_t>& v, std::size_t n, std::uint32_t value);
 void assignFill(std::vector<float>& v, std::size_t n, float value);
 
+/// What one step of the CPU pass writes and reads again before it returns: its dead (index
+/// and cause, per block) and per-block tallies and bounds. Held by the thread that steps a
+/// group, not by the group: a game's thousands of small groups share their thread's, in
+/// cache, where each of its own would be cold by its next step. Grows, never shrinks.
+struct PassScratch {
+  std::vector<std::uint32_t> deadIndex;    ///< per block: [block*B, block*B + deadCount[block])
+  std::vector<std::uint8_t> deadCode;      ///< 1 + index of the action that killed
+  std::vector<std::uint32_t> deadCount;    ///< per block
+  std::vector<std::uint32_t> culledCount;  ///< per block: actions the fused pass skipped
+  /// Per block, the dead each action killed and, last, the non-finite ones: counted while
+  /// the block is in cache, by its own thread, and summed after the pass.
+  std::vector<std::uint32_t> blockKills;
+  std::vector<float> blockBounds;       ///< per block: min xyz, max xyz of its live particles
+  std::vector<std::size_t> deathStart;  ///< each block's first death event
+  std::vector<float> stepStart;         ///< positions at the step's start, for the guard
+  bool busy = false;                    ///< a step on this thread is using it
+};
+
 struct GroupImpl;
+/// The calling thread's PassScratch for one step of `group` (its own while the thread's is in
+/// use: a Callback that steps a group). Out of line in group.cpp for the reason of assignFill.
+class PassScratchUse {
+ public:
+  explicit PassScratchUse(GroupImpl& group);
+  ~PassScratchUse();
+  PassScratchUse(const PassScratchUse&) = delete;
+  PassScratchUse& operator=(const PassScratchUse&) = delete;
+  PassScratch& operator*() const { return *scratch_; }
+  PassScratch* operator->() const { return scratch_; }
+
+ private:
+  PassScratch* scratch_;
+  bool threads_;  ///< the thread's (to release), not the group's
+};
+
 /// Brings group.plan up to date with its action list (when actionsVersion changed) and
 /// returns it (cpu/cpu_backend.cpp).
 const ActionPlan& planActions(GroupImpl& group);
 
 struct GroupImpl {
+  /// From the arena's huge pages, as its lanes (page_arena.hpp): a small group's step then
+  /// walks no page table for it.
+  static void* operator new(std::size_t bytes);
+  static void operator delete(void* group, std::size_t bytes) noexcept;
+
   std::string name;
   std::uint32_t index = 0;  ///< creation order in the context: keeps groups' random streams apart
   std::size_t capacity = 0;
@@ -228,12 +267,10 @@ struct GroupImpl {
   GroupStats stats;
   std::uint32_t nextId = 0;
 
-  // Scratch reused every step (no allocation per step).
-  std::vector<std::uint32_t> deadIndex;    ///< per block: [block*B, block*B + deadCount[block])
-  std::vector<std::uint8_t> deadCode;      ///< 1 + index of the action that killed
-  std::vector<std::uint32_t> deadCount;    ///< per block
-  std::vector<std::uint32_t> culledCount;  ///< per block: actions the fused pass skipped
-  std::size_t deathsPerStep = 0;           ///< Group::recordDeaths; 0: not recording
+  /// The pass's scratch while this thread's own is in use (a step within a step): see
+  /// PassScratchUse.
+  std::unique_ptr<PassScratch> ownScratch;
+  std::size_t deathsPerStep = 0;  ///< Group::recordDeaths; 0: not recording
   /// A death emitter names this group (set by Context::step): it records every death.
   bool deathsFeed = false;
   /// The deaths a step records: deathsPerStep, or the capacity while deathsFeed.
@@ -276,17 +313,12 @@ struct GroupImpl {
   /// Keeps the step's newborns [bornFirst, bornFirst + bornCount) as birthEvents, before the
   /// pass moves them (t1: the step's end; each was born bornRemaining[r] before it).
   void recordBirths(double t1);
-  std::vector<std::size_t> deathStart;  ///< scratch: each block's first event
-  bool onDevice = false;                ///< its context runs a device backend
+  bool onDevice = false;  ///< its context runs a device backend
   /// Group::bounds() was asked: from then on the CPU pass takes the live particles' box
   /// every step, each block while it is in cache (no pass of its own).
   bool boundsWanted = false;
-  bool boundsValid = false;        ///< stepBounds is the live particles' box now
-  Bounds stepBounds;               ///< of the last step's pass, when boundsValid
-  std::vector<float> blockBounds;  ///< per block of that pass: min xyz, max xyz
-  /// Per block, the dead each action killed and, last, the non-finite ones: counted while
-  /// the block is in cache, by its own thread, and summed after the pass.
-  std::vector<std::uint32_t> blockKills;
+  bool boundsValid = false;          ///< stepBounds is the live particles' box now
+  Bounds stepBounds;                 ///< of the last step's pass, when boundsValid
   std::vector<std::uint32_t> holes;  ///< sorted dead indices of this step
   /// This step's newborns, written before the act pass: [bornFirst, bornFirst + bornCount),
   /// each with the part of the step it still has to live (seconds, bornRemaining[r]), which
@@ -295,7 +327,6 @@ struct GroupImpl {
   std::vector<float> bornRemaining;      ///< grows, never shrinks
   std::vector<std::uint32_t> deadFlags;  ///< the unfused baseline's per-particle kill codes
   std::vector<float> snapshot;           ///< positions/velocities at the step's start
-  std::vector<float> stepStart;          ///< positions at the step's start, for the guard
   ActionPlan plan;                       ///< the fused pass's, for actionsVersion
 
   std::unique_ptr<DeviceMirror> mirror;  ///< null on the CPU backend
@@ -328,6 +359,14 @@ struct GroupImpl {
   /// first; no-op without a frame).
   void placeEmitters();
 
+  /// Asks the memory for what a step of this group reads, a few groups ahead of stepping it
+  /// (Context::step): a game's thousands of small groups are each out of cache by the next
+  /// step, and their step would otherwise wait on one miss after another. prefetchSelf()
+  /// first (this object), then, a group later, prefetchData() (its lanes and vectors, up to a
+  /// small group's worth).
+  void prefetchSelf() const;
+  void prefetchData() const;
+
   /// The attributes the group must store now. The action list's share is kept for its
   /// actionsVersion by ensureStorage: every step asks, and an idle group's step is little
   /// more than that question.
@@ -344,7 +383,8 @@ struct GroupImpl {
   /// The step's dead (deadIndex/deadCode of `blocks` blocks of B, their lanes not yet
   /// compacted) as DeathEvents at time t1, in particle order up to deathRoom(); the rest
   /// counted. Out of line in group.cpp for the reason of assignFill.
-  void recordDeaths(std::size_t B, std::size_t blocks, double t1, ThreadPool& pool);
+  void recordDeaths(PassScratch& pass, std::size_t B, std::size_t blocks, double t1,
+                    ThreadPool& pool);
   /// Records every death from now on (a death emitter names this group); the room is taken
   /// here, once.
   void feedDeaths();

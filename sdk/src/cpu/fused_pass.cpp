@@ -421,12 +421,12 @@ void liveBounds(const Lanes& L, std::size_t n, const std::uint32_t* __restrict d
 // flags, so that the flags are all zero again for the next block (no fill per block). Few
 // die in a step: runs of 16 with none are skipped after one vectorised test, and a run with
 // some is walked by the set bits of its mask.
-std::uint32_t collectDead(GroupImpl& g, std::size_t base, std::size_t n,
+std::uint32_t collectDead(PassScratch& pass, std::size_t base, std::size_t n,
                           std::uint32_t* __restrict dead) {
   constexpr std::size_t kRun = 16;
   std::uint32_t count = 0;
-  std::uint32_t* __restrict idx = g.deadIndex.data() + base;
-  std::uint8_t* __restrict code = g.deadCode.data() + base;
+  std::uint32_t* __restrict idx = pass.deadIndex.data() + base;
+  std::uint8_t* __restrict code = pass.deadCode.data() + base;
   auto take = [&](std::size_t i) {
     idx[count] = std::uint32_t(base + i);
     code[count] = std::uint8_t(dead[i]);
@@ -485,29 +485,31 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
   const std::size_t blocks = (n + B - 1) / B;
   const std::size_t blocksPerTask = std::max<std::size_t>(1, kParticlesPerTask / B);
   const std::size_t tasks = (blocks + blocksPerTask - 1) / blocksPerTask;
-  g.deadIndex.resize(n);
-  g.deadCode.resize(n);
-  assignFill(g.deadCount, blocks, 0);
-  assignFill(g.culledCount, blocks, 0);
+  const PassScratchUse scratch(g);
+  PassScratch& pass = *scratch;
+  pass.deadIndex.resize(n);
+  pass.deadCode.resize(n);
+  assignFill(pass.deadCount, blocks, 0);
+  assignFill(pass.culledCount, blocks, 0);
   const std::size_t killSlots = acts.size() + 1;  // the last: non-finite
-  assignFill(g.blockKills, blocks * killSlots, 0);
+  assignFill(pass.blockKills, blocks * killSlots, 0);
   // Tallies a block's dead by cause (codes: 1 + action, or kNonFiniteCode).
   auto tally = [&](std::size_t b, std::uint32_t k) {
-    std::uint32_t* kills = g.blockKills.data() + b * killSlots;
-    const std::uint8_t* code = g.deadCode.data() + b * B;
+    std::uint32_t* kills = pass.blockKills.data() + b * killSlots;
+    const std::uint8_t* code = pass.deadCode.data() + b * B;
     for (std::uint32_t j = 0; j < k; ++j)
       ++kills[code[j] == kNonFiniteCode ? killSlots - 1 : code[j] - 1u];
   };
   const Lanes lanes = g.lanePointers();
   const bool bounds = g.boundsWanted && lanes.p[0];
-  if (bounds) g.blockBounds.resize(6 * blocks);  // grows, never shrinks
+  if (bounds) pass.blockBounds.resize(6 * blocks);  // grows, never shrinks
   Plan plan{planActions(g), substepCount(g, sp, *sp.pool)};
   if (plan.list.guarded) {
     // Where each particle began the step: the guard compares with it.
-    g.stepStart.resize(3 * n);
+    pass.stepStart.resize(3 * n);
     for (int c = 0; c < 3; ++c) {
-      std::copy_n(lanes.p[c], n, g.stepStart.data() + c * n);
-      plan.start[c] = g.stepStart.data() + c * n;
+      std::copy_n(lanes.p[c], n, pass.stepStart.data() + c * n);
+      plan.start[c] = pass.stepStart.data() + c * n;
     }
   }
   const float subDt = float(sp.dt / plan.substeps);
@@ -590,7 +592,7 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
           Culler culler;  // the sub-step's own bounds
           runBlock(acts, plan, 0, acts.size(), blockLanes, m, old, atSubstep(ctx, s),
                    remainingAt(first, old), s, t1, cull ? &culler : nullptr);
-          g.culledCount[b] += culler.culled;
+          pass.culledCount[b] += culler.culled;
         }
         guardFinite(blockLanes, m, dead.data(), plan.list.guardVelocity);
         if (trailCount) {
@@ -598,9 +600,9 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
           std::uint32_t* __restrict count = trailCount + first;
           for (std::size_t i = 0; i < m; ++i) count[i] = std::min(count[i] + 1u, trailMost);
         }
-        if (bounds) liveBounds(blockLanes, m, dead.data(), g.blockBounds.data() + 6 * b);
-        g.deadCount[b] = collectDead(g, first, m, dead.data());
-        tally(b, g.deadCount[b]);
+        if (bounds) liveBounds(blockLanes, m, dead.data(), pass.blockBounds.data() + 6 * b);
+        pass.deadCount[b] = collectDead(pass, first, m, dead.data());
+        tally(b, pass.deadCount[b]);
         store.clean = true;
       }
     });
@@ -630,18 +632,18 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
       guardFinite(lanes.offset(first), m, g.deadFlags.data() + first, plan.list.guardVelocity);
       if (bounds)
         liveBounds(lanes.offset(first), m, g.deadFlags.data() + first,
-                   g.blockBounds.data() + 6 * b);
-      g.deadCount[b] = collectDead(g, first, m, g.deadFlags.data() + first);
-      tally(b, g.deadCount[b]);
+                   pass.blockBounds.data() + 6 * b);
+      pass.deadCount[b] = collectDead(pass, first, m, g.deadFlags.data() + first);
+      tally(b, pass.deadCount[b]);
     });
   }
 
   for (std::size_t b = 0; b < blocks; ++b) {
-    g.stats.blockActionsCulled += g.culledCount[b];
-    const std::uint32_t* idx = g.deadIndex.data() + b * B;
-    g.holes.insert(g.holes.end(), idx, idx + g.deadCount[b]);  // within the capacity
+    g.stats.blockActionsCulled += pass.culledCount[b];
+    const std::uint32_t* idx = pass.deadIndex.data() + b * B;
+    g.holes.insert(g.holes.end(), idx, idx + pass.deadCount[b]);  // within the capacity
   }
-  if (g.deathRoom() > 0) g.recordDeaths(B, blocks, sp.time + sp.dt, *sp.pool);
+  if (g.deathRoom() > 0) g.recordDeaths(pass, B, blocks, sp.time + sp.dt, *sp.pool);
   if (logHits) g.endCollisions(blocks);
   if (bounds) {
     Bounds& box = g.stepBounds;
@@ -649,15 +651,15 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
     box.max = Vec3(-kInfinity);
     for (std::size_t b = 0; b < blocks; ++b)
       for (int c = 0; c < 3; ++c) {
-        box.min[c] = std::min(box.min[c], g.blockBounds[6 * b + c]);
-        box.max[c] = std::max(box.max[c], g.blockBounds[6 * b + 3 + c]);
+        box.min[c] = std::min(box.min[c], pass.blockBounds[6 * b + c]);
+        box.max[c] = std::max(box.max[c], pass.blockBounds[6 * b + 3 + c]);
       }
     box.empty = !(box.min.x <= box.max.x);  // every particle died (the group is empty then)
     g.boundsValid = true;
   }
   for (std::size_t a = 0; a < killSlots; ++a) {
     std::uint64_t killed = 0;
-    for (std::size_t b = 0; b < blocks; ++b) killed += g.blockKills[b * killSlots + a];
+    for (std::size_t b = 0; b < blocks; ++b) killed += pass.blockKills[b * killSlots + a];
     if (killed == 0) continue;
     if (a == killSlots - 1)
       g.stats.killedNonFinite += killed;
