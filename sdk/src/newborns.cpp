@@ -20,6 +20,7 @@ namespace {
 constexpr std::size_t kNewbornsPerTask = 8192;  // a multiple of kBatch
 
 constexpr std::size_t kBatch = 256;
+static_assert(kBatch % 16 == 0, "a batch pads its newborns to whole vectors of 16");
 constexpr int kMaxDraws = 48;
 
 struct NewbornContext {
@@ -117,17 +118,21 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
   if (L.up[0]) draws += drawCount(type.up);
   if (L.rot[0]) draws += drawCount(type.rotVelocity);
   const std::uint32_t firstId = nc.firstId + std::uint32_t(i0);
+  // Drawn and shaped in whole vectors of the widest set (16 floats): a small group's few
+  // newborns a step then run the vector loops alone, not their scalar remainders. Each
+  // newborn's values depend on its own draws only; the extra lanes are never stored.
+  const std::size_t mv = std::min(kBatch, (m + 15) / 16 * 16);
   for (int blk = 0; blk * 4 < draws; ++blk)
-    uniformBatch(nc.sp.seed, firstId, nc.g.index, stream::kEmission, std::uint32_t(blk), m,
+    uniformBatch(nc.sp.seed, firstId, nc.g.index, stream::kEmission, std::uint32_t(blk), mv,
                  rows[4 * blk], rows[4 * blk + 1], rows[4 * blk + 2], rows[4 * blk + 3]);
 
   int cur = 0;
   auto vec = [&](const Domain& d, int a) {
-    sampleBatch(d, row + cur, m, attr[a], attr[a + 1], attr[a + 2]);
+    sampleBatch(d, row + cur, mv, attr[a], attr[a + 1], attr[a + 2]);
     cur += drawCount(d);
   };
   auto scalar = [&](const Fuzzy& f, int a) {
-    sampleBatch(f, row + cur, m, attr[a]);
+    sampleBatch(f, row + cur, mv, attr[a]);
     cur += drawCount(f);
   };
   vec(type.velocity, 0);  // attr 0-2
@@ -149,10 +154,10 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
   if (L.mass) scalar(type.mass, 12);
   if (L.charge) scalar(type.charge, 13);
   if (L.up[0]) {
-    sampleBatch(type.up, row + cur, m, up[0], up[1], up[2]);
+    sampleBatch(type.up, row + cur, mv, up[0], up[1], up[2]);
     cur += drawCount(type.up);
   }
-  if (L.rot[0]) sampleBatch(type.rotVelocity, row + cur, m, rot[0], rot[1], rot[2]);
+  if (L.rot[0]) sampleBatch(type.rotVelocity, row + cur, mv, rot[0], rot[1], rot[2]);
 
   // Birth places: where the emitter was at the birth time; and the time left of the step.
   float* const px = attr[3];
