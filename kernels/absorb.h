@@ -48,9 +48,6 @@ FL_INLINE int fl_passes(uint u, float fraction) {
   return fl_uniform_bits(u) < fraction;
 }
 
-/* The stream of the pass-through draws (flurry::stream::kPassThrough). */
-#define FL_STREAM_PASS_THROUGH 0xFFFF0002u
-
 /* After an absorber with action code `code` and a pass-through fraction: the particles it
  * took pass if one Philox word of (id, key, FL_STREAM_PASS_THROUGH, 0) says so. The same word
  * every step, so the decision is made once per particle and absorber (key: the group's stream

@@ -7,8 +7,6 @@
  * fl_newborn with the domain kinds and fuzzy modes as literals, so that each newborn's
  * draws compile to straight-line code. */
 
-#define FL_EMISSION_STREAM 0xFFFF0000u /* flurry::stream::kEmission */
-
 /* mode (a literal in generated code): 0 constant, 1 uniform, 2 normal. */
 FL_INLINE float fl_fuzzy(__global const FlFuzzy* f, uint mode, FlRandom* rng) {
   if (mode == 0) return f->center;

@@ -12,6 +12,13 @@
 #define FL_PHILOX_W0 0x9E3779B9u
 #define FL_PHILOX_W1 0xBB67AE85u
 
+/* Stream numbers the SDK reserves (flurry::stream in random.hpp, asserted equal in
+ * domain.cpp); an action's draws use its index in the action list. */
+#define FL_STREAM_EMISSION 0xFFFF0000u      /* a newborn's attributes */
+#define FL_STREAM_EMITTER_EVENT 0xFFFF0001u /* an emitter's bursts and births */
+#define FL_STREAM_PASS_THROUGH 0xFFFF0002u  /* a Sink's once-per-particle pass */
+#define FL_STREAM_DEATH_EMITTER 0xFFFE0000u /* plus the death emitter's index */
+
 /* The ten rounds on the counter (c0, c1, c2, c3) with the key (k0, k1), in place. 64-bit
  * products rather than mul_hi: PoCL's mul_hi made this ~10x slower. */
 FL_INLINE void fl_philox_rounds(uint* c0, uint* c1, uint* c2, uint* c3, uint k0, uint k1) {

@@ -49,7 +49,7 @@ FL_INLINE void fl_birth_body(uint gid, uint gsize, FL_LANE_PARAMS, __global floa
     tau[r] = (float)(dtb > 0 ? dtb : (fl_real)0);
     const float3 at = fl_emitter_at(em, keys, tb);
     const uint id = firstId + r;
-    FlRandom rng = fl_random(seedLo, seedHi, id, salt, FL_EMISSION_STREAM);
+    FlRandom rng = fl_random(seedLo, seedHi, id, salt, FL_STREAM_EMISSION);
     fl_emit(FL_LANE_ARGS, em->variant, n0 + r, id, at, em, types, &rng, shapes);
   }
 }

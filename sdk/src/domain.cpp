@@ -417,6 +417,12 @@ float detail::standardNormal(float ua, float ub) noexcept {
   return kern::fl_normal_from(ua, ub);
 }
 
+// The reserved streams, named once for both backends in kernels/philox.h.
+static_assert(stream::kEmission == FL_STREAM_EMISSION);
+static_assert(stream::kEmitterEvent == FL_STREAM_EMITTER_EVENT);
+static_assert(stream::kPassThrough == FL_STREAM_PASS_THROUGH);
+static_assert(stream::kDeathEmitter == FL_STREAM_DEATH_EMITTER);
+
 Philox4x32::Block Philox4x32::generate(std::uint32_t c0, std::uint32_t c1, std::uint32_t c2,
                                        std::uint32_t c3, std::uint32_t k0,
                                        std::uint32_t k1) noexcept {

@@ -62,7 +62,6 @@ inline void onLocals(float* const* lane, std::size_t i, F f) {
 // The particles this absorber would kill survive if they pass it: decided once per particle
 // and absorber (kernels/absorb.h), so a fraction passThrough of them passes in every mode.
 inline void passThrough(const BlockContext& c, const Lanes& L, std::size_t n, float fraction) {
-  static_assert(stream::kPassThrough == FL_STREAM_PASS_THROUGH);
   if (fraction <= 0.0f) return;
   const std::uint32_t code = c.action + 1;
   // The group's part of the stream base, without the sub-step's (fused_pass.cpp: s << 8).
