@@ -1574,6 +1574,47 @@ TEST(Instance, PrewarmIsBitwiseSteppingByHand) {
   EXPECT_EQ(b.prewarm(0.0), 0u);
 }
 
+// An effect's times count from its creation: an instance made 10 s into the game bursts,
+// emits and explodes as one made at the start, step for step (no burst lost, no backlog of
+// the rate); a spawned emitter's times are its own.
+TEST(Instance, TimesCountFromItsCreation) {
+  const Effect fx = parseEffect(R"({"name": "boom", "dt": 0.05,
+    "groups": [{"name": "boom", "capacity": 1000,
+      "emitters": [{"bursts": [{"time": 0, "count": 100}, {"time": 0.52, "count": 7}],
+                    "path": [{"time": 0, "position": [0, 0, 0]}, {"time": 1, "position": [1, 0, 0]}],
+                    "types": [{"lifetime": 5}]},
+                   {"rate": 10, "start": 0.21, "stop": 1.01, "types": [{"lifetime": 5}]}],
+      "actions": [{"type": "Explosion", "time": 0.3}, {"type": "Restore", "start": 0.4},
+                  {"type": "Move"}, {"type": "KillOld"}]}]})");
+  ContextOptions o = fx.contextOptions();
+  o.threads = 1;
+  Context early(o), late(o);
+  EffectInstance a = fx.instantiate(early, "a");
+  late.run(200);  // 10 s
+  const double t0 = late.time();
+  EffectInstance b = fx.instantiate(late, "a");
+  Group& ga = *a.groups()[0];
+  Group& gb = *b.groups()[0];
+  EXPECT_EQ(gb.emitters()[1].start, 0.21 + t0);
+  EXPECT_EQ(gb.emitters()[1].stop, 1.01 + t0);
+  EXPECT_EQ(gb.emitters()[0].bursts[1].time, 0.52 + t0);
+  EXPECT_EQ(gb.emitters()[0].path[1].time, 1.0 + t0);
+  EXPECT_EQ(std::get<Explosion>(gb.actions().actions()[0]).time, float(0.3 + t0));
+  EXPECT_EQ(std::get<Restore>(gb.actions().actions()[1]).start, float(0.4 + t0));
+  late.step();
+  EXPECT_EQ(gb.size(), 100u);  // the burst at 0, in the instance's first step
+  early.step();
+  for (int step = 1; step < 30; ++step) {
+    early.step();
+    late.step();
+    ASSERT_EQ(ga.stats().emitted, gb.stats().emitted) << step;
+    ASSERT_EQ(ga.size(), gb.size()) << step;
+  }
+  EXPECT_EQ(gb.stats().emitted, 100u + 7u + 8u);  // both bursts and 0.8 s of 10/s
+  // Built at the start, nothing moves.
+  EXPECT_EQ(ga.emitters()[1].start, 0.21);
+}
+
 TEST(Instance, TheEffectFileSaysItsSpace) {
   EXPECT_EQ(dropEffect("local").space, Space::Local);
   EXPECT_EQ(dropEffect("world").space, Space::World);

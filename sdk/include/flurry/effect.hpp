@@ -91,6 +91,9 @@ struct Effect {
   /// attributes. maxCapacity > 0 caps every group's capacity. A non-empty `instance` names
   /// the groups "GROUP@INSTANCE", so that one effect can be built many times in a Context
   /// (each instance draws its own random numbers; Context::destroyGroup removes one).
+  /// The effect's times (its emitters' start, stop, bursts and path keys, an Explosion's
+  /// time, a Restore's start) count from when it is built: built at ctx.time() = T, a burst
+  /// at 0 fires at T and a rate starts at T, as a game's effect started mid-level expects.
   /// Returns the groups created. Errors raised by the core are rethrown as EffectError
   /// naming the group.
   std::vector<Group*> build(Context& ctx, std::size_t maxCapacity = 0,

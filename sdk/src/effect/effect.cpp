@@ -1120,9 +1120,35 @@ ContextOptions Effect::contextOptions() const {
   return o;
 }
 
+namespace {
+// An effect's times count from its start: one built at t0 on the context's clock has them
+// moved by t0 (its emitters' start, stop, bursts and path keys; Explosion's time, Restore's
+// start), so that an effect built mid-game bursts, emits and explodes as one built at time
+// 0 does. A spawned emitter's times count from its own birth and stay as they are.
+template <class E>
+void delayTimes(E& e, double t0) {
+  e.start += t0;
+  e.stop += t0;  // infinity stays infinity
+  for (Burst& b : e.bursts) b.time += t0;
+  for (Keyframe& k : e.path) k.time += t0;
+}
+ActionList delayedActions(const ActionList& list, double t0) {
+  ActionList out;
+  out.setIntegrator(list.integrator());
+  out.setSubsteps(list.substeps());
+  for (Action a : list.actions()) {
+    if (auto* x = std::get_if<Explosion>(&a)) x->time = float(double(x->time) + t0);
+    if (auto* r = std::get_if<Restore>(&a)) r->start = float(double(r->start) + t0);
+    out.add(std::move(a));
+  }
+  return out;
+}
+}  // namespace
+
 std::vector<Group*> Effect::build(Context& ctx, std::size_t maxCapacity,
                                   std::string_view instance) const {
   const std::string where = file.empty() ? name : file.string();
+  const double t0 = ctx.time();
   std::vector<Group*> made;
   for (std::size_t i = 0; i < groups.size(); ++i) {
     const EffectGroup& eg = groups[i];
@@ -1131,15 +1157,20 @@ std::vector<Group*> Effect::build(Context& ctx, std::size_t maxCapacity,
       const std::size_t cap = maxCapacity > 0 ? std::min(eg.capacity, maxCapacity) : eg.capacity;
       Group& g =
           ctx.createGroup(instance.empty() ? eg.name : eg.name + "@" + std::string(instance), cap);
-      g.setActions(eg.actions);
+      g.setActions(t0 == 0.0 ? eg.actions : delayedActions(eg.actions, t0));
       if (eg.hair.enabled) g.setHair(eg.hair);
       if (eg.trail.length > 0) g.setTrail(eg.trail);
       g.setBudgetPolicy(eg.budget);
       g.require(eg.require);
       if (space == Space::Local) g.setSpace(Space::Local);
-      for (std::size_t k = 0; k < eg.emitters.size(); ++k) g.addEmitter(eg.emitters[k]);
-      for (std::size_t k = 0; k < eg.primeEmitters.size(); ++k)
-        g.addPrimeEmitter(eg.primeEmitters[k]);
+      for (Emitter e : eg.emitters) {
+        delayTimes(e, t0);
+        g.addEmitter(std::move(e));
+      }
+      for (PrimeEmitter p : eg.primeEmitters) {
+        delayTimes(p, t0);
+        g.addPrimeEmitter(std::move(p));
+      }
       for (DeathEmitter de : eg.deathEmitters) {
         if (!instance.empty()) (de.source += '@') += instance;  // its own instance's
         g.addDeathEmitter(std::move(de));
