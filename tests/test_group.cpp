@@ -1615,6 +1615,48 @@ TEST(Instance, TimesCountFromItsCreation) {
   EXPECT_EQ(ga.emitters()[1].start, 0.21);
 }
 
+// A one-shot effect a game lets finish: stopped, nothing is born after the stop and the
+// particles live out their lives; done() is true exactly when none lives and none can be
+// born. Killed: none at once. A prime emitter's showers go on after a stop, not a kill.
+TEST(Instance, StopKillAndDone) {
+  const Effect fx = parseEffect(R"({"name": "torch", "dt": 0.05,
+    "groups": [{"name": "flames", "capacity": 2000,
+      "emitters": [{"rate": 100, "bursts": [{"time": 2, "count": 50}], "types": [{"lifetime": 1}]}],
+      "primeEmitters": [{"rate": 2, "child": {"lifetime": 0.5, "emitter": {"rate": 20,
+                         "types": [{"lifetime": 0.25}]}}}],
+      "actions": [{"type": "Move"}, {"type": "KillOld"}]}]})");
+  for (unsigned threads : {1u, 2u}) {
+    ContextOptions o = fx.contextOptions();
+    o.threads = threads;
+    Context ctx(o);
+    EffectInstance a = fx.instantiate(ctx, "a");
+    EffectInstance b = fx.instantiate(ctx, "b");
+    a.setTransform({Vec3(3, 0, 0), glm::quat(1, 0, 0, 0), 1.0f});  // the frame's copies too
+    Group& g = *a.groups()[0];
+    ctx.run(10);
+    EXPECT_FALSE(a.done());
+    a.stop();
+    const std::uint64_t emitted = g.stats().emitted;
+    ctx.run(5);
+    EXPECT_GT(g.size(), 0u);
+    EXPECT_FALSE(a.done());
+    ctx.run(20);  // past every lifetime and shower (and the burst at 2 s, which never fires)
+    EXPECT_EQ(g.size(), 0u);
+    EXPECT_TRUE(a.done());
+    EXPECT_LE(g.stats().emitted, emitted + 30);  // only the showers' births after the stop
+    EXPECT_EQ(g.liveEmitterCount(), 0u);
+    // The other instance emits on; killed, it holds nothing at once.
+    EXPECT_FALSE(b.done());
+    b.kill();
+    EXPECT_EQ(b.groups()[0]->size(), 0u);
+    EXPECT_EQ(b.groups()[0]->liveEmitterCount(), 0u);
+    EXPECT_TRUE(b.done());
+    ctx.run(5);
+    EXPECT_EQ(b.groups()[0]->size(), 0u);
+    EXPECT_THROW(EffectInstance().done(), Error);
+  }
+}
+
 TEST(Instance, TheEffectFileSaysItsSpace) {
   EXPECT_EQ(dropEffect("local").space, Space::Local);
   EXPECT_EQ(dropEffect("world").space, Space::World);

@@ -53,6 +53,12 @@ void emitNewborns(GroupImpl& group, const StepParams& params);
 /// Whether the group's emitters (static, prime or live) could give birth, or change their
 /// state, over this step: false only when a step would leave them as they are.
 bool mayEmit(const GroupImpl& group, const StepParams& params);
+/// Whether they could ever give birth again after time `at` (mayEmit over (at, infinity)).
+bool mayEverEmit(const GroupImpl& group, double at);
+/// Stops every emitter and prime emitter of the group at time `at` (stop = min(stop, at), the
+/// frame's own copies too): nothing is born after it. With `showers`, the live emitters that
+/// prime emitters spawned go too; else they live out their lives.
+void stopEmitting(GroupImpl& group, double at, bool showers);
 /// Fills the act pass's holes with the live particles at the tail, so [0, size) is dense
 /// again.
 void compact(GroupImpl& group, const StepParams& params);

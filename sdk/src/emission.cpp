@@ -9,6 +9,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <span>
 
 #include "backend.hpp"
@@ -322,7 +323,8 @@ bool mayFire(double rate, const std::vector<Burst>& bursts, double start, double
   for (const Burst& b : bursts) {
     if (b.count == 0 || b.repeat == 0) continue;
     const double last = b.time + double(b.repeat - 1) * b.interval;
-    if (!(std::max(b.time, last) < lo) && !(std::min(b.time, last) >= t1) && !(lo > stop))
+    if (!(std::max(b.time, last) < lo) && !(std::min(b.time, last) >= t1) && !(lo > stop) &&
+        !(std::min(b.time, last) > stop))
       return true;
   }
   return spacing > 0 && std::min(t1, stop) > lo;
@@ -342,6 +344,29 @@ bool mayEmit(const GroupImpl& g, const StepParams& sp) {
     if (mayFire(p.rate, p.bursts, p.start, p.stop, 0.0, g.primeState[k], t0, t1)) return true;
   }
   return false;
+}
+
+bool mayEverEmit(const GroupImpl& g, double at) {
+  StepParams sp;
+  sp.time = at;
+  sp.dt = std::numeric_limits<double>::infinity();
+  return mayEmit(g, sp);
+}
+
+void stopEmitting(GroupImpl& g, double at, bool showers) {
+  auto stop = [at](auto& e) { e.stop = std::min(e.stop, at); };
+  for (Emitter& e : g.emitters) stop(e);
+  for (PrimeEmitter& p : g.primes) stop(p);
+  if (g.frame) {
+    for (Emitter& e : g.frame->emitters) stop(e);
+    for (PrimeEmitter& p : g.frame->primes) stop(p);
+  }
+  if (showers) {
+    g.live.clear();
+    std::fill(g.primeLive.begin(), g.primeLive.end(), 0u);
+  }
+  ++g.emittersVersion;  // the device's tables, the world emitters: derived again
+  if (g.frame) g.frame->emittersDerived = g.emittersVersion;
 }
 
 // Live emitters that died this step go after their last births are written.

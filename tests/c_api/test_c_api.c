@@ -824,6 +824,21 @@ static void test_instances(void) {
   CHECK(scale == 2.0f);
   OK(flurry_instance_prewarm(b, 0.5, &steps));
   CHECK(steps == 5);
+  /* Its one burst fired: stopped, it is done when no particle is left; killed, at once. */
+  OK(flurry_instance_done(a, &empty));
+  CHECK(empty == 0);
+  OK(flurry_instance_stop(a));
+  OK(flurry_instance_done(a, &empty));
+  CHECK(empty == 0); /* the drop still lives */
+  OK(flurry_instance_kill(a));
+  OK(flurry_instance_done(a, &empty));
+  CHECK(empty == 1);
+  OK(flurry_instance_group_at(a, 0, &g));
+  OK(flurry_group_size(g, &n));
+  CHECK(n == 0);
+  FAILS(flurry_instance_done(a, NULL), FLURRY_ERROR_NULL_ARGUMENT, "done");
+  FAILS(flurry_instance_stop(NULL), FLURRY_ERROR_NULL_ARGUMENT, "instance");
+  FAILS(flurry_instance_kill(NULL), FLURRY_ERROR_NULL_ARGUMENT, "instance");
   FAILS(flurry_instance_prewarm(b, -1, NULL), FLURRY_ERROR_INVALID_ARGUMENT, "seconds");
   FAILS(flurry_instance_group_at(a, 2, &g), FLURRY_ERROR_NOT_FOUND, "group index 2");
   FAILS(flurry_effect_instantiate(fx, ctx, NULL, 0, &a), FLURRY_ERROR_NULL_ARGUMENT, "name");

@@ -349,6 +349,13 @@ FLURRY_C_EXPORT flurry_status flurry_instance_transform(const flurry_instance* i
  * groups); *steps (may be NULL) gets the steps taken. */
 FLURRY_C_EXPORT flurry_status flurry_instance_prewarm(flurry_instance* instance, double seconds,
                                                       uint64_t* steps);
+/** Stops emitting now (flurry::EffectInstance::stop): the live particles live out their lives. */
+FLURRY_C_EXPORT flurry_status flurry_instance_stop(flurry_instance* instance);
+/** Stops emitting and removes every particle at once (the groups stay). */
+FLURRY_C_EXPORT flurry_status flurry_instance_kill(flurry_instance* instance);
+/** *done = 1 when nothing of the instance lives and nothing can be born again (then
+ * flurry_instance_destroy it), else 0. */
+FLURRY_C_EXPORT flurry_status flurry_instance_done(const flurry_instance* instance, int* done);
 FLURRY_C_EXPORT flurry_status flurry_instance_group_count(const flurry_instance* instance,
                                                           size_t* count);
 /** Group `index` of the instance, in the effect's order (FLURRY_ERROR_NOT_FOUND past them). */

@@ -954,6 +954,25 @@ flurry_status flurry_instance_prewarm(flurry_instance* inst, double seconds, uin
     if (steps) *steps = n;
   });
 }
+flurry_status flurry_instance_stop(flurry_instance* inst) {
+  return guard([&] {
+    need(inst, "instance");
+    inst->instance.stop();
+  });
+}
+flurry_status flurry_instance_kill(flurry_instance* inst) {
+  return guard([&] {
+    need(inst, "instance");
+    inst->instance.kill();
+  });
+}
+flurry_status flurry_instance_done(const flurry_instance* inst, int* done) {
+  return guard([&] {
+    need(inst, "instance");
+    need(done, "done");
+    *done = inst->instance.done() ? 1 : 0;
+  });
+}
 flurry_status flurry_instance_group_count(const flurry_instance* inst, size_t* count) {
   return guard([&] {
     need(inst, "instance");

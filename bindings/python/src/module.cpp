@@ -672,7 +672,16 @@ NB_MODULE(_flurry, m) {
           "seconds"_a, "Starts the instance as if it had run `seconds`; returns the steps taken.")
       .def(
           "bounds", [](const InstanceRef& pi) { return boundsOf(pi.instance.bounds()); },
-          "The union of its groups' bounds, or None when no particle lives.");
+          "The union of its groups' bounds, or None when no particle lives.")
+      .def(
+          "stop", [](InstanceRef& pi) { pi.instance.stop(); },
+          "Stops emitting now: the live particles live out their lives.")
+      .def(
+          "kill", [](InstanceRef& pi) { pi.instance.kill(); },
+          "Stops emitting and removes every particle at once (the groups stay).")
+      .def_prop_ro(
+          "done", [](const InstanceRef& pi) { return pi.instance.done(); },
+          "True when nothing of it lives and nothing can be born again.");
 
   m.def(
       "load",

@@ -324,6 +324,24 @@ def test_an_instance_is_placed_and_prewarmed():
     assert (lo, hi) == flames.bounds()
 
 
+def test_an_instance_stops_and_is_done_when_its_particles_are():
+    effect = flurry.Effect.parse(json.dumps(_TORCH))
+    ctx = flurry.Context(threads=1)
+    torch = effect.instantiate(ctx, "torch")
+    ctx.step(10)
+    (flames,) = torch.groups
+    assert len(flames) > 0 and not torch.done
+    torch.stop()
+    ctx.step()
+    assert len(flames) > 0 and not torch.done  # the flames born live on
+    ctx.step(int(1.1 / ctx.dt) + 1)  # past their lifetime of 1 s: none is born again
+    assert len(flames) == 0 and torch.done
+    other = effect.instantiate(ctx, "other")
+    ctx.step(10)
+    other.kill()
+    assert len(other.groups[0]) == 0 and other.done
+
+
 def test_deaths_are_recorded_with_what_killed_them():
     ctx = fountain()
     g = ctx.groups[0]

@@ -128,6 +128,15 @@ class EffectInstance {
   /// The box of every live particle of the instance, in the world: the union of its groups'
   /// Group::bounds() (kept by the CPU pass every step once asked). Empty when none lives.
   Bounds bounds() const;
+  /// Stops emitting now (every emitter's and prime emitter's stop becomes the context's
+  /// time): the live particles, and the showers prime emitters launched, live out their
+  /// lives. A one-shot effect a game lets finish.
+  void stop();
+  /// Stops emitting and removes every particle and shower at once (the groups stay; their
+  /// stats are kept).
+  void kill();
+  /// True when nothing of it lives and nothing can be born again: a game may destroy() it.
+  bool done() const;
   /// Destroys its groups (Context::destroyGroup); the handle is empty after.
   void destroy();
 

@@ -3,10 +3,12 @@
 // errors with a suggestion: a typo must not silently become a default.
 #include "flurry/effect.hpp"
 
+#include "backend.hpp"
 #include "effect/descriptors.hpp"
 #include "effect/effect_parts.hpp"
 #include "effect/json_writer.hpp"
 #include "effect/obj_mesh.hpp"
+#include "group_impl.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -1223,6 +1225,27 @@ Bounds EffectInstance::bounds() const {
 std::uint64_t EffectInstance::prewarm(double seconds) {
   if (!context_) throw Error("prewarm: an empty EffectInstance (use Effect::instantiate)");
   return context_->prewarm(groups_, seconds);
+}
+
+void EffectInstance::stop() {
+  if (!context_) throw Error("stop: an empty EffectInstance (use Effect::instantiate)");
+  for (Group* g : groups_) detail::stopEmitting(detail::implOf(*g), context_->time(), false);
+}
+
+void EffectInstance::kill() {
+  if (!context_) throw Error("kill: an empty EffectInstance (use Effect::instantiate)");
+  for (Group* g : groups_) {
+    detail::stopEmitting(detail::implOf(*g), context_->time(), true);
+    g->clear();
+  }
+}
+
+bool EffectInstance::done() const {
+  if (!context_) throw Error("done: an empty EffectInstance (use Effect::instantiate)");
+  // From the context's clock: a prewarmed group is ahead of it, so this errs on "not yet".
+  return std::all_of(groups_.begin(), groups_.end(), [&](const Group* g) {
+    return g->size() == 0 && !detail::mayEverEmit(detail::implOf(*g), context_->time());
+  });
 }
 
 void EffectInstance::destroy() {
