@@ -1621,7 +1621,8 @@ TEST(Instance, TimesCountFromItsCreation) {
 TEST(Instance, StopKillAndDone) {
   const Effect fx = parseEffect(R"({"name": "torch", "dt": 0.05,
     "groups": [{"name": "flames", "capacity": 2000,
-      "emitters": [{"rate": 100, "bursts": [{"time": 2, "count": 50}], "types": [{"lifetime": 1}]}],
+      "emitters": [{"rate": 100, "bursts": [{"time": 0, "count": 50}, {"time": 2, "count": 50}],
+                    "types": [{"lifetime": 1}]}],
       "primeEmitters": [{"rate": 2, "child": {"lifetime": 0.5, "emitter": {"rate": 20,
                          "types": [{"lifetime": 0.25}]}}}],
       "actions": [{"type": "Move"}, {"type": "KillOld"}]}]})");
@@ -1653,6 +1654,12 @@ TEST(Instance, StopKillAndDone) {
     EXPECT_TRUE(b.done());
     ctx.run(5);
     EXPECT_EQ(b.groups()[0]->size(), 0u);
+    // Killed in the frame it is made: its burst at 0 (now) never fires.
+    EffectInstance c = fx.instantiate(ctx, "c");
+    c.kill();
+    ctx.step();
+    EXPECT_EQ(c.groups()[0]->size(), 0u);
+    EXPECT_TRUE(c.done());
     EXPECT_THROW(EffectInstance().done(), Error);
   }
 }

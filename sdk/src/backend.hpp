@@ -55,9 +55,9 @@ void emitNewborns(GroupImpl& group, const StepParams& params);
 bool mayEmit(const GroupImpl& group, const StepParams& params);
 /// Whether they could ever give birth again after time `at` (mayEmit over (at, infinity)).
 bool mayEverEmit(const GroupImpl& group, double at);
-/// Stops every emitter and prime emitter of the group at time `at` (stop = min(stop, at), the
-/// frame's own copies too): nothing is born after it. With `showers`, the live emitters that
-/// prime emitters spawned go too; else they live out their lives.
+/// Stops every emitter and prime emitter of the group at time `at` (the frame's own copies
+/// too): nothing is born from `at` on, a burst due at `at` included. With `showers`, the live
+/// emitters that prime emitters spawned go too; else they live out their lives.
 void stopEmitting(GroupImpl& group, double at, bool showers);
 /// Fills the act pass's holes with the live particles at the tail, so [0, size) is dense
 /// again.

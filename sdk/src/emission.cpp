@@ -354,7 +354,13 @@ bool mayEverEmit(const GroupImpl& g, double at) {
 }
 
 void stopEmitting(GroupImpl& g, double at, bool showers) {
-  auto stop = [at](auto& e) { e.stop = std::min(e.stop, at); };
+  // Just before `at`, as a burst at `stop` itself still fires (one an instance made this
+  // frame has at `at`); never before the start, and bursts not yet begun are dropped.
+  const double before = std::nextafter(at, -std::numeric_limits<double>::infinity());
+  auto stop = [&](auto& e) {
+    e.stop = std::max(e.start, std::min(e.stop, before));
+    std::erase_if(e.bursts, [&](const Burst& b) { return b.time >= at; });
+  };
   for (Emitter& e : g.emitters) stop(e);
   for (PrimeEmitter& p : g.primes) stop(p);
   if (g.frame) {
@@ -365,8 +371,11 @@ void stopEmitting(GroupImpl& g, double at, bool showers) {
     g.live.clear();
     std::fill(g.primeLive.begin(), g.primeLive.end(), 0u);
   }
-  ++g.emittersVersion;  // the device's tables, the world emitters: derived again
-  if (g.frame) g.frame->emittersDerived = g.emittersVersion;
+  // Both copies are stopped: the world ones need no deriving again, unless edits to the
+  // frame's were pending already.
+  const bool derived = g.frame && g.frame->emittersDerived == g.emittersVersion;
+  ++g.emittersVersion;  // the device's tables: built again
+  if (derived) g.frame->emittersDerived = g.emittersVersion;
 }
 
 // Live emitters that died this step go after their last births are written.

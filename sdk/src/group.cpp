@@ -776,7 +776,9 @@ const GroupStats& Group::stats() const {
 
 detail::PassScratchUse::PassScratchUse(GroupImpl& group) {
   thread_local PassScratch mine;
-  threads_ = !mine.busy;
+  // A large group keeps its own (freed with it): a thread's stays the size of a small one.
+  constexpr std::size_t kThreadsMost = 32768;
+  threads_ = !mine.busy && group.capacity <= kThreadsMost;
   if (threads_) {
     mine.busy = true;
     scratch_ = &mine;

@@ -165,9 +165,10 @@ void assignFill(std::vector<std::uint32_t>& v, std::size_t n, std::uint32_t valu
 void assignFill(std::vector<float>& v, std::size_t n, float value);
 
 /// What one step of the CPU pass writes and reads again before it returns: its dead (index
-/// and cause, per block) and per-block tallies and bounds. Held by the thread that steps a
-/// group, not by the group: a game's thousands of small groups share their thread's, in
-/// cache, where each of its own would be cold by its next step. Grows, never shrinks.
+/// and cause, per block) and per-block tallies and bounds. A small group's (capacity up to
+/// 32,768) is held by the thread that steps it: a game's thousands of small groups share
+/// their thread's, in cache, where each of its own would be cold by its next step. A large
+/// group keeps its own, freed with it. Grows, never shrinks.
 struct PassScratch {
   std::vector<std::uint32_t> deadIndex;    ///< per block: [block*B, block*B + deadCount[block])
   std::vector<std::uint8_t> deadCode;      ///< 1 + index of the action that killed
@@ -183,8 +184,9 @@ struct PassScratch {
 };
 
 struct GroupImpl;
-/// The calling thread's PassScratch for one step of `group` (its own while the thread's is in
-/// use: a Callback that steps a group). Out of line in group.cpp for the reason of assignFill.
+/// The calling thread's PassScratch for one step of `group` (the group's own when it is
+/// large, or while the thread's is in use). Out of line in group.cpp for the reason of
+/// assignFill.
 class PassScratchUse {
  public:
   explicit PassScratchUse(GroupImpl& group);
@@ -267,7 +269,7 @@ struct GroupImpl {
   GroupStats stats;
   std::uint32_t nextId = 0;
 
-  /// The pass's scratch while this thread's own is in use (a step within a step): see
+  /// The pass's scratch of a large group, or of any while the thread's is in use: see
   /// PassScratchUse.
   std::unique_ptr<PassScratch> ownScratch;
   std::size_t deathsPerStep = 0;  ///< Group::recordDeaths; 0: not recording

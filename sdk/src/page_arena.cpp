@@ -12,7 +12,7 @@ namespace flurry::detail {
 
 namespace {
 
-constexpr std::size_t kPage = std::size_t(2) << 20;
+[[maybe_unused]] constexpr std::size_t kPage = std::size_t(2) << 20;
 constexpr std::size_t kLine = 64;
 
 #if defined(__SANITIZE_ADDRESS__)
@@ -31,7 +31,7 @@ struct Arena {
   std::vector<void*> pages;  ///< all of them, kept for the process's life
 };
 
-Arena& arena() {
+[[maybe_unused]] Arena& arena() {
   // Never destroyed: groups of a static Context may give pieces back after static teardown.
   static Arena* a = new Arena;
   return *a;

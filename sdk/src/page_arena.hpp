@@ -17,8 +17,9 @@ inline constexpr std::size_t kArenaMostBytes = std::size_t(64) << 10;
 /// rounded size freed before, or the next one of a 2 MiB page (madvise'd for a huge page).
 /// Throws std::bad_alloc when no page can be had. Thread-safe.
 void* arenaAllocate(std::size_t bytes);
-/// Gives back a piece of `bytes` that arenaAllocate returned, for reuse by a piece of that
-/// size (the pages themselves stay with the process, as the heap's do).
+/// Gives back a piece of `bytes` that arenaAllocate returned, for reuse by a piece of the
+/// same rounded size only: the pages stay with the process, so its peak use of each size
+/// stays too (groups of a few capacities, as a game's effects have, reuse theirs).
 void arenaFree(void* piece, std::size_t bytes) noexcept;
 
 }  // namespace flurry::detail
