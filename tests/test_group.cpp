@@ -1664,6 +1664,141 @@ TEST(Instance, StopKillAndDone) {
   }
 }
 
+// restart() starts an instance over: everything removed, its emitters and Explosion as built
+// (the stop undone), their times from now: it emits step for step as an instance made then.
+TEST(Instance, RestartStartsItOverFromNow) {
+  const Effect fx = parseEffect(R"({"name": "pop", "dt": 0.05,
+    "groups": [{"name": "pop", "capacity": 2000,
+      "emitters": [{"rate": 30, "stop": 1.02, "bursts": [{"time": 0, "count": 40},
+                    {"time": 0.51, "count": 9}], "types": [{"lifetime": 0.7}]}],
+      "primeEmitters": [{"rate": 3, "stop": 1.02, "child": {"lifetime": 0.3,
+                         "emitter": {"rate": 20, "types": [{"lifetime": 0.2}]}}}],
+      "actions": [{"type": "Explosion", "time": 0.26}, {"type": "Move"},
+                  {"type": "KillOld"}]}]})");
+  for (unsigned threads : {1u, 2u}) {
+    ContextOptions o = fx.contextOptions();
+    o.threads = threads;
+    Context ctx(o);
+    EffectInstance a = fx.instantiate(ctx, "a");
+    a.setTransform({Vec3(2, 0, 0), glm::quat(1, 0, 0, 0), 1.0f});
+    ctx.run(12);
+    a.stop();
+    ctx.run(40);  // 2.6 s: everything dead
+    ASSERT_TRUE(a.done());
+    Group& g = *a.groups()[0];
+    const std::uint64_t before = g.stats().emitted;
+    a.restart();
+    EXPECT_FALSE(a.done());
+    EffectInstance fresh = fx.instantiate(ctx, "fresh");
+    fresh.setTransform(a.transform());
+    Group& f = *fresh.groups()[0];
+    EXPECT_EQ(std::get<Explosion>(g.actions().actions()[0]).time,
+              std::get<Explosion>(f.actions().actions()[0]).time);
+    for (int step = 0; step < 30; ++step) {
+      ctx.step();
+      ASSERT_EQ(g.stats().emitted - before, f.stats().emitted) << step;
+      ASSERT_EQ(g.size(), f.size()) << step;
+      ASSERT_EQ(g.liveEmitterCount(), f.liveEmitterCount()) << step;
+    }
+    EXPECT_GE(f.stats().emitted, 40u + 9u + 30u);  // both bursts, the rate, the showers
+    // Restarted while it runs: the live particles go at once.
+    a.restart();
+    EXPECT_EQ(g.size(), 0u);
+    EXPECT_EQ(g.liveEmitterCount(), 0u);
+    ctx.step();
+    EXPECT_GE(g.size(), 40u);
+    EXPECT_THROW(EffectInstance().restart(), Error);
+  }
+}
+
+// A time scale runs an instance's clock at its own rate: at 0.5 it goes as a context of half
+// the step does (its emitters, Explosion's time and ages read its clock), at 0 it stands
+// still, and stop() and done() read its clock, not the context's.
+TEST(Instance, ATimeScaleRunsItsOwnClock) {
+  const Effect fx = parseEffect(R"({"name": "slow", "dt": 0.05,
+    "groups": [{"name": "slow", "capacity": 2000,
+      "emitters": [{"rate": 7, "bursts": [{"time": 0.71, "count": 20}],
+                    "types": [{"lifetime": 3, "velocity": {"type": "sphere",
+                      "center": [0, 2, 0], "outerRadius": 1}}]}],
+      "actions": [{"type": "Gravity"}, {"type": "Explosion", "time": 0.31, "center": [0, 1, 0]},
+                  {"type": "Move"}, {"type": "KillOld"}]}]})");
+  ContextOptions o = fx.contextOptions();
+  o.threads = 1;
+  ContextOptions half = o;
+  half.dt = o.dt / 2;
+  Context game(o), reference(half);
+  EffectInstance slow = fx.instantiate(game, "a");
+  EffectInstance byHand = fx.instantiate(reference, "a");
+  Group& g = *slow.groups()[0];
+  Group& r = *byHand.groups()[0];
+  EXPECT_EQ(slow.setTimeScale(0.5).timeScale(), 0.5);
+  for (int step = 0; step < 40; ++step) {
+    game.step();
+    reference.step();
+    ASSERT_EQ(g.stats().emitted, r.stats().emitted) << step;
+    ASSERT_EQ(g.size(), r.size()) << step;
+  }
+  EXPECT_NEAR(game.time(g), 1.0, 1e-12);
+  EXPECT_NEAR(game.time(), 2.0, 1e-12);
+  EXPECT_GE(g.stats().emitted, 20u + 7u);  // the burst at 0.71 s of its own clock fired
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const Particle p = g.particle(i), q = r.particle(i);
+    ASSERT_EQ(p.id, q.id);
+    EXPECT_NEAR(glm::length(p.position - q.position), 0.0f, 1e-4f) << i;
+    EXPECT_NEAR(p.age, q.age, 1e-5f) << i;
+  }
+  // Paused: nothing moves, ages or is born, and its clock stands.
+  const auto before = allLanes(g);
+  const std::uint64_t emitted = g.stats().emitted;
+  slow.setTimeScale(0.0);
+  game.run(10);
+  EXPECT_EQ(allLanes(g), before);
+  EXPECT_EQ(g.stats().emitted, emitted);
+  EXPECT_NEAR(game.time(g), 1.0, 1e-12);
+  slow.setTimeScale(1.0);
+  game.run(3);  // to 1.15 s: the rate's 8th birth, at 8/7 s
+  EXPECT_NEAR(game.time(g), 1.15, 1e-12);
+  EXPECT_GT(g.stats().emitted, emitted);
+  EXPECT_THROW(slow.setTimeScale(-1.0), InvalidArgument);
+  EXPECT_THROW(slow.setTimeScale(std::nan("")), InvalidArgument);
+  EXPECT_THROW(reference.time(g), InvalidArgument);
+
+  // stop() at the instance's own time: a burst later on its clock (but earlier on the
+  // context's) never fires.
+  Context ctx(o);
+  EffectInstance late = fx.instantiate(ctx, "late");
+  late.setTimeScale(0.5);
+  ctx.run(20);  // 1 s of the game, 0.5 s of the instance
+  late.stop();
+  const std::uint64_t atStop = late.groups()[0]->stats().emitted;
+  ctx.run(40);
+  EXPECT_EQ(late.groups()[0]->stats().emitted, atStop);
+  EXPECT_FALSE(late.done());  // its particles live 3 s of its clock
+}
+
+// A seed gives an instance its own random numbers: two instances with one seed draw alike
+// whatever the context's seed and the order they were made in, and another seed differs.
+TEST(Instance, ASeedMakesItsOwnRandomNumbers) {
+  const Effect fx = dropEffect("world");
+  ContextOptions o1 = fx.contextOptions(), o2 = fx.contextOptions();
+  o1.seed = 1;
+  o2.seed = 2;
+  Context c1(o1), c2(o2);
+  EffectInstance a = fx.instantiate(c1, "a");
+  fx.instantiate(c2, "first");  // another index before it
+  EffectInstance b = fx.instantiate(c2, "b");
+  EffectInstance c = fx.instantiate(c2, "c");
+  a.setSeed(42);
+  b.setSeed(42);
+  c.setSeed(43);
+  c1.run(20);
+  c2.run(20);
+  ASSERT_GT(a.groups()[0]->size(), 0u);
+  EXPECT_EQ(allLanes(*a.groups()[0]), allLanes(*b.groups()[0]));
+  EXPECT_NE(allLanes(*a.groups()[0]), allLanes(*c.groups()[0]));
+  EXPECT_THROW(a.groups()[0]->setSeed(1, 65536), InvalidArgument);
+}
+
 TEST(Instance, TheEffectFileSaysItsSpace) {
   EXPECT_EQ(dropEffect("local").space, Space::Local);
   EXPECT_EQ(dropEffect("world").space, Space::World);

@@ -263,21 +263,31 @@ detail::StepParams groupStep(const detail::StepParams& sp, const detail::GroupIm
                              double timeAtDtChange, std::uint64_t stepsSinceDtChange,
                              std::uint64_t extra) {
   const std::uint64_t ahead = gi.stepsAhead + extra;
-  if (ahead == 0) return sp;
   detail::StepParams r = sp;
-  r.step = sp.step + ahead;
-  r.time = std::isnan(gi.aheadSeconds) ? timeAtDtChange + double(stepsSinceDtChange + ahead) * sp.dt
-                                       : sp.time + gi.aheadSeconds + double(extra) * sp.dt;
+  if (gi.ownSeed) r.seed = gi.seed;
+  if (ahead > 0) {
+    r.step = sp.step + ahead;
+    r.time = std::isnan(gi.aheadSeconds)
+                 ? timeAtDtChange + double(stepsSinceDtChange + ahead) * sp.dt
+                 : sp.time + gi.aheadSeconds + double(extra) * sp.dt;
+  }
+  // Group::setTimeScale: from where its clock stood when it left the context's.
+  if (gi.ownsClock()) {
+    if (!std::isnan(gi.ownClock)) r.time = gi.ownClock + double(extra) * sp.dt * gi.timeScale;
+    r.dt = sp.dt * gi.timeScale;
+  }
   return r;
 }
 
 void stepGroup(detail::BackendImpl& backend, detail::GroupImpl& gi, const detail::StepParams& sp) {
-  gi.placeEmitters();
-  gi.ensureStorage();
-  gi.boundsValid = false;  // the CPU pass takes them again
   gi.deathEvents.clear();
   gi.collisionEvents.clear();
   gi.birthEvents.clear();
+  if (gi.ownsClock()) gi.ownClock = sp.time + sp.dt;
+  if (sp.dt == 0.0) return;  // paused (Group::setTimeScale(0)): nothing moves, ages or is born
+  gi.placeEmitters();
+  gi.ensureStorage();
+  gi.boundsValid = false;  // the CPU pass takes them again
   if (gi.stats.killedByAction.size() != gi.actions.size())
     gi.stats.killedByAction.assign(gi.actions.size(), 0);
   backend.step(gi, sp);
@@ -361,7 +371,8 @@ void Context::Impl::runDeathEmitters(std::span<Group* const> only) {
     for (std::size_t k = 0; k < gi.deathEmitters.size(); ++k) {
       // feedDeathEmitters found it; a step's Callback may have destroyed it since.
       const Group* source = sourceOf(gi, k);
-      if (source && in(source)) detail::emitFromDeaths(gi, k, *source->impl_, options.seed);
+      if (source && in(source))
+        detail::emitFromDeaths(gi, k, *source->impl_, gi.ownSeed ? gi.seed : options.seed);
     }
     // Under a budget, a DropOldest group makes room for these newborns too.
     if (gi.size > gi.keepAtMost) gi.dropOldest(gi.size - gi.keepAtMost, params());
@@ -452,6 +463,15 @@ std::uint64_t Context::prewarm(std::span<Group* const> groups, double seconds) {
 
 double Context::time() const {
   return impl_->time;
+}
+
+double Context::time(const Group& group) const {
+  const auto& all = impl_->groups;
+  if (std::none_of(all.begin(), all.end(), [&](const auto& g) { return g.get() == &group; }))
+    throw InvalidArgument("group", "not a group of this context");
+  return groupStep(impl_->params(), *group.impl_, impl_->timeAtDtChange, impl_->stepsSinceDtChange,
+                   0)
+      .time;
 }
 std::uint64_t Context::stepIndex() const {
   return impl_->step;

@@ -206,7 +206,7 @@ std::uint64_t spawn(GroupImpl& g, const StepParams& sp, std::uint32_t prime,
   std::uint64_t made = 0;
   for (; made < count && reserveLive(g, prime); ++made) {
     const std::uint32_t id = g.nextEmitterId++;
-    Random rng(sp.seed, id, g.index, stream::kEmitterEvent);
+    Random rng(sp.seed, id, g.streamKey(), stream::kEmitterEvent);
     LiveEmitter e;
     e.id = id;
     e.prime = prime;
@@ -484,7 +484,7 @@ void emitFrom(GroupImpl& g, std::size_t k, std::span<const Event> events, std::u
     if (de.cause >= 0 && d.action != std::uint32_t(de.cause)) continue;
     // How many, keyed by the event, this group and this emitter: two emitters fed by one
     // source draw apart.
-    Random counter(seed, d.key, g.index, stream::kDeathEmitter + std::uint32_t(k));
+    Random counter(seed, d.key, g.streamKey(), stream::kDeathEmitter + std::uint32_t(k));
     const float c = std::min(std::max(de.count.sample(counter), 0.0f), 1e6f);
     std::uint64_t n = std::uint64_t(c);
     if (counter.uniform() < c - float(n)) ++n;
@@ -503,7 +503,7 @@ void emitFrom(GroupImpl& g, std::size_t k, std::span<const Event> events, std::u
     for (std::uint64_t j = 0; j < n; ++j) {
       // A newborn's own stream, as an emitter's newborn has (ids never repeat in a group).
       const std::uint32_t id = g.nextId++;
-      Random rng(seed, id, g.index, stream::kEmission);
+      Random rng(seed, id, g.streamKey(), stream::kEmission);
       const ParticleType& type = de.types[chooseType(de.types, rng)];
       Particle p;
       p.position = d.position + de.shape.sample(rng);

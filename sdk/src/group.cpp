@@ -469,6 +469,25 @@ Space Group::space() const {
   return impl_->frame ? impl_->frame->space : Space::World;
 }
 
+Group& Group::setTimeScale(double scale) {
+  if (!std::isfinite(scale) || !(scale >= 0.0) || scale > 1000.0)
+    throw InvalidArgument("scale", "must be finite and 0 <= scale <= 1000");
+  impl_->timeScale = scale;
+  return *this;
+}
+
+double Group::timeScale() const {
+  return impl_->timeScale;
+}
+
+Group& Group::setSeed(std::uint64_t seed, std::uint32_t stream) {
+  if (stream > 0xFFFFu) throw InvalidArgument("stream", "must be < 65536");
+  impl_->ownSeed = true;
+  impl_->seed = seed;
+  impl_->stream = stream;
+  return *this;
+}
+
 namespace {
 // Prefetches [p, p + bytes), at most kMostPrefetched of it: the head of a large buffer (its
 // rest streams in by the hardware's own prefetch).
@@ -549,6 +568,22 @@ std::span<Emitter> Group::emitters() {
   ++impl_->emittersVersion;  // the caller may edit through the span
   if (impl_->frame) return impl_->frame->emitters;
   return impl_->emitters;
+}
+
+void detail::clearEmitters(GroupImpl& g) {
+  g.emitters.clear();
+  g.emitterState.clear();
+  g.primes.clear();
+  g.primeState.clear();
+  g.primeSpecs.clear();
+  g.live.clear();
+  g.primeLive.clear();
+  if (g.frame) {
+    g.frame->emitters.clear();
+    g.frame->primes.clear();
+  }
+  ++g.emittersVersion;
+  if (g.frame) g.frame->emittersDerived = g.emittersVersion;
 }
 
 void Group::removeEmitter(std::size_t i) {

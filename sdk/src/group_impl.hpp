@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -157,6 +158,19 @@ struct Frame {
   std::uint64_t emittersDerived = ~std::uint64_t(0);
 };
 
+/// What Effect::build gave a group, for EffectInstance::restart: its emitters, prime
+/// emitters and action list as built (in the group's frame), and when (on its clock).
+struct GroupOrigin {
+  double builtAt = 0.0;
+  std::vector<Emitter> emitters;
+  std::vector<PrimeEmitter> primes;
+  ActionList actions;
+};
+
+/// Removes every emitter and prime emitter, and the emitters they spawned (the frame's copies
+/// too): EffectInstance::restart then adds them anew.
+void clearEmitters(GroupImpl& g);
+
 /// v = n copies of `value`. Out of line in a baseline translation unit (group.cpp) for the
 /// code built once per instruction set (cpu/fused_pass.cpp): a std::vector member it
 /// instantiated itself would be a weak symbol, compiled with that set's instructions, which
@@ -213,6 +227,14 @@ struct GroupImpl {
 
   std::string name;
   std::uint32_t index = 0;  ///< creation order in the context: keeps groups' random streams apart
+  /// Group::setSeed: the seed and stream its draws take instead of the context's seed and
+  /// `index`.
+  bool ownSeed = false;
+  std::uint64_t seed = 0;
+  std::uint32_t stream = 0;
+  /// What keeps its random streams apart from other groups': `index`, or Group::setSeed's.
+  std::uint32_t streamKey() const { return ownSeed ? stream : index; }
+
   std::size_t capacity = 0;
   std::size_t size = 0;
   AttributeSet required{Attribute::Position, Attribute::Id};
@@ -236,6 +258,7 @@ struct GroupImpl {
   std::vector<LiveEmitter> live;         ///< grown only up to the primes' maxEmitters together
   std::vector<std::uint32_t> primeLive;  ///< live emitters of each prime emitter
   std::uint32_t nextEmitterId = 0;
+  std::shared_ptr<const GroupOrigin> origin;  ///< null unless Effect::build made it
   HairOptions hair;
   Strands strands;
   TrailOptions trail;
@@ -339,6 +362,11 @@ struct GroupImpl {
   /// NaN while the context's dt is the one the steps ahead were taken with; after a change of
   /// dt, the lead in seconds.
   double aheadSeconds = std::numeric_limits<double>::quiet_NaN();
+  /// Group::setTimeScale. Once it is not 1 the group keeps a clock of its own, `ownClock`
+  /// (where its next step starts; NaN until then), which each step moves by scale·dt.
+  double timeScale = 1.0;
+  double ownClock = std::numeric_limits<double>::quiet_NaN();
+  bool ownsClock() const { return timeScale != 1.0 || !std::isnan(ownClock); }
 
   /// Brings the live count and `attributes` (default: all; before the host writes, all) up
   /// to date on the host.

@@ -12,6 +12,9 @@ void simulateHair(GroupImpl& g, const StepParams& sp) {
   GroupImpl h;
   h.name = g.name;
   h.index = g.index;
+  h.ownSeed = g.ownSeed;  // its draws are the group's
+  h.seed = g.seed;
+  h.stream = g.stream;
   h.capacity = g.size;
   h.required = g.required;
   h.actions = g.actions;

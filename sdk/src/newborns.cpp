@@ -123,7 +123,7 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
   // newborn's values depend on its own draws only; the extra lanes are never stored.
   const std::size_t mv = std::min(kBatch, (m + 15) / 16 * 16);
   for (int blk = 0; blk * 4 < draws; ++blk)
-    uniformBatch(nc.sp.seed, firstId, nc.g.index, stream::kEmission, std::uint32_t(blk), mv,
+    uniformBatch(nc.sp.seed, firstId, nc.g.streamKey(), stream::kEmission, std::uint32_t(blk), mv,
                  rows[4 * blk], rows[4 * blk + 1], rows[4 * blk + 2], rows[4 * blk + 3]);
 
   int cur = 0;
@@ -213,7 +213,7 @@ void emitOneByOne(const NewbornContext& nc, const BirthRun& run, const Emitter& 
   std::size_t key = 0;  // the path's key the last birth found
   for (std::size_t k = 0; k < m; ++k) {
     const std::uint32_t id = nc.firstId + std::uint32_t(i0 + k);
-    Random rng(nc.sp.seed, id, nc.g.index, stream::kEmission);
+    Random rng(nc.sp.seed, id, nc.g.streamKey(), stream::kEmission);
     const ParticleType& type = em.types[chooseType(em.types, rng)];
     const double tb = birthTime(run, em, q0 + k);
     nc.remaining[i0 + k] = nc.left(tb);

@@ -833,10 +833,23 @@ static void test_instances(void) {
   OK(flurry_instance_kill(a));
   OK(flurry_instance_done(a, &empty));
   CHECK(empty == 1);
+  /* Restarted, its burst at 0 fires again (now), then it is killed once more. */
+  OK(flurry_instance_restart(a));
+  OK(flurry_context_step(ctx));
+  OK(flurry_instance_group_at(a, 0, &g));
+  OK(flurry_group_size(g, &n));
+  CHECK(n == 1);
+  OK(flurry_instance_kill(a));
+  FAILS(flurry_instance_restart(NULL), FLURRY_ERROR_NULL_ARGUMENT, "instance");
   OK(flurry_instance_group_at(a, 0, &g));
   OK(flurry_group_size(g, &n));
   CHECK(n == 0);
   FAILS(flurry_instance_done(a, NULL), FLURRY_ERROR_NULL_ARGUMENT, "done");
+  FAILS(flurry_instance_set_time_scale(a, -1.0), FLURRY_ERROR_INVALID_ARGUMENT, "scale");
+  FAILS(flurry_instance_set_time_scale(NULL, 1.0), FLURRY_ERROR_NULL_ARGUMENT, "instance");
+  FAILS(flurry_instance_set_seed(NULL, 1), FLURRY_ERROR_NULL_ARGUMENT, "instance");
+  OK(flurry_instance_set_time_scale(a, 0.5));
+  OK(flurry_instance_set_seed(a, 99));
   FAILS(flurry_instance_stop(NULL), FLURRY_ERROR_NULL_ARGUMENT, "instance");
   FAILS(flurry_instance_kill(NULL), FLURRY_ERROR_NULL_ARGUMENT, "instance");
   FAILS(flurry_instance_prewarm(b, -1, NULL), FLURRY_ERROR_INVALID_ARGUMENT, "seconds");

@@ -81,6 +81,33 @@ TEST(OpenCLCore, CallbackWithAnOpenCLBody) {
   expectSame(cpu, cl);
 }
 
+TEST(OpenCLCore, ACallbackWrittenOnceRunsOnBoth) {
+  // One FLURRY_CALLBACK body: C++ on the CPU, OpenCL C on the device, the same particles.
+  // Builtins with OpenCL's definitions (clamp, mix, step, min, max), <cmath>'s correctly
+  // rounded ones (sqrt, fmax), a comma in a declaration and a break.
+  const Callback cb = FLURRY_CALLBACK(
+      const float speed = sqrt(vx * vx + vy * vy + vz * vz), cap = 2.5f;
+      user += dt;
+      if (speed > cap) {
+        vx = vx * (cap / speed);
+        vz = vz * (cap / speed);
+      }
+      if (id % 3u == 1u) break;
+      vy += clamp(mix(0.0f, 1.0f, 0.5f), 0.0f, 0.25f) * step(2.0f, py) + fmax(min(py, 0.0f), -1.0f);
+      size = max(size, 0.02f););
+  auto build = [&cb](Context& ctx) -> Group& {
+    Group& g = ctx.createGroup("callback", 20000);
+    g.addEmitter(spray());
+    g.setActions({Gravity{kDown}, cb, Move{}, KillOld{}});
+    return g;
+  };
+  FLURRY_REQUIRE_OPENCL();
+  const RunResult cpu = runEffect(Backend::Cpu, build, kSteps);
+  const RunResult cl = runEffect(Backend::OpenCL, build, kSteps);
+  EXPECT_GT(cpu.stats.emitted, 0u);
+  expectSame(cpu, cl);
+}
+
 TEST(OpenCLCore, ACallbackWithoutAnOpenCLBodyIsRefusedByName) {
   FLURRY_REQUIRE_OPENCL();
   ContextOptions o;

@@ -349,10 +349,20 @@ FLURRY_C_EXPORT flurry_status flurry_instance_transform(const flurry_instance* i
  * groups); *steps (may be NULL) gets the steps taken. */
 FLURRY_C_EXPORT flurry_status flurry_instance_prewarm(flurry_instance* instance, double seconds,
                                                       uint64_t* steps);
+/** Runs the instance at `scale` times the context's time (finite, 0 <= scale <= 1000; 0
+ * pauses it): flurry::EffectInstance::setTimeScale. */
+FLURRY_C_EXPORT flurry_status flurry_instance_set_time_scale(flurry_instance* instance,
+                                                             double scale);
+/** Gives the instance its own random numbers (flurry::EffectInstance::setSeed): instances
+ * with one seed look alike wherever they are made. */
+FLURRY_C_EXPORT flurry_status flurry_instance_set_seed(flurry_instance* instance, uint64_t seed);
 /** Stops emitting now (flurry::EffectInstance::stop): the live particles live out their lives. */
 FLURRY_C_EXPORT flurry_status flurry_instance_stop(flurry_instance* instance);
 /** Stops emitting and removes every particle at once (the groups stay). */
 FLURRY_C_EXPORT flurry_status flurry_instance_kill(flurry_instance* instance);
+/** Starts the instance over now (flurry::EffectInstance::restart): everything removed, its
+ * emitters as the effect built them, their times counting from now. */
+FLURRY_C_EXPORT flurry_status flurry_instance_restart(flurry_instance* instance);
 /** *done = 1 when nothing of the instance lives and nothing can be born again (then
  * flurry_instance_destroy it), else 0. */
 FLURRY_C_EXPORT flurry_status flurry_instance_done(const flurry_instance* instance, int* done);

@@ -954,6 +954,18 @@ flurry_status flurry_instance_prewarm(flurry_instance* inst, double seconds, uin
     if (steps) *steps = n;
   });
 }
+flurry_status flurry_instance_set_time_scale(flurry_instance* inst, double scale) {
+  return guard([&] {
+    need(inst, "instance");
+    inst->instance.setTimeScale(scale);
+  });
+}
+flurry_status flurry_instance_set_seed(flurry_instance* inst, uint64_t seed) {
+  return guard([&] {
+    need(inst, "instance");
+    inst->instance.setSeed(seed);
+  });
+}
 flurry_status flurry_instance_stop(flurry_instance* inst) {
   return guard([&] {
     need(inst, "instance");
@@ -964,6 +976,12 @@ flurry_status flurry_instance_kill(flurry_instance* inst) {
   return guard([&] {
     need(inst, "instance");
     inst->instance.kill();
+  });
+}
+flurry_status flurry_instance_restart(flurry_instance* inst) {
+  return guard([&] {
+    need(inst, "instance");
+    inst->instance.restart();
   });
 }
 flurry_status flurry_instance_done(const flurry_instance* inst, int* done) {

@@ -679,9 +679,20 @@ NB_MODULE(_flurry, m) {
       .def(
           "kill", [](InstanceRef& pi) { pi.instance.kill(); },
           "Stops emitting and removes every particle at once (the groups stay).")
+      .def(
+          "restart", [](InstanceRef& pi) { pi.instance.restart(); },
+          "Starts it over now: everything removed, its emitters as the effect built them.")
       .def_prop_ro(
           "done", [](const InstanceRef& pi) { return pi.instance.done(); },
-          "True when nothing of it lives and nothing can be born again.");
+          "True when nothing of it lives and nothing can be born again.")
+      .def_prop_rw(
+          "time_scale", [](const InstanceRef& pi) { return pi.instance.timeScale(); },
+          [](InstanceRef& pi, double scale) { pi.instance.setTimeScale(scale); },
+          "How fast the instance runs against the context's time (0 pauses it).")
+      .def(
+          "set_seed", [](InstanceRef& pi, std::uint64_t seed) { pi.instance.setSeed(seed); },
+          "seed"_a,
+          "Gives the instance its own random numbers: instances with one seed look alike.");
 
   m.def(
       "load",

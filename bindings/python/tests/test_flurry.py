@@ -340,6 +340,27 @@ def test_an_instance_stops_and_is_done_when_its_particles_are():
     ctx.step(10)
     other.kill()
     assert len(other.groups[0]) == 0 and other.done
+    torch.restart()
+    ctx.step(10)
+    assert len(flames) > 0 and not torch.done
+
+
+def test_instances_with_one_seed_look_alike_and_a_paused_one_stands_still():
+    effect = flurry.Effect.parse(json.dumps(_TORCH))
+    ctx = flurry.Context(threads=1)
+    a, b, c = (effect.instantiate(ctx, n) for n in "abc")
+    a.set_seed(5)
+    b.set_seed(5)
+    c.set_seed(6)
+    ctx.step(10)
+    pa, pb, pc = (i.groups[0].lane("position", 1).copy() for i in (a, b, c))
+    assert len(pa) > 0 and np.array_equal(pa, pb) and not np.array_equal(pa, pc)
+    assert a.time_scale == 1.0
+    a.time_scale = 0.0
+    ctx.step(5)
+    assert np.array_equal(a.groups[0].lane("position", 1), pa)  # paused
+    with pytest.raises(flurry.InvalidArgument):
+        a.time_scale = -1.0
 
 
 def test_deaths_are_recorded_with_what_killed_them():

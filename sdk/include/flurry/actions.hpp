@@ -341,13 +341,13 @@ struct CallbackContext {
 ///
 /// On the OpenCL backend `opencl` holds OpenCL C statements run for each particle inside the
 /// fused kernel; without it the list cannot run there. They see the attributes named in
-/// `attributes` as variables: position px py pz, velocity vx vy vz, color r g b a, size,
-/// mass, age, life (lifetime), id (read only), prevx prevy prevz, upx upy upz, rotx roty rotz
-/// (angular velocity), charge, vis (visible, uint), user (user data), pbx pby pbz
-/// (PositionB), vbx vby vbz (VelocityB), birthr birthg birthb birtha (BirthColor), birthsize
-/// (BirthSize); and float dt, time (the step's start). For example
-/// `"user += dt; if (py > 2.0f) vx += 0.5f;"`. `break` ends the callback; `return` is not
-/// allowed (it would leave the whole kernel).
+/// `attributes` by the variables flurry::kCallbackVariables lists (px py pz, vx vy vz, ...,
+/// id read only, vis a uint), float dt and time (the step's start, a double where the
+/// device has doubles). `break` ends the callback; `return` is not allowed (it would leave
+/// the whole kernel).
+///
+/// Written once for both: FLURRY_CALLBACK(statements) (flurry/callback.hpp) makes the C++
+/// function and the OpenCL C text from one body, and the attributes from the names it uses.
 struct Callback {
   std::function<void(Particle&, const CallbackContext&)> function;
   AttributeSet attributes{Attribute::Position, Attribute::Velocity};

@@ -107,6 +107,10 @@ class Context {
   std::uint64_t prewarm(std::span<Group* const> groups, double seconds);
 
   double time() const;
+  /// The time on `group`'s own clock, where its next step starts: time() unless the group
+  /// runs ahead (prewarm) or at another rate (Group::setTimeScale). Throws InvalidArgument
+  /// "group" for a group of another context.
+  double time(const Group& group) const;
   std::uint64_t stepIndex() const;
   double timeStep() const;
   /// Throws InvalidArgument "dt" unless 0 < dt <= 10 and finite.

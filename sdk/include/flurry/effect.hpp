@@ -128,13 +128,26 @@ class EffectInstance {
   /// The box of every live particle of the instance, in the world: the union of its groups'
   /// Group::bounds() (kept by the CPU pass every step once asked). Empty when none lives.
   Bounds bounds() const;
-  /// Stops emitting now (every emitter's and prime emitter's stop becomes the context's
-  /// time): the live particles, and the showers prime emitters launched, live out their
-  /// lives. A one-shot effect a game lets finish.
+  /// Runs the instance at `scale` times the game's time (slow motion, a paused effect at 0):
+  /// Group::setTimeScale of every group. Throws InvalidArgument "scale".
+  EffectInstance& setTimeScale(double scale);
+  double timeScale() const;
+  /// Gives the instance its own random numbers: group k of the effect draws from (seed, k)
+  /// (Group::setSeed), so two instances with one seed look alike wherever they are made
+  /// (a replay), and a seed per instance tells them apart. From the next step on.
+  EffectInstance& setSeed(std::uint64_t seed);
+  /// Stops emitting now (every emitter's and prime emitter's stop becomes the time on its
+  /// group's clock, Context::time(group)): the live particles, and the showers prime emitters
+  /// launched, live out their lives. A one-shot effect a game lets finish.
   void stop();
   /// Stops emitting and removes every particle and shower at once (the groups stay; their
   /// stats are kept).
   void kill();
+  /// Starts it over now: kill(), then its emitters, prime emitters and action list as the
+  /// effect built them (before any stop() or edit), their times counting from now on each
+  /// group's clock: bursts at 0 fire again, a rate starts with no backlog. The transform,
+  /// time scale, seed and stats stay. A pooled one-shot effect a game fires again.
+  void restart();
   /// True when nothing of it lives and nothing can be born again: a game may destroy() it.
   bool done() const;
   /// Destroys its groups (Context::destroyGroup); the handle is empty after.

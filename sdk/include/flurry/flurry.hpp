@@ -3,6 +3,7 @@
 
 #include "flurry/actions.hpp"
 #include "flurry/attribute.hpp"
+#include "flurry/callback.hpp"
 #include "flurry/context.hpp"
 #include "flurry/domain.hpp"
 #include "flurry/emitter.hpp"

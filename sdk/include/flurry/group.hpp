@@ -199,6 +199,20 @@ class Group {
   Group& setSpace(Space space);
   Space space() const;
 
+  /// Runs the group's clock at `scale` times the context's (an effect instance's slowed or
+  /// hastened: EffectInstance::setTimeScale), from the next step on: each step then takes
+  /// scale·timeStep() seconds of its own clock (Context::time(group)), which its emitters,
+  /// Explosion's time and Restore's start read. 0 pauses it: nothing moves, ages or is born
+  /// until the scale is raised again. Throws InvalidArgument "scale" unless finite and
+  /// 0 <= scale <= 1000.
+  Group& setTimeScale(double scale);
+  double timeScale() const;
+  /// Draws the group's random numbers from `seed` and `stream` (< 65536) instead of the
+  /// context's seed and the group's index, from the next step on: groups given the same two
+  /// draw alike whichever context and order made them (a replay, a seeded instance:
+  /// EffectInstance::setSeed). Throws InvalidArgument "stream" past 65535.
+  Group& setSeed(std::uint64_t seed, std::uint32_t stream = 0);
+
   /// Adds an emitter (validated: throws InvalidArgument naming the bad field).
   Emitter& addEmitter(Emitter emitter);
   /// The emitters as given (in the group's frame once it has a transform); edits through the

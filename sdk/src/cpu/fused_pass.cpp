@@ -513,7 +513,7 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
     }
   }
   const float subDt = float(sp.dt / plan.substeps);
-  cpu::BlockContext base{subDt, sp.seed, std::uint32_t(sp.step), g.index << 16, 0, nullptr};
+  cpu::BlockContext base{subDt, sp.seed, std::uint32_t(sp.step), g.streamKey() << 16, 0, nullptr};
   base.time = sp.time;
   base.firstBlocker = plan.list.firstBlocker;
   // Actions that read other particles read them as they were at the start of the step, so

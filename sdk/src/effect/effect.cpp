@@ -1159,7 +1159,10 @@ std::vector<Group*> Effect::build(Context& ctx, std::size_t maxCapacity,
       const std::size_t cap = maxCapacity > 0 ? std::min(eg.capacity, maxCapacity) : eg.capacity;
       Group& g =
           ctx.createGroup(instance.empty() ? eg.name : eg.name + "@" + std::string(instance), cap);
-      g.setActions(t0 == 0.0 ? eg.actions : delayedActions(eg.actions, t0));
+      auto origin = std::make_shared<detail::GroupOrigin>();
+      origin->builtAt = t0;
+      origin->actions = t0 == 0.0 ? eg.actions : delayedActions(eg.actions, t0);
+      g.setActions(origin->actions);
       if (eg.hair.enabled) g.setHair(eg.hair);
       if (eg.trail.length > 0) g.setTrail(eg.trail);
       g.setBudgetPolicy(eg.budget);
@@ -1167,12 +1170,13 @@ std::vector<Group*> Effect::build(Context& ctx, std::size_t maxCapacity,
       if (space == Space::Local) g.setSpace(Space::Local);
       for (Emitter e : eg.emitters) {
         delayTimes(e, t0);
-        g.addEmitter(std::move(e));
+        origin->emitters.push_back(g.addEmitter(std::move(e)));
       }
       for (PrimeEmitter p : eg.primeEmitters) {
         delayTimes(p, t0);
-        g.addPrimeEmitter(std::move(p));
+        origin->primes.push_back(g.addPrimeEmitter(std::move(p)));
       }
+      detail::implOf(g).origin = std::move(origin);
       for (DeathEmitter de : eg.deathEmitters) {
         if (!instance.empty()) (de.source += '@') += instance;  // its own instance's
         g.addDeathEmitter(std::move(de));
@@ -1227,24 +1231,65 @@ std::uint64_t EffectInstance::prewarm(double seconds) {
   return context_->prewarm(groups_, seconds);
 }
 
+EffectInstance& EffectInstance::setTimeScale(double scale) {
+  if (!context_) throw Error("setTimeScale: an empty EffectInstance (use Effect::instantiate)");
+  for (Group* g : groups_) g->setTimeScale(scale);  // the first refuses a bad scale
+  return *this;
+}
+
+double EffectInstance::timeScale() const {
+  return groups_.empty() ? 1.0 : groups_.front()->timeScale();
+}
+
+EffectInstance& EffectInstance::setSeed(std::uint64_t seed) {
+  if (!context_) throw Error("setSeed: an empty EffectInstance (use Effect::instantiate)");
+  for (std::size_t k = 0; k < groups_.size(); ++k) groups_[k]->setSeed(seed, std::uint32_t(k));
+  return *this;
+}
+
 void EffectInstance::stop() {
   if (!context_) throw Error("stop: an empty EffectInstance (use Effect::instantiate)");
-  for (Group* g : groups_) detail::stopEmitting(detail::implOf(*g), context_->time(), false);
+  for (Group* g : groups_) detail::stopEmitting(detail::implOf(*g), context_->time(*g), false);
 }
 
 void EffectInstance::kill() {
   if (!context_) throw Error("kill: an empty EffectInstance (use Effect::instantiate)");
   for (Group* g : groups_) {
-    detail::stopEmitting(detail::implOf(*g), context_->time(), true);
+    detail::stopEmitting(detail::implOf(*g), context_->time(*g), true);
     g->clear();
+  }
+}
+
+void EffectInstance::restart() {
+  if (!context_) throw Error("restart: an empty EffectInstance (use Effect::instantiate)");
+  kill();
+  for (Group* g : groups_) {
+    detail::GroupImpl& gi = detail::implOf(*g);
+    if (!gi.origin) continue;
+    // The effect's times as built, moved on to now on the group's clock.
+    const auto& origin = gi.origin;
+    const double now = context_->time(*g), shift = now - origin->builtAt;
+    detail::clearEmitters(gi);
+    for (Emitter e : origin->emitters) {
+      delayTimes(e, shift);
+      g->addEmitter(std::move(e));
+    }
+    for (PrimeEmitter p : origin->primes) {
+      delayTimes(p, shift);
+      g->addPrimeEmitter(std::move(p));
+    }
+    const auto& acts = origin->actions.actions();
+    if (std::any_of(acts.begin(), acts.end(), [](const Action& a) {
+          return std::holds_alternative<Explosion>(a) || std::holds_alternative<Restore>(a);
+        }))
+      g->setActions(delayedActions(origin->actions, shift));
   }
 }
 
 bool EffectInstance::done() const {
   if (!context_) throw Error("done: an empty EffectInstance (use Effect::instantiate)");
-  // From the context's clock: a prewarmed group is ahead of it, so this errs on "not yet".
   return std::all_of(groups_.begin(), groups_.end(), [&](const Group* g) {
-    return g->size() == 0 && !detail::mayEverEmit(detail::implOf(*g), context_->time());
+    return g->size() == 0 && !detail::mayEverEmit(detail::implOf(*g), context_->time(*g));
   });
 }
 

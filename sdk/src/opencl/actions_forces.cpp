@@ -38,7 +38,7 @@ cl::FlDomain packSampled(const Domain& d, ActionPack& p) {
 
 // The random-stream arguments the fl_* functions take after the lanes.
 std::string rngArgs(const ActionSource& s) {
-  return "id, seedLo, seedHi, step, " + s.in.stream;
+  return "id, seedLo, seedHi, fl_step, " + s.in.stream;
 }
 
 std::string call(const std::string& fn, const std::string& args) {

@@ -524,7 +524,7 @@ void ClGroup::queueHair(GroupImpl& g, const StepParams& sp, std::size_t births) 
   setArg(k, i++, cl_uint(sp.seed));
   setArg(k, i++, cl_uint(sp.seed >> 32));
   setArg(k, i++, cl_uint(sp.step));
-  setArg(k, i++, cl_uint(g.index << 16));
+  setArg(k, i++, cl_uint(g.streamKey() << 16));
   setArg(k, i++, cl_uint(stepSubsteps(g.actions, sp.dt)));
   setArg(k, i++, cl_uint(0));
   setArg(k, i++, cl_uint(g.hair.every));
@@ -773,7 +773,7 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
       setArg(k, i++, seedLo);
       setArg(k, i++, seedHi);
     }
-    setArg(k, i++, cl_uint(g.index));
+    setArg(k, i++, cl_uint(g.streamKey()));
   };
   // A small group's step is one launch (fl_small) when its program has it.
   const std::size_t tiles = (nBound + FL_TILE - 1) / FL_TILE;
@@ -830,7 +830,7 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     setArg(k, i++, seedLo);
     setArg(k, i++, seedHi);
     setArg(k, i++, cl_uint(sp.step));
-    setArg(k, i++, cl_uint(g.index << 16));
+    setArg(k, i++, cl_uint(g.streamKey() << 16));
     setArg(k, i++, cl_uint(stepSubsteps(g.actions, sp.dt)));
     setArg(k, i++, cl_uint(g.capacity));
     setArg(k, i++, tau_.get());

@@ -9,6 +9,7 @@
 
 #include "../action_traits.hpp"
 #include "../shape_math.hpp"
+#include "flurry/callback.hpp"
 #include "flurry/error.hpp"
 
 namespace flurry::detail::ocl {
@@ -32,30 +33,29 @@ namespace {
 struct AttrInfo {
   Attribute attribute;
   const char* macro;  // FL_HAS_<macro>
-  const char* names[4];
   bool isUint;
 };
 
-// The canonical lane order and names; emit.cl uses these names.
+// The canonical lane order; the lanes are named by kCallbackVariables (emit.cl uses them).
 constexpr AttrInfo kAttrs[] = {
-    {Attribute::Position, "POSITION", {"px", "py", "pz"}, false},
-    {Attribute::Velocity, "VELOCITY", {"vx", "vy", "vz"}, false},
-    {Attribute::Color, "COLOR", {"r", "g", "b", "a"}, false},
-    {Attribute::Size, "SIZE", {"size"}, false},
-    {Attribute::Mass, "MASS", {"mass"}, false},
-    {Attribute::Age, "AGE", {"age"}, false},
-    {Attribute::Lifetime, "LIFETIME", {"life"}, false},
-    {Attribute::Id, "ID", {"id"}, true},
-    {Attribute::PrevPosition, "PREV_POSITION", {"prevx", "prevy", "prevz"}, false},
-    {Attribute::Up, "UP", {"upx", "upy", "upz"}, false},
-    {Attribute::RotVelocity, "ROT_VELOCITY", {"rotx", "roty", "rotz"}, false},
-    {Attribute::Charge, "CHARGE", {"charge"}, false},
-    {Attribute::Visible, "VISIBLE", {"vis"}, true},
-    {Attribute::UserData, "USER_DATA", {"user"}, false},
-    {Attribute::PositionB, "POSITION_B", {"pbx", "pby", "pbz"}, false},
-    {Attribute::VelocityB, "VELOCITY_B", {"vbx", "vby", "vbz"}, false},
-    {Attribute::BirthColor, "BIRTH_COLOR", {"birthr", "birthg", "birthb", "birtha"}, false},
-    {Attribute::BirthSize, "BIRTH_SIZE", {"birthsize"}, false},
+    {Attribute::Position, "POSITION", false},
+    {Attribute::Velocity, "VELOCITY", false},
+    {Attribute::Color, "COLOR", false},
+    {Attribute::Size, "SIZE", false},
+    {Attribute::Mass, "MASS", false},
+    {Attribute::Age, "AGE", false},
+    {Attribute::Lifetime, "LIFETIME", false},
+    {Attribute::Id, "ID", true},
+    {Attribute::PrevPosition, "PREV_POSITION", false},
+    {Attribute::Up, "UP", false},
+    {Attribute::RotVelocity, "ROT_VELOCITY", false},
+    {Attribute::Charge, "CHARGE", false},
+    {Attribute::Visible, "VISIBLE", true},
+    {Attribute::UserData, "USER_DATA", false},
+    {Attribute::PositionB, "POSITION_B", false},
+    {Attribute::VelocityB, "VELOCITY_B", false},
+    {Attribute::BirthColor, "BIRTH_COLOR", false},
+    {Attribute::BirthSize, "BIRTH_SIZE", false},
 };
 
 const AttrInfo& info(Attribute a) {
@@ -90,7 +90,7 @@ std::vector<LaneRef> lanesOf(AttributeSet stored) {
   for (const auto& i : kAttrs)
     if (stored.has(i.attribute))
       for (int c = 0; c < componentCount(i.attribute); ++c)
-        out.push_back({i.attribute, c, i.names[c]});
+        out.push_back({i.attribute, c, kCallbackVariables[std::size_t(i.attribute)][c].data()});
   return out;
 }
 
@@ -373,7 +373,7 @@ std::string hairKernel(const std::string& stepCode, const std::vector<LaneRef>& 
        "  fl_real t0 = fl_real_from_bits(timeBits);\n"
        "  uint alive = 1u;\n"
        "  for (uint k = 1u; k <= maxSteps; ++k) {\n"
-       "    const uint step = step0 + (k - 1u);\n"
+       "    const uint fl_step = step0 + (k - 1u);\n"
        "    uint killed;\n"
        "    {\n"
        "      const fl_real fl_len = fl_real_from_bits(dtBits), fl_t0 = t0;\n"
@@ -746,7 +746,7 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
       "__global uchar* restrict codes, __global const FlActionParams* restrict ap,\n"
       "    __global uint* state, __global const float* restrict extra,\n"
       "    __global const float* restrict snap, ulong dtBits, ulong timeBits, uint seedLo,\n"
-      "    uint seedHi, uint step, uint streamBase, uint nsubStep, uint snapStride,\n"
+      "    uint seedHi, uint fl_step, uint streamBase, uint nsubStep, uint snapStride,\n"
       "    __global float* restrict tau, uint births, uint capacity, ulong t1Bits,\n"
       "    uint reachOff";
   // [0, n0) lived before the step, [n0, n) are its newborns (fl_birth wrote them).
@@ -755,7 +755,7 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
       "  const uint n = fl_step_range(state, births, capacity);\n"
       "  const uint snapN = n;\n"
       "  (void)extra; (void)snap; (void)snapN; (void)snapStride; (void)seedLo; (void)seedHi;\n"
-      "  (void)step; (void)reachOff;\n"
+      "  (void)fl_step; (void)reachOff;\n"
       "  const fl_real t0 = fl_real_from_bits(timeBits), t1 = fl_real_from_bits(t1Bits);\n";
   // The per-particle part once, as a function both kernels call: PoCL compiles the action
   // list's body once per program instead of once per kernel (cold start, issue #11).
@@ -764,18 +764,18 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   s << "__global uchar* restrict codes, __global const FlActionParams* restrict ap,\n"
        "    __global uint* state, __global const float* restrict extra,\n"
        "    __global const float* restrict snap, ulong dtBits, uint seedLo, uint seedHi,\n"
-       "    uint step, uint streamBase, uint nsubStep, uint snapStride,\n"
+       "    uint fl_step, uint streamBase, uint nsubStep, uint snapStride,\n"
        "    __global float* restrict tau, uint i, uint n0, uint n, uint snapN, fl_real t0,\n"
        "    fl_real t1"
     << (g.culls ? ", uint reachOff, uint fl_live, __local int* fl_red" : "")
     << ") {\n"
        "  (void)state; (void)extra; (void)snap; (void)snapN; (void)snapStride; (void)seedLo;\n"
-       "  (void)seedHi; (void)step; (void)n;\n"
+       "  (void)seedHi; (void)fl_step; (void)n;\n"
     << one.str() << "}\n";
   std::string call = "fl_act_one(";
   for (const auto& l : g.actLanes) call += std::string("l_") + l.name + ", ";
   call +=
-      "codes, ap, state, extra, snap, dtBits, seedLo, seedHi, step, streamBase, nsubStep,\n"
+      "codes, ap, state, extra, snap, dtBits, seedLo, seedHi, fl_step, streamBase, nsubStep,\n"
       "      snapStride, tau, i, n0, n, snapN, t0, t1";
   call += g.culls ? ", reachOff, i < n, fl_red);\n" : ");\n";
   const std::string local = g.culls ? "  __local int fl_red[FL_CULL_LOCAL + " +
