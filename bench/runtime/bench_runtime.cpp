@@ -9,7 +9,8 @@
 //
 // After the runs it prints the ratio of the medians, per thread count, what bounds every step
 // cost, what a recorded death or collision event costs (Deaths, Collisions: recording on
-// against off), and what a trail of 8 positions costs a particle (Trails).
+// against off), what a trail of 8 positions costs a particle (Trails), and what instances
+// out of sight cost stepped once every 4 frames (OutOfSight).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -94,6 +95,28 @@ void Instances(benchmark::State& state) {
   state.counters["us/instance"] =
       benchmark::Counter(double(state.iterations()) * double(count) * 1e-6,
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+// A level of detail: 10,000 instances out of sight, stepped once every `interval` frames
+// (range 0; EffectInstance::setUpdateInterval) against every frame (1), on `threads` (range
+// 1). The game's frame costs about 1/interval, the instances staying on time.
+void OutOfSight(benchmark::State& state) {
+  constexpr std::size_t count = 10000;
+  ContextOptions o;
+  o.threads = unsigned(state.range(1));
+  Context ctx(o);
+  const Effect effect = parseEffect(sparks(kPerInstance));
+  std::vector<EffectInstance> all;
+  all.reserve(count);
+  for (std::size_t k = 0; k < count; ++k) {
+    all.push_back(effect.instantiate(ctx, std::to_string(k)));
+    all.back().setTransform(placeOf(k, count));
+  }
+  ctx.run(45);
+  for (EffectInstance& i : all) i.setUpdateInterval(std::uint32_t(state.range(0)));
+  ctx.run(8);
+  for (auto _ : state) ctx.step();
+  state.counters["instances"] = double(count);
 }
 
 // The same particles as one group: the effect at `count` times the rate, one instance; with
@@ -208,6 +231,14 @@ void args(benchmark::internal::Benchmark* b) {
 
 BENCHMARK(Instances)->Apply(args);
 BENCHMARK(OneGroup)->Apply(args);
+BENCHMARK(OutOfSight)->Apply([](benchmark::internal::Benchmark* b) {
+  const auto cores = int(std::max(1u, std::thread::hardware_concurrency()));
+  for (int t : {1, cores}) {
+    for (int interval : {1, 4}) b->Args({interval, t});
+    if (cores == 1) break;
+  }
+  b->ArgNames({"interval", "threads"})->Unit(benchmark::kMillisecond)->UseRealTime();
+});
 BENCHMARK(Deaths)->Apply([](benchmark::internal::Benchmark* b) {
   const auto cores = int(std::max(1u, std::thread::hardware_concurrency()));
   for (int t : {1, cores}) {
@@ -258,6 +289,17 @@ class RatioReporter : public benchmark::ConsoleReporter {
       std::printf(
           "  %s: %.2f ms a step, the same particles as one group %.2f ms: %.2fx (goal <= 1.5)\n",
           args.c_str(), ms, one->second, ms / one->second);
+    }
+    for (const auto& [name, ms] : ms_) {
+      const std::string lod = "OutOfSight/interval:4/threads:";
+      if (name.rfind(lod, 0) != 0) continue;
+      const std::string threads = name.substr(lod.size());
+      const auto every = ms_.find("OutOfSight/interval:1/threads:" + threads);
+      if (every == ms_.end()) continue;
+      std::printf(
+          "  10,000 instances out of sight, threads:%s: a step every 4 frames %.2f ms a frame, "
+          "every frame %.2f ms: %.2fx\n",
+          threads.c_str(), ms, every->second, ms / every->second);
     }
     // What keeping the bounds costs: the same run with and without asking every step.
     for (const auto& [name, ms] : ms_) {

@@ -15,6 +15,9 @@ struct StepParams {
   double dt = 0.0;
   std::uint64_t seed = 0;
   std::uint64_t step = 0;
+  /// A group with a clock of its own (GroupImpl::ownsClock): the length of one of its units
+  /// (scale·dt; dt spans skipped + 1 of them).
+  double clockUnit = 0.0;
   std::size_t blockSize = 0;
   bool fused = true;
   bool cull = true;

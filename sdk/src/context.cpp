@@ -99,8 +99,9 @@ void Context::Impl::shareBudget() {
   std::size_t live = 0;
   double asked = 0.0;
   auto emits = [](const detail::GroupImpl& gi) {
-    return !gi.emitters.empty() || !gi.primes.empty() || !gi.live.empty() ||
-           !gi.deathEmitters.empty();
+    return gi.timeScale != 0.0 &&  // paused: it asks for nothing
+           (!gi.emitters.empty() || !gi.primes.empty() || !gi.live.empty() ||
+            !gi.deathEmitters.empty());
   };
   for (auto& g : groups) {
     live += g->impl_->size;
@@ -209,6 +210,7 @@ Group& Context::createGroup(std::string name, std::size_t capacity) {
   auto& freed = impl_->freeIndices;
   const bool reuse = !freed.empty();
   gi->index = reuse ? freed.front() : impl_->nextIndex;
+  gi->updatePhase = gi->index;  // Group::setUpdateInterval's stagger
   gi->onDevice = impl_->backendKind != Backend::Cpu;
   gi->contextDeathEmitters = &impl_->deathEmitters;
   gi->ensureStorage();
@@ -271,20 +273,44 @@ detail::StepParams groupStep(const detail::StepParams& sp, const detail::GroupIm
                  ? timeAtDtChange + double(stepsSinceDtChange + ahead) * sp.dt
                  : sp.time + gi.aheadSeconds + double(extra) * sp.dt;
   }
-  // Group::setTimeScale: from where its clock stood when it left the context's.
+  // Group::setTimeScale, setUpdateInterval: from where its clock stood when it left the
+  // context's, over the steps it skipped and this one.
   if (gi.ownsClock()) {
-    if (!std::isnan(gi.ownClock)) r.time = gi.ownClock + double(extra) * sp.dt * gi.timeScale;
-    r.dt = sp.dt * gi.timeScale;
+    const double unit = sp.dt * gi.timeScale;
+    if (gi.clockStarted()) r.time = gi.clockAt(unit, extra);
+    r.dt = unit * double(gi.skippedSteps + 1);
+    r.clockUnit = unit;
   }
+  // A seeded group's draws are keyed by its own steps: alike whenever it was made.
+  if (gi.ownSeed) r.step = gi.ownSteps + extra;
   return r;
+}
+
+// A step a group at an update interval sits out (Group::setUpdateInterval): its clock waits
+// for the next step it takes, and it leaves no events of its last one.
+void skipGroup(detail::GroupImpl& gi, const detail::StepParams& sp) {
+  if (!gi.clockStarted()) gi.startClock(sp.time);
+  ++gi.skippedSteps;
+  gi.lastStepParts = {};
+  if (!gi.deathEvents.empty()) gi.deathEvents.clear();  // (each a line not to write)
+  if (!gi.collisionEvents.empty()) gi.collisionEvents.clear();
+  if (!gi.birthEvents.empty()) gi.birthEvents.clear();
 }
 
 void stepGroup(detail::BackendImpl& backend, detail::GroupImpl& gi, const detail::StepParams& sp) {
   gi.deathEvents.clear();
   gi.collisionEvents.clear();
   gi.birthEvents.clear();
-  if (gi.ownsClock()) gi.ownClock = sp.time + sp.dt;
-  if (sp.dt == 0.0) return;  // paused (Group::setTimeScale(0)): nothing moves, ages or is born
+  if (gi.ownsClock()) {
+    if (!gi.clockStarted()) gi.startClock(sp.time);
+    gi.advanceClock(sp.clockUnit, gi.skippedSteps + 1);
+  }
+  gi.skippedSteps = 0;
+  ++gi.ownSteps;
+  if (sp.dt == 0.0) {  // paused (Group::setTimeScale(0)): nothing moves, ages or is born
+    gi.lastStepParts = {};
+    return;
+  }
   gi.placeEmitters();
   gi.ensureStorage();
   gi.boundsValid = false;  // the CPU pass takes them again
@@ -371,7 +397,7 @@ void Context::Impl::runDeathEmitters(std::span<Group* const> only) {
     for (std::size_t k = 0; k < gi.deathEmitters.size(); ++k) {
       // feedDeathEmitters found it; a step's Callback may have destroyed it since.
       const Group* source = sourceOf(gi, k);
-      if (source && in(source))
+      if (source && in(source) && gi.timeScale != 0.0)  // a paused group is not fed
         detail::emitFromDeaths(gi, k, *source->impl_, gi.ownSeed ? gi.seed : options.seed);
     }
     // Under a budget, a DropOldest group makes room for these newborns too.
@@ -405,9 +431,15 @@ void Context::step() {
                          std::size_t to, const detail::StepParams& params) {
     for (std::size_t i = from; i < to; ++i) {
       if (i + 2 < to) list[i + 2]->prefetchSelf();
-      if (i + 1 < to) list[i + 1]->prefetchData();
-      stepGroup(*impl_->backend, *list[i],
-                groupStep(params, *list[i], impl_->timeAtDtChange, impl_->stepsSinceDtChange, 0));
+      // (A group that sits this step out needs nothing but its own state.)
+      if (i + 1 < to && list[i + 1]->dueAt(params.step)) list[i + 1]->prefetchData();
+      detail::GroupImpl& gi = *list[i];
+      if (!gi.dueAt(params.step)) {
+        skipGroup(gi, groupStep(params, gi, impl_->timeAtDtChange, impl_->stepsSinceDtChange, 0));
+        continue;
+      }
+      stepGroup(*impl_->backend, gi,
+                groupStep(params, gi, impl_->timeAtDtChange, impl_->stepsSinceDtChange, 0));
     }
   };
   stepInOrder(impl_->largeGroups, 0, impl_->largeGroups.size(), sp);
@@ -466,8 +498,8 @@ double Context::time() const {
 }
 
 double Context::time(const Group& group) const {
-  const auto& all = impl_->groups;
-  if (std::none_of(all.begin(), all.end(), [&](const auto& g) { return g.get() == &group; }))
+  // Every group of this context, and only those, points at its death emitter count.
+  if (group.impl_->contextDeathEmitters != &impl_->deathEmitters)
     throw InvalidArgument("group", "not a group of this context");
   return groupStep(impl_->params(), *group.impl_, impl_->timeAtDtChange, impl_->stepsSinceDtChange,
                    0)

@@ -480,6 +480,16 @@ double Group::timeScale() const {
   return impl_->timeScale;
 }
 
+Group& Group::setUpdateInterval(std::uint32_t interval) {
+  if (interval < 1 || interval > 256) throw InvalidArgument("interval", "must be 1 to 256");
+  impl_->updateInterval = interval;
+  return *this;
+}
+
+std::uint32_t Group::updateInterval() const {
+  return impl_->updateInterval;
+}
+
 Group& Group::setSeed(std::uint64_t seed, std::uint32_t stream) {
   if (stream > 0xFFFFu) throw InvalidArgument("stream", "must be < 65536");
   impl_->ownSeed = true;

@@ -159,9 +159,9 @@ struct Frame {
 };
 
 /// What Effect::build gave a group, for EffectInstance::restart: its emitters, prime
-/// emitters and action list as built (in the group's frame), and when (on its clock).
+/// emitters and action list as the effect has them (in the group's frame, their times from
+/// the effect's start).
 struct GroupOrigin {
-  double builtAt = 0.0;
   std::vector<Emitter> emitters;
   std::vector<PrimeEmitter> primes;
   ActionList actions;
@@ -362,11 +362,42 @@ struct GroupImpl {
   /// NaN while the context's dt is the one the steps ahead were taken with; after a change of
   /// dt, the lead in seconds.
   double aheadSeconds = std::numeric_limits<double>::quiet_NaN();
-  /// Group::setTimeScale. Once it is not 1 the group keeps a clock of its own, `ownClock`
-  /// (where its next step starts; NaN until then), which each step moves by scale·dt.
+  /// Group::setTimeScale. Once it is not 1 (or an update interval is set) the group keeps a
+  /// clock of its own, where its next step starts: clockBase + clockUnits·clockUnit, as the
+  /// context keeps its own (no drift from adding a step at a time), based anew when the
+  /// length of a unit (scale·dt) changes. clockBase is NaN until it starts.
   double timeScale = 1.0;
-  double ownClock = std::numeric_limits<double>::quiet_NaN();
-  bool ownsClock() const { return timeScale != 1.0 || !std::isnan(ownClock); }
+  double clockBase = std::numeric_limits<double>::quiet_NaN();
+  double clockUnit = 0.0;
+  std::uint64_t clockUnits = 0;
+  /// Group::setUpdateInterval: it steps when (context step + updatePhase) % updateInterval
+  /// is 0, over its skippedSteps + 1 steps' time.
+  std::uint32_t updateInterval = 1, updatePhase = 0, skippedSteps = 0;
+  std::uint64_t ownSteps = 0;  ///< steps taken: a seeded group's random step key
+  bool clockStarted() const { return !std::isnan(clockBase); }
+  bool ownsClock() const {
+    return timeScale != 1.0 || updateInterval != 1 || skippedSteps != 0 || clockStarted();
+  }
+  void startClock(double at) {
+    clockBase = at;
+    clockUnits = 0;
+  }
+  /// The clock `extra` units of `unit` past where it stands.
+  double clockAt(double unit, std::uint64_t extra) const {
+    if (unit != clockUnit) return clockBase + double(clockUnits) * clockUnit + double(extra) * unit;
+    return clockBase + double(clockUnits + extra) * unit;
+  }
+  void advanceClock(double unit, std::uint64_t units) {
+    if (unit != clockUnit) {
+      clockBase = clockAt(clockUnit, 0);
+      clockUnits = 0;
+      clockUnit = unit;
+    }
+    clockUnits += units;
+  }
+  bool dueAt(std::uint64_t contextStep) const {
+    return updateInterval <= 1 || (contextStep + updatePhase) % updateInterval == 0;
+  }
 
   /// Brings the live count and `attributes` (default: all; before the host writes, all) up
   /// to date on the host.

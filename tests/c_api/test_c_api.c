@@ -850,6 +850,9 @@ static void test_instances(void) {
   FAILS(flurry_instance_set_seed(NULL, 1), FLURRY_ERROR_NULL_ARGUMENT, "instance");
   OK(flurry_instance_set_time_scale(a, 0.5));
   OK(flurry_instance_set_seed(a, 99));
+  FAILS(flurry_instance_set_update_interval(a, 0), FLURRY_ERROR_INVALID_ARGUMENT, "interval");
+  FAILS(flurry_instance_set_update_interval(NULL, 2), FLURRY_ERROR_NULL_ARGUMENT, "instance");
+  OK(flurry_instance_set_update_interval(a, 4));
   FAILS(flurry_instance_stop(NULL), FLURRY_ERROR_NULL_ARGUMENT, "instance");
   FAILS(flurry_instance_kill(NULL), FLURRY_ERROR_NULL_ARGUMENT, "instance");
   FAILS(flurry_instance_prewarm(b, -1, NULL), FLURRY_ERROR_INVALID_ARGUMENT, "seconds");

@@ -356,6 +356,11 @@ FLURRY_C_EXPORT flurry_status flurry_instance_set_time_scale(flurry_instance* in
 /** Gives the instance its own random numbers (flurry::EffectInstance::setSeed): instances
  * with one seed look alike wherever they are made. */
 FLURRY_C_EXPORT flurry_status flurry_instance_set_seed(flurry_instance* instance, uint64_t seed);
+/** Steps the instance once every `interval` context steps (1 to 256), each time over the
+ * time it skipped: a level of detail for an instance out of sight
+ * (flurry::EffectInstance::setUpdateInterval). */
+FLURRY_C_EXPORT flurry_status flurry_instance_set_update_interval(flurry_instance* instance,
+                                                                  uint32_t interval);
 /** Stops emitting now (flurry::EffectInstance::stop): the live particles live out their lives. */
 FLURRY_C_EXPORT flurry_status flurry_instance_stop(flurry_instance* instance);
 /** Stops emitting and removes every particle at once (the groups stay). */

@@ -960,6 +960,12 @@ flurry_status flurry_instance_set_time_scale(flurry_instance* inst, double scale
     inst->instance.setTimeScale(scale);
   });
 }
+flurry_status flurry_instance_set_update_interval(flurry_instance* inst, uint32_t interval) {
+  return guard([&] {
+    need(inst, "instance");
+    inst->instance.setUpdateInterval(interval);
+  });
+}
 flurry_status flurry_instance_set_seed(flurry_instance* inst, uint64_t seed) {
   return guard([&] {
     need(inst, "instance");

@@ -690,6 +690,11 @@ NB_MODULE(_flurry, m) {
           [](InstanceRef& pi, double scale) { pi.instance.setTimeScale(scale); },
           "How fast the instance runs against the context's time (0 pauses it).")
       .def(
+          "set_update_interval",
+          [](InstanceRef& pi, std::uint32_t interval) { pi.instance.setUpdateInterval(interval); },
+          "interval"_a,
+          "Steps it once every `interval` context steps, catching up each time (out of sight).")
+      .def(
           "set_seed", [](InstanceRef& pi, std::uint64_t seed) { pi.instance.setSeed(seed); },
           "seed"_a,
           "Gives the instance its own random numbers: instances with one seed look alike.");

@@ -361,6 +361,10 @@ def test_instances_with_one_seed_look_alike_and_a_paused_one_stands_still():
     assert np.array_equal(a.groups[0].lane("position", 1), pa)  # paused
     with pytest.raises(flurry.InvalidArgument):
         a.time_scale = -1.0
+    c.set_update_interval(4)  # out of sight: a step every 4, on time still
+    ctx.step(8)
+    with pytest.raises(flurry.InvalidArgument):
+        c.set_update_interval(0)
 
 
 def test_deaths_are_recorded_with_what_killed_them():

@@ -10,7 +10,8 @@
 //
 // What the body may contain is what both languages read alike: float arithmetic with float
 // literals (2.0f: a double literal needs a device with doubles), the variables, if/else,
-// loops, locals of float, int or uint, and the builtins. Not `return` (it would leave the
+// loops that end whatever the values (the device may run the body on zeros past the live
+// particles), locals of float, int or uint, and the builtins. Not `return` (it would leave the
 // device's kernel), not preprocessor lines, not comments that matter (the preprocessor drops
 // them before the body becomes a string). A body the device's compiler refuses is reported
 // when the list first runs there, with the compiler's log.
@@ -94,14 +95,26 @@ inline Callback sharedCallback(std::string_view body,
 
 /// OpenCL C's scalar math builtins for FLURRY_CALLBACK's body on the CPU: the float overloads
 /// of <cmath>, and OpenCL's own (clamp, mix, step, smoothstep, sign, min, max, radians,
-/// degrees, rsqrt) with OpenCL's definitions. A builtin not here does not compile on the CPU.
+/// degrees, rsqrt) with OpenCL's definitions; min, max and clamp on int and uint as OpenCL
+/// has them, abs on integers only (fabs for floats, as in OpenCL). The body sees exactly
+/// these names (declared in its scope); a builtin not here may find the C library's double
+/// function on the CPU: stick to these. Correctly rounded operations (+ - * /, sqrt, fmin,
+/// fmax, fabs, floor, ...) agree to the bit with the device; sin, exp, pow and their kind
+/// agree within the device's error bounds.
 namespace callback_builtins {
+using uint = std::uint32_t;
 using std::acos, std::asin, std::atan, std::atan2, std::cbrt, std::ceil, std::copysign, std::cos,
     std::cosh, std::exp, std::exp2, std::fabs, std::floor, std::fma, std::fmax, std::fmin,
     std::fmod, std::hypot, std::log, std::log10, std::log2, std::pow, std::round, std::sin,
     std::sinh, std::sqrt, std::tan, std::tanh, std::trunc;
 inline float clamp(float x, float lo, float hi) {
   return fmin(fmax(x, lo), hi);
+}
+inline int clamp(int x, int lo, int hi) {
+  return x < lo ? lo : (x > hi ? hi : x);
+}
+inline uint clamp(uint x, uint lo, uint hi) {
+  return x < lo ? lo : (x > hi ? hi : x);
 }
 inline float mix(float x, float y, float a) {
   return x + (y - x) * a;
@@ -120,9 +133,28 @@ inline float sign(float x) {
 inline float min(float x, float y) {
   return y < x ? y : x;
 }
+inline int min(int x, int y) {
+  return y < x ? y : x;
+}
+inline uint min(uint x, uint y) {
+  return y < x ? y : x;
+}
 inline float max(float x, float y) {
   return x < y ? y : x;
 }
+inline int max(int x, int y) {
+  return x < y ? y : x;
+}
+inline uint max(uint x, uint y) {
+  return x < y ? y : x;
+}
+inline uint abs(int x) {
+  return x < 0 ? 0u - uint(x) : uint(x);
+}
+inline uint abs(uint x) {
+  return x;
+}
+float abs(float) = delete;  // OpenCL's abs is for integers: fabs
 inline float radians(float degrees) {
   return degrees * 0.0174532925199432957692f;
 }
@@ -151,11 +183,37 @@ inline constexpr float M_PI_F = 3.14159265358979323846f;
   [[maybe_unused]] float &rotx = P.rotVelocity.x, &roty = P.rotVelocity.y,                 \
                          &rotz = P.rotVelocity.z;                                          \
   [[maybe_unused]] float &charge = P.charge, &user = P.userData;                           \
-  [[maybe_unused]] bool& vis = P.visible;                                                  \
+  [[maybe_unused]] std::uint32_t vis = P.visible ? 1u : 0u; /* a uint, as on the device */ \
   [[maybe_unused]] float &pbx = P.positionB.x, &pby = P.positionB.y, &pbz = P.positionB.z; \
   [[maybe_unused]] float &vbx = P.velocityB.x, &vby = P.velocityB.y, &vbz = P.velocityB.z; \
   [[maybe_unused]] const float dt = C.dt;                                                  \
   [[maybe_unused]] const double time = C.time;
+
+// callback_builtins' names, declared in the body's scope so that they hide any other
+// function of that name the surrounding code sees.
+#define FLURRY_DETAIL_CALLBACK_BUILTINS                                           \
+  using ::flurry::callback_builtins::uint;                                        \
+  using ::flurry::callback_builtins::acos, ::flurry::callback_builtins::asin,     \
+      ::flurry::callback_builtins::atan, ::flurry::callback_builtins::atan2,      \
+      ::flurry::callback_builtins::cbrt, ::flurry::callback_builtins::ceil,       \
+      ::flurry::callback_builtins::copysign, ::flurry::callback_builtins::cos,    \
+      ::flurry::callback_builtins::cosh, ::flurry::callback_builtins::exp,        \
+      ::flurry::callback_builtins::exp2, ::flurry::callback_builtins::fabs,       \
+      ::flurry::callback_builtins::floor, ::flurry::callback_builtins::fma,       \
+      ::flurry::callback_builtins::fmax, ::flurry::callback_builtins::fmin,       \
+      ::flurry::callback_builtins::fmod, ::flurry::callback_builtins::hypot,      \
+      ::flurry::callback_builtins::log, ::flurry::callback_builtins::log10,       \
+      ::flurry::callback_builtins::log2, ::flurry::callback_builtins::pow,        \
+      ::flurry::callback_builtins::round, ::flurry::callback_builtins::sin,       \
+      ::flurry::callback_builtins::sinh, ::flurry::callback_builtins::sqrt,       \
+      ::flurry::callback_builtins::tan, ::flurry::callback_builtins::tanh,        \
+      ::flurry::callback_builtins::trunc, ::flurry::callback_builtins::clamp,     \
+      ::flurry::callback_builtins::mix, ::flurry::callback_builtins::step,        \
+      ::flurry::callback_builtins::smoothstep, ::flurry::callback_builtins::sign, \
+      ::flurry::callback_builtins::min, ::flurry::callback_builtins::max,         \
+      ::flurry::callback_builtins::abs, ::flurry::callback_builtins::radians,     \
+      ::flurry::callback_builtins::degrees, ::flurry::callback_builtins::rsqrt,   \
+      ::flurry::callback_builtins::M_PI_F;
 
 /// A Callback action whose body is written once, as statements in the shared subset (see the
 /// top of this file): the CPU runs them compiled as C++, a device as OpenCL C.
@@ -165,8 +223,9 @@ inline constexpr float M_PI_F = 3.14159265358979323846f;
     static_assert(!::flurry::usesIdentifier(#__VA_ARGS__, "return"),                        \
                   "FLURRY_CALLBACK: 'return' would leave the device's kernel; use break");  \
     FLURRY_DETAIL_CALLBACK_VARIABLES(flurry_particle_, flurry_ctx_)                         \
-    using namespace ::flurry::callback_builtins;                                            \
+    FLURRY_DETAIL_CALLBACK_BUILTINS                                                         \
     do {                                                                                    \
       __VA_ARGS__                                                                           \
     } while (0);                                                                            \
+    flurry_particle_.visible = vis != 0u;                                                   \
   })

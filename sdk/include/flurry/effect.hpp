@@ -132,6 +132,11 @@ class EffectInstance {
   /// Group::setTimeScale of every group. Throws InvalidArgument "scale".
   EffectInstance& setTimeScale(double scale);
   double timeScale() const;
+  /// Steps the instance once every `interval` context steps, catching up each time (see
+  /// Group::setUpdateInterval): a game sets it when the instance leaves the view or goes far
+  /// away, and back to 1 when it returns. Its groups step together. InvalidArgument
+  /// "interval" unless 1 <= interval <= 256.
+  EffectInstance& setUpdateInterval(std::uint32_t interval);
   /// Gives the instance its own random numbers: group k of the effect draws from (seed, k)
   /// (Group::setSeed), so two instances with one seed look alike wherever they are made
   /// (a replay), and a seed per instance tells them apart. From the next step on.
@@ -143,10 +148,12 @@ class EffectInstance {
   /// Stops emitting and removes every particle and shower at once (the groups stay; their
   /// stats are kept).
   void kill();
-  /// Starts it over now: kill(), then its emitters, prime emitters and action list as the
+  /// Starts it over now: kill(), then its emitters, prime emitters and action lists as the
   /// effect built them (before any stop() or edit), their times counting from now on each
-  /// group's clock: bursts at 0 fire again, a rate starts with no backlog. The transform,
-  /// time scale, seed and stats stay. A pooled one-shot effect a game fires again.
+  /// group's clock: bursts at 0 fire again, a rate starts with no backlog, it emits as many
+  /// as an instance made now would. The transform, time scale and seed stay, and the stats
+  /// (but the per-action kill counts, which start again). A pooled one-shot effect a game
+  /// fires again.
   void restart();
   /// True when nothing of it lives and nothing can be born again: a game may destroy() it.
   bool done() const;

@@ -207,6 +207,15 @@ class Group {
   /// 0 <= scale <= 1000.
   Group& setTimeScale(double scale);
   double timeScale() const;
+  /// A level of detail for what the game does not see: the group steps only once every
+  /// `interval` context steps, each time over the time it skipped (one step of
+  /// interval·timeStep(), newborns placed inside it as ever), so it costs 1/interval and
+  /// stays on time. Staggered by the group's index, so that a crowd of them spreads over the
+  /// frames. Between its steps nothing of it moves and it records no events. Set back to 1,
+  /// its next step catches up what it skipped. Throws InvalidArgument "interval" unless
+  /// 1 <= interval <= 256.
+  Group& setUpdateInterval(std::uint32_t interval);
+  std::uint32_t updateInterval() const;
   /// Draws the group's random numbers from `seed` and `stream` (< 65536) instead of the
   /// context's seed and the group's index, from the next step on: groups given the same two
   /// draw alike whichever context and order made them (a replay, a seeded instance:

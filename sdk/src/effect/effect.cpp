@@ -1159,22 +1159,24 @@ std::vector<Group*> Effect::build(Context& ctx, std::size_t maxCapacity,
       const std::size_t cap = maxCapacity > 0 ? std::min(eg.capacity, maxCapacity) : eg.capacity;
       Group& g =
           ctx.createGroup(instance.empty() ? eg.name : eg.name + "@" + std::string(instance), cap);
+      // What restart() builds again (the effect's own times: moved once, to then).
       auto origin = std::make_shared<detail::GroupOrigin>();
-      origin->builtAt = t0;
-      origin->actions = t0 == 0.0 ? eg.actions : delayedActions(eg.actions, t0);
-      g.setActions(origin->actions);
+      origin->actions = eg.actions;
+      g.setActions(t0 == 0.0 ? eg.actions : delayedActions(eg.actions, t0));
       if (eg.hair.enabled) g.setHair(eg.hair);
       if (eg.trail.length > 0) g.setTrail(eg.trail);
       g.setBudgetPolicy(eg.budget);
       g.require(eg.require);
       if (space == Space::Local) g.setSpace(Space::Local);
       for (Emitter e : eg.emitters) {
+        origin->emitters.push_back(e);
         delayTimes(e, t0);
-        origin->emitters.push_back(g.addEmitter(std::move(e)));
+        g.addEmitter(std::move(e));
       }
       for (PrimeEmitter p : eg.primeEmitters) {
+        origin->primes.push_back(p);
         delayTimes(p, t0);
-        origin->primes.push_back(g.addPrimeEmitter(std::move(p)));
+        g.addPrimeEmitter(std::move(p));
       }
       detail::implOf(g).origin = std::move(origin);
       for (DeathEmitter de : eg.deathEmitters) {
@@ -1241,6 +1243,18 @@ double EffectInstance::timeScale() const {
   return groups_.empty() ? 1.0 : groups_.front()->timeScale();
 }
 
+EffectInstance& EffectInstance::setUpdateInterval(std::uint32_t interval) {
+  if (!context_)
+    throw Error("setUpdateInterval: an empty EffectInstance (use Effect::instantiate)");
+  for (Group* g : groups_) {
+    g->setUpdateInterval(interval);  // the first refuses a bad interval
+    // Its groups step together (death emitters feed on each other's events), on the first's
+    // turn.
+    detail::implOf(*g).updatePhase = detail::implOf(*groups_.front()).updatePhase;
+  }
+  return *this;
+}
+
 EffectInstance& EffectInstance::setSeed(std::uint64_t seed) {
   if (!context_) throw Error("setSeed: an empty EffectInstance (use Effect::instantiate)");
   for (std::size_t k = 0; k < groups_.size(); ++k) groups_[k]->setSeed(seed, std::uint32_t(k));
@@ -1266,9 +1280,9 @@ void EffectInstance::restart() {
   for (Group* g : groups_) {
     detail::GroupImpl& gi = detail::implOf(*g);
     if (!gi.origin) continue;
-    // The effect's times as built, moved on to now on the group's clock.
+    // The effect's times, moved to now on the group's clock.
     const auto& origin = gi.origin;
-    const double now = context_->time(*g), shift = now - origin->builtAt;
+    const double shift = context_->time(*g);
     detail::clearEmitters(gi);
     for (Emitter e : origin->emitters) {
       delayTimes(e, shift);
@@ -1278,11 +1292,7 @@ void EffectInstance::restart() {
       delayTimes(p, shift);
       g->addPrimeEmitter(std::move(p));
     }
-    const auto& acts = origin->actions.actions();
-    if (std::any_of(acts.begin(), acts.end(), [](const Action& a) {
-          return std::holds_alternative<Explosion>(a) || std::holds_alternative<Restore>(a);
-        }))
-      g->setActions(delayedActions(origin->actions, shift));
+    g->setActions(delayedActions(origin->actions, shift));
   }
 }
 
