@@ -62,6 +62,20 @@ Transform placeOf(std::size_t k, std::size_t count) {
   return t;
 }
 
+// `count` instances of the 100-particle effect, each placed on the grid, run until births and
+// deaths balance (1.5 s: past the lifetime).
+std::vector<EffectInstance> instances(Context& ctx, std::size_t count) {
+  const Effect effect = parseEffect(sparks(kPerInstance));
+  std::vector<EffectInstance> all;
+  all.reserve(count);
+  for (std::size_t k = 0; k < count; ++k) {
+    all.push_back(effect.instantiate(ctx, std::to_string(k)));
+    all.back().setTransform(placeOf(k, count));
+  }
+  ctx.run(45);
+  return all;
+}
+
 // `count` instances of the 100-particle effect (range 0), on `threads` (range 1); each step
 // is Context::step() of them all, and with bounds (range 2) every instance's bounds, as an
 // engine culls them.
@@ -70,14 +84,7 @@ void Instances(benchmark::State& state) {
   ContextOptions o;
   o.threads = unsigned(state.range(1));
   Context ctx(o);
-  const Effect effect = parseEffect(sparks(kPerInstance));
-  std::vector<EffectInstance> all;
-  all.reserve(count);
-  for (std::size_t k = 0; k < count; ++k) {
-    all.push_back(effect.instantiate(ctx, std::to_string(k)));
-    all.back().setTransform(placeOf(k, count));
-  }
-  ctx.run(45);  // 1.5 s: past the lifetime, births and deaths balance
+  const std::vector<EffectInstance> all = instances(ctx, count);
   double live = 0;
   const bool bounds = state.range(2) != 0;
   float sink = 0.0f;
@@ -105,14 +112,7 @@ void OutOfSight(benchmark::State& state) {
   ContextOptions o;
   o.threads = unsigned(state.range(1));
   Context ctx(o);
-  const Effect effect = parseEffect(sparks(kPerInstance));
-  std::vector<EffectInstance> all;
-  all.reserve(count);
-  for (std::size_t k = 0; k < count; ++k) {
-    all.push_back(effect.instantiate(ctx, std::to_string(k)));
-    all.back().setTransform(placeOf(k, count));
-  }
-  ctx.run(45);
+  std::vector<EffectInstance> all = instances(ctx, count);
   for (EffectInstance& i : all) i.setUpdateInterval(std::uint32_t(state.range(0)));
   ctx.run(8);
   for (auto _ : state) ctx.step();

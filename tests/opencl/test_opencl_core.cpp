@@ -95,17 +95,22 @@ TEST(OpenCLCore, ACallbackWrittenOnceRunsOnBoth) {
       if (id % 3u == 1u) break;
       vy += clamp(mix(0.0f, 1.0f, 0.5f), 0.0f, 0.25f) * step(2.0f, py) + fmax(min(py, 0.0f), -1.0f);
       size = max(size, 0.02f););
-  auto build = [&cb](Context& ctx) -> Group& {
-    Group& g = ctx.createGroup("callback", 20000);
+  checkParity(spraying({Gravity{kDown}, cb, Move{}, KillOld{}}));
+}
+
+TEST(OpenCLCore, ClocksSeedsAndUpdateIntervalsAsOnTheCpu) {
+  // A group with its own clock (half speed), its own seed (random actions keyed by its own
+  // steps) and an update interval (a step of three steps' time every third step): the device
+  // takes each step's dt, time, seed and step key from the host as the CPU does.
+  auto build = [](Context& ctx) -> Group& {
+    Group& g = ctx.createGroup("lod", 20000);
     g.addEmitter(spray());
-    g.setActions({Gravity{kDown}, cb, Move{}, KillOld{}});
+    g.setActions(
+        {Gravity{kDown}, RandomAccel{Domain::sphere(Vec3(0.0f), 2.0f)}, Move{}, KillOld{}});
+    g.setTimeScale(0.5).setSeed(9, 1).setUpdateInterval(3);
     return g;
   };
-  FLURRY_REQUIRE_OPENCL();
-  const RunResult cpu = runEffect(Backend::Cpu, build, kSteps);
-  const RunResult cl = runEffect(Backend::OpenCL, build, kSteps);
-  EXPECT_GT(cpu.stats.emitted, 0u);
-  expectSame(cpu, cl);
+  checkParity(build);
 }
 
 TEST(OpenCLCore, ACallbackWithoutAnOpenCLBodyIsRefusedByName) {

@@ -19,6 +19,7 @@
 
 #include <array>
 #include <cmath>
+#include <concepts>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -107,14 +108,23 @@ using std::acos, std::asin, std::atan, std::atan2, std::cbrt, std::ceil, std::co
     std::cosh, std::exp, std::exp2, std::fabs, std::floor, std::fma, std::fmax, std::fmin,
     std::fmod, std::hypot, std::log, std::log10, std::log2, std::pow, std::round, std::sin,
     std::sinh, std::sqrt, std::tan, std::tanh, std::trunc;
-inline float clamp(float x, float lo, float hi) {
+// On float, int and uint, as OpenCL has them (both arguments of one type).
+template <class T>
+concept OpenCLScalar = std::same_as<T, float> || std::same_as<T, int> || std::same_as<T, uint>;
+template <OpenCLScalar T>
+inline T min(T x, T y) {
+  return y < x ? y : x;
+}
+template <OpenCLScalar T>
+inline T max(T x, T y) {
+  return x < y ? y : x;
+}
+template <OpenCLScalar T>
+inline T clamp(T x, T lo, T hi) {
+  return min(max(x, lo), hi);
+}
+inline float clamp(float x, float lo, float hi) {  // OpenCL's, for floats
   return fmin(fmax(x, lo), hi);
-}
-inline int clamp(int x, int lo, int hi) {
-  return x < lo ? lo : (x > hi ? hi : x);
-}
-inline uint clamp(uint x, uint lo, uint hi) {
-  return x < lo ? lo : (x > hi ? hi : x);
 }
 inline float mix(float x, float y, float a) {
   return x + (y - x) * a;
@@ -129,24 +139,6 @@ inline float smoothstep(float e0, float e1, float x) {
 inline float sign(float x) {
   if (std::isnan(x)) return 0.0f;
   return x > 0.0f ? 1.0f : (x < 0.0f ? -1.0f : copysign(0.0f, x));
-}
-inline float min(float x, float y) {
-  return y < x ? y : x;
-}
-inline int min(int x, int y) {
-  return y < x ? y : x;
-}
-inline uint min(uint x, uint y) {
-  return y < x ? y : x;
-}
-inline float max(float x, float y) {
-  return x < y ? y : x;
-}
-inline int max(int x, int y) {
-  return x < y ? y : x;
-}
-inline uint max(uint x, uint y) {
-  return x < y ? y : x;
 }
 inline uint abs(int x) {
   return x < 0 ? 0u - uint(x) : uint(x);
@@ -213,7 +205,8 @@ inline constexpr float M_PI_F = 3.14159265358979323846f;
       ::flurry::callback_builtins::min, ::flurry::callback_builtins::max,         \
       ::flurry::callback_builtins::abs, ::flurry::callback_builtins::radians,     \
       ::flurry::callback_builtins::degrees, ::flurry::callback_builtins::rsqrt,   \
-      ::flurry::callback_builtins::M_PI_F;
+      ::flurry::callback_builtins::M_PI_F;                                        \
+  (void)M_PI_F; /* a body need not use it */
 
 /// A Callback action whose body is written once, as statements in the shared subset (see the
 /// top of this file): the CPU runs them compiled as C++, a device as OpenCL C.
