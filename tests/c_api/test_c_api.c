@@ -863,6 +863,23 @@ static void test_instances(void) {
   FAILS(flurry_instance_set_transform(a, NULL, rot, 1), FLURRY_ERROR_NULL_ARGUMENT, "position");
   FAILS(flurry_instance_group_count(NULL, &count), FLURRY_ERROR_NULL_ARGUMENT, "instance");
   FAILS(flurry_instance_prewarm(NULL, 1, NULL), FLURRY_ERROR_NULL_ARGUMENT, "instance");
+  /* One group alone: at half speed its clock takes half of each step (dt 0.1). */
+  {
+    double t0 = 0, t1 = 0;
+    OK(flurry_instance_group_at(b, 1, &g));
+    OK(flurry_group_set_time_scale(g, 0.5));
+    OK(flurry_context_group_time(ctx, g, &t0));
+    OK(flurry_context_step(ctx));
+    OK(flurry_context_group_time(ctx, g, &t1));
+    CHECK(fabs(t1 - t0 - 0.05) < 1e-12);
+    OK(flurry_group_set_seed(g, 5, 1));
+    OK(flurry_group_set_update_interval(g, 2));
+    FAILS(flurry_group_set_time_scale(g, NAN), FLURRY_ERROR_INVALID_ARGUMENT, "scale");
+    FAILS(flurry_group_set_seed(g, 5, 65536), FLURRY_ERROR_INVALID_ARGUMENT, "stream");
+    FAILS(flurry_group_set_update_interval(g, 0), FLURRY_ERROR_INVALID_ARGUMENT, "interval");
+    FAILS(flurry_group_set_time_scale(NULL, 1), FLURRY_ERROR_NULL_ARGUMENT, "group");
+    FAILS(flurry_context_group_time(ctx, g, NULL), FLURRY_ERROR_NULL_ARGUMENT, "time");
+  }
   /* The same name twice is refused (its groups exist). */
   CHECK(flurry_effect_instantiate(fx, ctx, "a", 0, &dup) != FLURRY_OK && dup == NULL);
   OK(flurry_context_group_count(ctx, &count));

@@ -189,6 +189,18 @@ FLURRY_C_EXPORT flurry_status flurry_context_set_particle_budget(flurry_context*
 /** `policy`: a flurry_budget_policy (an int, so that a value outside it is an error, not
  * undefined behaviour). */
 FLURRY_C_EXPORT flurry_status flurry_group_set_budget_policy(flurry_group* group, int policy);
+/** One group alone, as the flurry_instance_ calls do an instance's groups: its clock at
+ * `scale` times the context's (0 pauses it), its random numbers from (`seed`, `stream`
+ * < 65536), a step every `interval` context steps (1 to 256) over the time it skipped
+ * (flurry::Group::setTimeScale, setSeed, setUpdateInterval). */
+FLURRY_C_EXPORT flurry_status flurry_group_set_time_scale(flurry_group* group, double scale);
+FLURRY_C_EXPORT flurry_status flurry_group_set_seed(flurry_group* group, uint64_t seed,
+                                                    uint32_t stream);
+FLURRY_C_EXPORT flurry_status flurry_group_set_update_interval(flurry_group* group,
+                                                               uint32_t interval);
+/** The time on the group's own clock, where its next step starts (flurry::Context::time(group)). */
+FLURRY_C_EXPORT flurry_status flurry_context_group_time(const flurry_context* ctx,
+                                                        const flurry_group* group, double* time);
 /** Why FLURRY_BACKEND_AUTO took the CPU ("" when it did not). */
 FLURRY_C_EXPORT flurry_status flurry_context_backend_fallback(const flurry_context* ctx,
                                                               const char** why);

@@ -478,6 +478,34 @@ flurry_status flurry_group_set_budget_policy(flurry_group* g, int policy) {
   });
 }
 
+flurry_status flurry_group_set_time_scale(flurry_group* g, double scale) {
+  return guard([&] {
+    need(g, "group");
+    group(g).setTimeScale(scale);
+  });
+}
+flurry_status flurry_group_set_seed(flurry_group* g, uint64_t seed, uint32_t stream) {
+  return guard([&] {
+    need(g, "group");
+    group(g).setSeed(seed, stream);
+  });
+}
+flurry_status flurry_group_set_update_interval(flurry_group* g, uint32_t interval) {
+  return guard([&] {
+    need(g, "group");
+    group(g).setUpdateInterval(interval);
+  });
+}
+flurry_status flurry_context_group_time(const flurry_context* ctx, const flurry_group* g,
+                                        double* time) {
+  return guard([&] {
+    need(ctx, "ctx");
+    need(g, "group");
+    need(time, "time");
+    *time = ctx->ctx.time(group(g));
+  });
+}
+
 flurry_status flurry_context_destroy(flurry_context* ctx) {
   return guard([&] { delete ctx; });  // NULL is fine, as free(NULL)
 }

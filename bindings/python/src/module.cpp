@@ -482,6 +482,26 @@ NB_MODULE(_flurry, m) {
           "transform", [](const GroupRef& pg) { return transformDict(pg.g->transform()); },
           "The group's transform: position, rotation (w, x, y, z), scale.")
       .def_prop_rw(
+          "time_scale", [](const GroupRef& pg) { return pg.g->timeScale(); },
+          [](GroupRef& pg, double scale) { pg.g->setTimeScale(scale); },
+          "How fast the group's clock runs against the context's (0 pauses it).")
+      .def(
+          "set_seed",
+          [](GroupRef& pg, std::uint64_t seed, std::uint32_t stream) {
+            pg.g->setSeed(seed, stream);
+          },
+          "seed"_a, "stream"_a = 0,
+          "Draws its random numbers from (seed, stream) instead of the context's seed and its "
+          "index.")
+      .def_prop_ro(
+          "time", [](const GroupRef& pg) { return pg.pc->ctx->time(*pg.g); },
+          "The time on its own clock, where its next step starts (the context's unless scaled, "
+          "prewarmed or skipping steps).")
+      .def_prop_rw(
+          "update_interval", [](const GroupRef& pg) { return pg.g->updateInterval(); },
+          [](GroupRef& pg, std::uint32_t n) { pg.g->setUpdateInterval(n); },
+          "Steps once every this many context steps over the time it skipped (1: every step).")
+      .def_prop_rw(
           "budget_policy",
           [](const GroupRef& pg) {
             const char* names[] = {"drop_newest", "drop_oldest", "scale_emission"};

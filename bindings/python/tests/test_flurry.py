@@ -361,6 +361,16 @@ def test_instances_with_one_seed_look_alike_and_a_paused_one_stands_still():
     assert np.array_equal(a.groups[0].lane("position", 1), pa)  # paused
     with pytest.raises(flurry.InvalidArgument):
         a.time_scale = -1.0
+    g = c.groups[0]
+    g.time_scale = 0.5
+    before = g.time
+    ctx.step()
+    assert abs(g.time - before - 0.5 * ctx.dt) < 1e-12 and g.time_scale == 0.5
+    g.time_scale = 1.0
+    g.set_seed(3, 1)
+    g.update_interval = 2
+    assert g.update_interval == 2
+    g.update_interval = 1
     c.set_update_interval(4)  # out of sight: a step every 4, on time still
     ctx.step(8)
     with pytest.raises(flurry.InvalidArgument):
