@@ -208,6 +208,21 @@ inline constexpr float M_PI_F = 3.14159265358979323846f;
       ::flurry::callback_builtins::M_PI_F;                                        \
   (void)M_PI_F; /* a body need not use it */
 
+// The body's names (r, g, size, ...) may shadow the caller's locals on purpose: no -Wshadow
+// warning for them.
+#if defined(__clang__)
+#define FLURRY_DETAIL_NO_SHADOW_BEGIN \
+  _Pragma("clang diagnostic push") _Pragma("clang diagnostic ignored \"-Wshadow-all\"")
+#define FLURRY_DETAIL_NO_SHADOW_END _Pragma("clang diagnostic pop")
+#elif defined(__GNUC__)
+#define FLURRY_DETAIL_NO_SHADOW_BEGIN \
+  _Pragma("GCC diagnostic push") _Pragma("GCC diagnostic ignored \"-Wshadow\"")
+#define FLURRY_DETAIL_NO_SHADOW_END _Pragma("GCC diagnostic pop")
+#else
+#define FLURRY_DETAIL_NO_SHADOW_BEGIN
+#define FLURRY_DETAIL_NO_SHADOW_END
+#endif
+
 /// A Callback action whose body is written once, as statements in the shared subset (see the
 /// top of this file): the CPU runs them compiled as C++, a device as OpenCL C.
 #define FLURRY_CALLBACK(...)                                                                \
@@ -215,7 +230,9 @@ inline constexpr float M_PI_F = 3.14159265358979323846f;
                                             const ::flurry::CallbackContext& flurry_ctx_) { \
     static_assert(!::flurry::usesIdentifier(#__VA_ARGS__, "return"),                        \
                   "FLURRY_CALLBACK: 'return' would leave the device's kernel; use break");  \
+    FLURRY_DETAIL_NO_SHADOW_BEGIN                                                           \
     FLURRY_DETAIL_CALLBACK_VARIABLES(flurry_particle_, flurry_ctx_)                         \
+    FLURRY_DETAIL_NO_SHADOW_END                                                             \
     FLURRY_DETAIL_CALLBACK_BUILTINS                                                         \
     do {                                                                                    \
       __VA_ARGS__                                                                           \
