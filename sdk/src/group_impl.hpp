@@ -376,7 +376,7 @@ struct GroupImpl {
   std::uint64_t ownSteps = 0;  ///< steps taken: a seeded group's random step key
   bool clockStarted() const { return !std::isnan(clockBase); }
   bool ownsClock() const {
-    return timeScale != 1.0 || updateInterval != 1 || skippedSteps != 0 || clockStarted();
+    return timeScale != 1.0 || updateInterval != 1 || clockStarted();  // (a skip starts it)
   }
   void startClock(double at) {
     clockBase = at;
