@@ -145,6 +145,38 @@ __kernel void fl_scan_list(__global const uchar* codes, __global uint* tileDead,
   fl_scan_list_body(codes, tileDead, tileOff, holes, tail, state, births, capacity, tiles);
 }
 
+/* Death events (Group::recordDeaths; group.cpp recordDeaths on the CPU): the step's dead in
+ * particle order, the first `room` of them, each as 8 words: position, velocity (zeros
+ * where `velocity` is 0: vx..vz then alias px), id and kill code. After the scan (tileOff)
+ * and before fl_tail moves survivors into the holes. One work item per tile. */
+__kernel void fl_deaths(__global const uchar* codes, __global const uint* tileOff,
+                        __global const uint* state, __global const float* px,
+                        __global const float* py, __global const float* pz,
+                        __global const float* vx, __global const float* vy,
+                        __global const float* vz, uint velocity, __global const uint* id,
+                        __global uint* events, uint room, uint tiles) {
+  const uint t = get_global_id(0);
+  if (t >= tiles) return;
+  const uint n = state[FL_STATE_OLD_SIZE];
+  const uint begin = t * FL_TILE;
+  const uint end = min(n, begin + FL_TILE);
+  uint at = tileOff[t];
+  for (uint i = begin; i < end && at < room; ++i) {
+    const uint code = codes[i];
+    if (code == 0u) continue;
+    __global uint* e = events + 8u * at;
+    e[0] = as_uint(px[i]);
+    e[1] = as_uint(py[i]);
+    e[2] = as_uint(pz[i]);
+    e[3] = velocity ? as_uint(vx[i]) : 0u;
+    e[4] = velocity ? as_uint(vy[i]) : 0u;
+    e[5] = velocity ? as_uint(vz[i]) : 0u;
+    e[6] = id[i];
+    e[7] = code;
+    ++at;
+  }
+}
+
 /* The fastest particle's |v|^2 into the state, for sub-steps by distance (fused_pass.cpp
  * makePlan), newborns included. Non-negative floats order as their bits; NaN is left out, as std::max does. */
 __kernel void fl_max_speed(__global const float* restrict vx, __global const float* restrict vy,

@@ -427,4 +427,48 @@ FL_INLINE int fl_on_segment(float wx, float wy, float wz, float dx, float dy, fl
   return (t >= 0.0f) & (t <= 1.0f);
 }
 
+/* ---- Collision events (Group::recordCollisions): where a deflected particle met a solid ---- */
+
+/* When the straight path p + v·t meets a sphere (centre c, radius R) within [0, dt]: from
+ * outside its first meeting, from inside its way out; the outward normal there (up when the
+ * point is the centre). */
+FL_INLINE float fl_sphere_hit(float px, float py, float pz, float vx, float vy, float vz, float cx,
+                              float cy, float cz, float R, int inside, float dt, float* nx,
+                              float* ny, float* nz) {
+  const float dx = px - cx, dy = py - cy, dz = pz - cz;
+  const float a = vx * vx + vy * vy + vz * vz, b = dx * vx + dy * vy + dz * vz,
+              c = dx * dx + dy * dy + dz * dz - R * R;
+  const float disc = fl_maxf(b * b - a * c, 0.0f);
+  float t = a > 0.0f ? (inside ? (-b + sqrt(disc)) / a : (-b - sqrt(disc)) / a) : 0.0f;
+  t = fl_clampf(t, 0.0f, dt);
+  const float hx = dx + vx * t, hy = dy + vy * t, hz = dz + vz * t;
+  const float len = sqrt(hx * hx + hy * hy + hz * hz);
+  *nx = len > 0.0f ? hx / len : 0.0f;
+  *ny = len > 0.0f ? hy / len : 1.0f;
+  *nz = len > 0.0f ? hz / len : 0.0f;
+  return t;
+}
+
+/* The same for a box (lo, hi): the face the path enters by (outside: the latest entry) or
+ * leaves by (inside: the earliest exit), and that face's outward normal. */
+FL_INLINE float fl_box_hit(const float* p, const float* v, const float* lo, const float* hi,
+                           int inside, float dt, float* n) {
+  float best = inside ? INFINITY : -INFINITY;
+  int axis = 0;
+  float sign = 1.0f;
+  for (int k = 0; k < 3; ++k) {
+    if (v[k] == 0.0f) continue;
+    const float t0 = (lo[k] - p[k]) / v[k], t1 = (hi[k] - p[k]) / v[k];
+    const float enter = fl_minf(t0, t1), leave = fl_maxf(t0, t1);
+    if (inside ? leave < best : enter > best) {
+      best = inside ? leave : enter;
+      axis = k;
+      /* The face met: max when moving + and leaving, or moving - and entering. */
+      sign = (v[k] > 0.0f) == (inside != 0) ? 1.0f : -1.0f;
+    }
+  }
+  for (int k = 0; k < 3; ++k) n[k] = k == axis ? sign : 0.0f;
+  return fabs(best) < INFINITY ? fl_clampf(best, 0.0f, dt) : 0.0f;
+}
+
 #endif /* FLURRY_KERNELS_DEFLECT_H */

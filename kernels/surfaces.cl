@@ -109,6 +109,78 @@ FL_INLINE void fl_bounce_box(__global const FlActionParams* a, int inside, float
     fl_bounce_box_outside(fl_reflect_of(a), lo, hi, dt, px, py, pz, vxs, vys, vzs);
 }
 
+/* A collision event (Group::recordCollisions; cpu/collisions.hpp logCollisions, which finds
+ * the same): Bounce `action` (solid 0 a planar piece, 1 a sphere, 2 a box) changed the velocity
+ * of a live particle that had position p and velocity v before it, bouncing it with the
+ * acceleration acc (zero off the curve). Appended to `hits`: hits[0] counts every event, the
+ * first `room` are written, 16 words each (the key: particle index, then sub-step << 16 |
+ * action; position, velocity, normal, id, the time's bits); the host sorts them by key. */
+FL_INLINE void fl_log_collision(__global const FlActionParams* a, int solid, int inside, float px,
+                                float py, float pz, float vx, float vy, float vz, float ax,
+                                float ay, float az, float dt, fl_real start, uint i, uint sub,
+                                uint action, uint id, __global uint* hits, uint room) {
+  float hx, hy, hz, nx, ny, nz, tau;
+  if (solid == 0) {
+    float side;
+    const float Nx = a->f[3], Ny = a->f[4], Nz = a->f[5];
+    fl_planar_accel_hit(px, py, pz, vx, vy, vz, ax, ay, az, dt, a->f[0], a->f[1], a->f[2], Nx,
+                        Ny, Nz, &side, &tau, &hx, &hy, &hz);
+    nx = Nx * side;
+    ny = Ny * side;
+    nz = Nz * side;
+  } else {
+    if (solid == 1) {
+      tau = fl_sphere_hit(px, py, pz, vx, vy, vz, a->f[0], a->f[1], a->f[2], a->f[10], inside, dt,
+                          &nx, &ny, &nz);
+    } else {
+      __global const float* box = a->domain.v;
+      const float p[3] = {px, py, pz}, v[3] = {vx, vy, vz};
+      const float lo[3] = {box[0], box[1], box[2]}, hi[3] = {box[3], box[4], box[5]};
+      float n[3];
+      tau = fl_box_hit(p, v, lo, hi, inside, dt, n);
+      nx = n[0];
+      ny = n[1];
+      nz = n[2];
+    }
+    hx = px + vx * tau;
+    hy = py + vy * tau;
+    hz = pz + vz * tau;
+    if (inside) { /* towards where the particle came from */
+      nx = -nx;
+      ny = -ny;
+      nz = -nz;
+    }
+  }
+  const float ux = vx + ax * tau, uy = vy + ay * tau, uz = vz + az * tau;
+  const fl_real time = start + (fl_real)tau;
+  /* A particle left NaN or infinite by the list is killed by the step, not reported. */
+  const float sum = hx + hy + hz + ux + uy + uz + (float)time;
+  if (!isfinite(sum)) return;
+  const uint k = atomic_inc(hits);
+  if (k >= room) return;
+  __global uint* e = hits + 16u + 16u * k;
+  e[0] = i;
+  e[1] = (sub << 16) | (action & 0xFFFFu);
+  e[2] = as_uint(hx);
+  e[3] = as_uint(hy);
+  e[4] = as_uint(hz);
+  e[5] = as_uint(ux);
+  e[6] = as_uint(uy);
+  e[7] = as_uint(uz);
+  e[8] = as_uint(nx);
+  e[9] = as_uint(ny);
+  e[10] = as_uint(nz);
+  e[11] = id;
+#ifdef FL_FP64
+  const ulong tb = as_ulong(time);
+  e[12] = (uint)tb;
+  e[13] = (uint)(tb >> 32);
+#else
+  e[12] = as_uint(time);
+  e[13] = 0u;
+#endif
+}
+
 /* After a Move by an integrator other than semi-implicit Euler: a particle that its curved
  * step left on the wrong side of the deflector, compared with where it began the step
  * (sx, sy, sz), is put back on its side and reflected (fused_pass.cpp guard). The surface is

@@ -194,6 +194,54 @@ void IdleGroups(benchmark::State& state, Backend backend) {
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
+// Death events (Group::recordDeaths) on both backends: ~300k short-lived fountain particles,
+// a third dying every step, recorded (range 0 = 1) or not (0). The difference over the deaths
+// is an event's cost; on the device it includes waiting for the step and reading the events
+// back, which a step that does not record never does.
+void DeathEvents(benchmark::State& state, Backend backend) {
+  if (backend == Backend::OpenCL && !haveDevice()) return state.SkipWithError("no OpenCL device");
+  Context ctx(options(backend));
+  Group& g = samples::buildFountain(ctx, std::size_t(1) << 19, 3.0e6, 0.1f);
+  g.setActions(fountainActions());
+  g.recordDeaths(state.range(0) != 0 ? g.capacity() : 0);
+  ctx.run(10);
+  finish(g);
+  const int steps = 10;
+  const GroupStats before = g.stats();
+  timedSteps(state, ctx, g, steps);
+  const double died =
+      double(g.stats().killedByAge - before.killedByAge + g.stats().absorbed - before.absorbed);
+  state.counters["deaths/step"] = died / (double(state.iterations()) * steps);
+}
+
+// Collision events (Group::recordCollisions) on both backends: the fountain's ~300k particles
+// bouncing on the floor (many resting on it, deflected every step), recorded (range 0 = 1) or
+// not (0). The difference over the events is an event's cost; on the device it includes the
+// program that logs them, waiting for the step, reading them back and sorting them.
+void CollisionEvents(benchmark::State& state, Backend backend) {
+  if (backend == Backend::OpenCL && !haveDevice()) return state.SkipWithError("no OpenCL device");
+  Context ctx(options(backend));
+  Group& g = samples::buildFountain(ctx, std::size_t(1) << 19, 1.0e5, 3.0f);
+  g.setActions(fountainActions());
+  const bool record = state.range(0) != 0;
+  g.recordCollisions(record ? 4 * g.capacity() : 0);
+  ctx.run(90);
+  finish(g);
+  const int steps = 10;
+  double events = 0;
+  for (auto _ : state) {
+    for (int s = 0; s < steps; ++s) {
+      ctx.step();
+      events += double(g.collisions().size());
+    }
+    finish(g);
+  }
+  state.counters["us/step"] =
+      benchmark::Counter(double(state.iterations()) * steps * 1e-6,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  if (record) state.counters["events/step"] = events / (double(state.iterations()) * steps);
+}
+
 // The ceiling, measured the same way in every benchmark (bench/common).
 void ReadModifyWrite(benchmark::State& state) {
   flurry::bench::readModifyWrite(state, kLanes, threads());
@@ -251,6 +299,8 @@ class SummaryReporter : public benchmark::ConsoleReporter {
       bytes_[name] = get("bytes_per_second");
       items_[name] = get("items_per_second");
       usPerStep_[name] = get("us/step");
+      deathsPerStep_[name] = get("deaths/step");
+      eventsPerStep_[name] = get("events/step");
       if (name.rfind("Deflectors", 0) == 0) ms_[name] = r.GetAdjustedRealTime();
     }
   }
@@ -298,8 +348,9 @@ class SummaryReporter : public benchmark::ConsoleReporter {
       const double d32 = ms_["Deflectors/" + B + "/deflectors:32"];
       const double d2 = ms_["Deflectors/" + B + "/deflectors:2"];
       if (d32 > 0 && d2 > 0)
-        std::printf("  %-6s 1M particles, a floor in 32 pieces / in 2: %.2fx the time (aim <= 1.3)\n",
-                    b, d32 / d2);
+        std::printf(
+            "  %-6s 1M particles, a floor in 32 pieces / in 2: %.2fx the time (aim <= 1.3)\n", b,
+            d32 / d2);
       const double i100 = usPerStep_["IdleGroups/" + B + "/groups:100/alive:10"];
       const double i10 = usPerStep_["IdleGroups/" + B + "/groups:10/alive:10"];
       if (i100 > 0 && i10 > 0)
@@ -307,6 +358,26 @@ class SummaryReporter : public benchmark::ConsoleReporter {
             "  %-6s 100 groups of which 10 alive / the 10 alone: %.2fx (%.1f / %.1f us a step; "
             "aim <= 1.2)\n",
             b, i100 / i10, i100, i10);
+    }
+    for (const char* b : {"cpu", "opencl"}) {
+      const std::string on = std::string("DeathEvents/") + b + "/record:1",
+                        off = std::string("DeathEvents/") + b + "/record:0";
+      const double d = deathsPerStep_[on];
+      if (usPerStep_[on] > 0 && usPerStep_[off] > 0 && d > 0)
+        std::printf(
+            "  %-6s death events: %.0f us a step recording %.0f deaths, %.0f us not: %.1f ns an "
+            "event\n",
+            b, usPerStep_[on], d, usPerStep_[off], (usPerStep_[on] - usPerStep_[off]) * 1e3 / d);
+    }
+    for (const char* b : {"cpu", "opencl"}) {
+      const std::string on = std::string("CollisionEvents/") + b + "/record:1",
+                        off = std::string("CollisionEvents/") + b + "/record:0";
+      const double e = eventsPerStep_[on];
+      if (usPerStep_[on] > 0 && usPerStep_[off] > 0 && e > 0)
+        std::printf(
+            "  %-6s collision events: %.0f us a step recording %.0f events, %.0f us not: %.1f ns "
+            "an event\n",
+            b, usPerStep_[on], e, usPerStep_[off], (usPerStep_[on] - usPerStep_[off]) * 1e3 / e);
     }
     if (gCompile.measured)
       std::printf(
@@ -316,7 +387,7 @@ class SummaryReporter : public benchmark::ConsoleReporter {
   }
 
  private:
-  std::map<std::string, double> bytes_, items_, usPerStep_, ms_;
+  std::map<std::string, double> bytes_, items_, usPerStep_, ms_, deathsPerStep_, eventsPerStep_;
 };
 
 }  // namespace
@@ -379,6 +450,30 @@ BENCHMARK_CAPTURE(IdleGroups, opencl, Backend::OpenCL)
     ->Args({10, 10})
     ->Args({100, 10})
     ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(DeathEvents, cpu, Backend::Cpu)
+    ->ArgName("record")
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(DeathEvents, opencl, Backend::OpenCL)
+    ->ArgName("record")
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(CollisionEvents, cpu, Backend::Cpu)
+    ->ArgName("record")
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(CollisionEvents, opencl, Backend::OpenCL)
+    ->ArgName("record")
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(SmallStep, cpu, Backend::Cpu)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(SmallStep, opencl, Backend::OpenCL)->Unit(benchmark::kMillisecond)->UseRealTime();

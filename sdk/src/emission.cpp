@@ -475,6 +475,7 @@ void emitFrom(GroupImpl& g, std::size_t k, std::span<const Event> events, std::u
   const DeathEmitter& de = g.deathEmitters[k];
   if (events.empty()) return;
   g.ensureStorage();
+  if (g.mirror) g.mirror->beginAppend(g);  // a device's group: its count, then only the newborns
   const Lanes L = g.lanePointers();
   const std::size_t before = g.size;
   for (const Event& event : events) {
@@ -528,6 +529,7 @@ void emitFrom(GroupImpl& g, std::size_t k, std::span<const Event> events, std::u
     }
   }
   g.startTrails(before, g.size);
+  if (g.mirror) g.mirror->endAppend(g, before);
   // The step's box, kept by the pass, grows to hold them.
   if (g.boundsValid)
     for (std::size_t i = before; i < g.size; ++i) {

@@ -902,19 +902,15 @@ void detail::GroupImpl::endCollisions(std::size_t blocks) {
 }
 
 namespace {
-// Events (deaths, collisions) are the CPU pass's, and carry the particles' ids.
-void startRecording(Group& g, const char* call, const char* what, std::size_t perStep) {
-  if (perStep == 0) return;
-  if (detail::GroupAccess::of(g).onDevice)
-    throw Error(std::string(call) + ": group '" + g.name() + "': " + what +
-                " events are recorded by the CPU backend only (this context runs on a device)");
-  g.require({Attribute::Id});
+// Events carry the particles' ids (both backends record them).
+void startRecording(Group& g, std::size_t perStep) {
+  if (perStep > 0) g.require({Attribute::Id});
 }
 }  // namespace
 
 Group& Group::recordCollisions(std::size_t perStep) {
   auto& g = *impl_;
-  startRecording(*this, "recordCollisions", "collision", perStep);
+  startRecording(*this, perStep);
   g.collisionEvents.clear();
   g.collisionEvents.reserve(std::min(perStep, g.capacity));
   g.collisionsPerStep = perStep;
@@ -949,7 +945,7 @@ void detail::GroupImpl::feedDeaths() {
 
 Group& Group::recordDeaths(std::size_t perStep) {
   auto& g = *impl_;
-  startRecording(*this, "recordDeaths", "death", perStep);
+  startRecording(*this, perStep);
   g.deathEvents.clear();
   g.deathEvents.reserve(std::min(std::max(perStep, g.deathRoom()), g.capacity));
   g.deathsPerStep = perStep;
@@ -959,9 +955,6 @@ Group& Group::recordDeaths(std::size_t perStep) {
 DeathEmitter& Group::addDeathEmitter(DeathEmitter emitter) {
   auto& g = *impl_;
   const std::string where = "deathEmitters[" + std::to_string(g.deathEmitters.size()) + "]";
-  if (g.onDevice)
-    throw Error("group '" + g.name + "': " + where +
-                ": a death emitter does not run on the device yet (the CPU backend runs it)");
   emitter.validate(where);
   g.deathEmitters.push_back(std::move(emitter));
   if (g.contextDeathEmitters) ++*g.contextDeathEmitters;

@@ -106,6 +106,12 @@ class DeviceMirror {
   virtual void hostChanged(GroupImpl& group) = 0;
   /// Brings the group's statistics up to date (without reading particles back).
   virtual void syncStats(GroupImpl& /*group*/) {}
+  /// The host appends particles (a death emitter's newborns): beginAppend brings the live
+  /// count and the next id up to date, the host writes its lanes from there on, and
+  /// endAppend(group, from) takes [from, size) to the device. By default the whole group
+  /// goes both ways.
+  virtual void beginAppend(GroupImpl& group) { pullToHost(group, AttributeSet::all()); }
+  virtual void endAppend(GroupImpl& group, std::size_t /*from*/) { hostChanged(group); }
 };
 
 /// What the CPU fused pass derives from the action list alone. Built when the list changes

@@ -243,3 +243,192 @@ TEST(OpenCLCore, ACallbackMayNotReturn) {
     EXPECT_NE(std::string(e.what()).find("return"), std::string::npos) << e.what();
   }
 }
+
+// Death events on the device: the same deaths as the CPU's, step by step (ids, causes and
+// times exactly, places and velocities within the parity tolerance), the first `room` in
+// particle order when a step has more and the rest counted alike. A small group (one
+// work-group's step when it does not record) and one of many tiles, and a group that stores
+// no velocity (its events say zero).
+TEST(OpenCLCore, DeathEventsAsOnTheCpu) {
+  FLURRY_REQUIRE_OPENCL();
+  auto run = [](Backend backend, double rate, std::size_t room, bool velocity) {
+    ContextOptions o;
+    o.seed = 7;
+    o.dt = 1.0 / 30.0;
+    o.threads = 2;
+    o.backend = backend;
+    Context ctx(o);
+    Group& g = ctx.createGroup("deaths", 40000);
+    g.addEmitter(spray(Vec3(0.0f, 1.0f, 0.0f), rate));
+    // Killed below the floor (Sink, action 1) or by age (KillOld, action 3).
+    ActionList list{
+        Gravity{kDown},
+        Sink{.region = Domain::box(Vec3(-50.0f, -50.0f, -50.0f), Vec3(50.0f, -5.0f, 50.0f))},
+        Move{}, KillOld{}};
+    if (!velocity)
+      list = {Sink{.region = Domain::box(Vec3(-0.05f), Vec3(0.05f, 2.0f, 0.05f))}, KillOld{}};
+    g.setActions(list);
+    g.recordDeaths(room);
+    EXPECT_EQ(g.attributes().has(Attribute::Velocity), velocity);
+    std::vector<std::vector<DeathEvent>> steps;
+    for (int s = 0; s < 90; ++s) {
+      ctx.step();
+      steps.emplace_back(g.deaths().begin(), g.deaths().end());
+    }
+    return std::pair(steps, g.stats());
+  };
+  for (const auto& [rate, room, velocity] :
+       {std::tuple(1500.0, std::size_t(1000000), true), std::tuple(1500.0, std::size_t(20), true),
+        std::tuple(9000.0, std::size_t(1000000), true), std::tuple(9000.0, std::size_t(150), true),
+        std::tuple(1500.0, std::size_t(1000000), false)}) {
+    SCOPED_TRACE("rate " + std::to_string(rate) + ", room " + std::to_string(room) +
+                 (velocity ? "" : ", no velocity"));
+    const auto [cpu, cpuStats] = run(Backend::Cpu, rate, room, velocity);
+    const auto [cl, clStats] = run(Backend::OpenCL, rate, room, velocity);
+    ASSERT_EQ(cpu.size(), cl.size());
+    std::size_t events = 0, causes[2] = {0, 0};
+    for (std::size_t s = 0; s < cpu.size(); ++s) {
+      ASSERT_EQ(cpu[s].size(), cl[s].size()) << "step " << s;
+      for (std::size_t k = 0; k < cpu[s].size(); ++k) {
+        const DeathEvent &a = cpu[s][k], &b = cl[s][k];
+        ASSERT_EQ(a.id, b.id) << "step " << s << ", event " << k;
+        EXPECT_EQ(a.action, b.action);
+        EXPECT_EQ(a.time, b.time);
+        for (int c = 0; c < 3; ++c) {
+          expectClose(a.position[c], b.position[c], "position", a.id, c);
+          expectClose(a.velocity[c], b.velocity[c], "velocity", a.id, c);
+          if (!velocity) {
+            EXPECT_EQ(b.velocity[c], 0.0f);
+          }
+        }
+        ++causes[a.action == (velocity ? 1u : 0u) ? 0 : 1];  // the Sink, or KillOld
+      }
+      events += cpu[s].size();
+    }
+    EXPECT_EQ(cpuStats.deathEventsDropped, clStats.deathEventsDropped);
+    EXPECT_EQ(cpuStats.killedByAction, clStats.killedByAction);
+    // Each run has deaths of both causes, and the small rooms dropped some.
+    EXPECT_GT(causes[0], 0u);
+    if (velocity) {
+      EXPECT_GT(causes[1], 0u);  // (without Move nothing ages)
+    }
+    if (room < 1000) {
+      EXPECT_GT(cpuStats.deathEventsDropped, 0u);
+    }
+    EXPECT_GT(events, 0u);
+  }
+}
+
+// Collision events on the device: the same deflections as the CPU's, step by step, in the
+// CPU's order (particle, sub-step, action): ids and Bounces exactly, places, arriving
+// velocities, normals and times within the parity tolerance; the first `room` when a step has
+// more, the rest counted alike. A floor (a planar piece), a ball from outside and a box from
+// inside, on the straight path (semi-implicit Euler, two sub-steps) and on the parabola
+// (Exact: the floor bounces with the acceleration).
+TEST(OpenCLCore, CollisionEventsAsOnTheCpu) {
+  FLURRY_REQUIRE_OPENCL();
+  auto run = [](Backend backend, Integrator integrator, std::size_t room) {
+    ContextOptions o;
+    o.seed = 7;
+    o.dt = 1.0 / 30.0;
+    o.threads = 2;
+    o.backend = backend;
+    Context ctx(o);
+    Group& g = ctx.createGroup("hits", 20000);
+    g.addEmitter(spray(Vec3(0.0f, 1.0f, 0.0f), 3000));
+    ActionList list{Gravity{kDown},
+                    Bounce{Domain::plane(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f)), 0.6f, 0.1f},
+                    Bounce{Domain::sphere(Vec3(0.3f, 2.5f, 0.0f), 0.6f), 0.8f},
+                    Bounce{Domain::box(Vec3(-1.5f, -1.0f, -1.5f), Vec3(1.5f, 6.0f, 1.5f)), 0.9f,
+                           0.0f, 0.0f, true},
+                    Move{},
+                    KillOld{}};
+    list.setIntegrator(integrator);
+    if (integrator == Integrator::SemiImplicitEuler) list.setSubsteps({1.0 / 60.0, 0.0f, 4});
+    g.setActions(list);
+    g.recordCollisions(room);
+    std::vector<std::vector<CollisionEvent>> steps;
+    for (int s = 0; s < 60; ++s) {
+      ctx.step();
+      steps.emplace_back(g.collisions().begin(), g.collisions().end());
+    }
+    return std::pair(steps, g.stats());
+  };
+  for (const auto& [integrator, room] :
+       {std::pair(Integrator::SemiImplicitEuler, std::size_t(1 << 20)),
+        std::pair(Integrator::SemiImplicitEuler, std::size_t(40)),
+        std::pair(Integrator::Exact, std::size_t(1 << 20))}) {
+    SCOPED_TRACE(std::string(integrator == Integrator::Exact ? "Exact" : "semi-implicit Euler") +
+                 ", room " + std::to_string(room));
+    const auto [cpu, cpuStats] = run(Backend::Cpu, integrator, room);
+    const auto [cl, clStats] = run(Backend::OpenCL, integrator, room);
+    ASSERT_EQ(cpu.size(), cl.size());
+    std::size_t byBounce[3] = {0, 0, 0};
+    for (std::size_t s = 0; s < cpu.size(); ++s) {
+      ASSERT_EQ(cpu[s].size(), cl[s].size()) << "step " << s;
+      for (std::size_t k = 0; k < cpu[s].size(); ++k) {
+        const CollisionEvent &a = cpu[s][k], &b = cl[s][k];
+        ASSERT_EQ(a.id, b.id) << "step " << s << ", event " << k;
+        ASSERT_EQ(a.action, b.action) << "step " << s << ", event " << k;
+        EXPECT_NEAR(a.time, b.time, 1e-6) << "particle " << a.id;
+        for (int c = 0; c < 3; ++c) {
+          expectClose(a.position[c], b.position[c], "position", a.id, c);
+          expectClose(a.velocity[c], b.velocity[c], "velocity", a.id, c);
+          expectClose(a.normal[c], b.normal[c], "normal", a.id, c);
+        }
+        if (a.action >= 1 && a.action <= 3) ++byBounce[a.action - 1];
+      }
+    }
+    EXPECT_EQ(cpuStats.collisionEventsDropped, clStats.collisionEventsDropped);
+    // Every Bounce deflected some, and the small room dropped some.
+    for (std::size_t n : byBounce) EXPECT_GT(n, 0u);
+    if (room < 1000) {
+      EXPECT_GT(cpuStats.collisionEventsDropped, 0u);
+    }
+  }
+}
+
+// Sub-emitters on death and on collision with their source on the device: the source's events
+// come back from the device, the host makes their newborns as on the CPU (emission.cpp
+// emitFrom) and sends only those to the device's end of the group. The splashes are the same
+// particles as the CPU's, step after step, flying on under their own list. A sub-emitter on
+// birth is a clear error on the device.
+TEST(OpenCLCore, SubEmittersOnDeathAndCollisionAsOnTheCpu) {
+  auto build = [](Context& ctx) -> Group& {
+    Group& sparks = ctx.createGroup("sparks", 20000);
+    sparks.addEmitter(spray(Vec3(0.0f, 1.0f, 0.0f), 1500));
+    sparks.setActions({Gravity{kDown},
+                       Bounce{Domain::plane(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f)), 0.5f, 0.2f},
+                       Move{}, KillOld{}});
+    Group& splash = ctx.createGroup("splash", 30000);
+    ParticleType drop;
+    drop.velocity = Domain::sphere(Vec3(0.0f, 1.0f, 0.0f), 0.5f);
+    drop.lifetime = Fuzzy(0.5f, 0.2f);
+    DeathEmitter onDeath;
+    onDeath.source = "sparks";
+    onDeath.count = 2.5f;
+    onDeath.shape = Domain::sphere(Vec3(0.0f), 0.05f);
+    onDeath.types = {drop};
+    splash.addDeathEmitter(onDeath);
+    DeathEmitter onHit = onDeath;
+    onHit.on = DeathEmitter::Trigger::Collision;
+    onHit.count = 0.5f;
+    onHit.inheritVelocity = 0.3f;
+    splash.addDeathEmitter(onHit);
+    splash.setActions({Gravity{kDown}, Move{}, KillOld{}});
+    return splash;
+  };
+  checkParity(build, 90);
+  FLURRY_REQUIRE_OPENCL();
+  ContextOptions o;
+  o.backend = Backend::OpenCL;
+  Context ctx(o);
+  Group& splash = build(ctx);
+  splash.deathEmitters()[0].on = DeathEmitter::Trigger::Birth;
+  try {
+    ctx.step();
+    FAIL() << "a sub-emitter on birth ran on the device";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("on birth"), std::string::npos) << e.what();
+  }
+}

@@ -292,8 +292,7 @@ ActionList allForces(Integrator integrator) {
   f.field = grid();
   f.mode = SampledField::Mode::Velocity;
   f.falloff = kFalloff;
-  ActionList l{Gravity{kDown, kFalloffPow},
-               Damping{Vec3(0.3f, 0.1f, 0.6f), kFalloff},
+  ActionList l{Gravity{kDown, kFalloffPow}, Damping{Vec3(0.3f, 0.1f, 0.6f), kFalloff},
                // A soft core (epsilon 0.5): explicit Euler near a hard one turns the device's
                // one-ulp differences in exp/sqrt into a drift past the tolerance over 200 steps.
                OrbitPoint{Vec3(0.5f, 3.0f, 0.0f), 10.0f, 0.5f, 4.0f},
@@ -304,11 +303,8 @@ ActionList allForces(Integrator integrator) {
                RandomAccel{Domain::sphere(Vec3(0.0f), 3.0f), kFalloff},
                Turbulence{3.0f, 0.8f, 2, Vec3(0.5f, 0.0f, 0.2f), kFalloffPow},
                ElectricField{Vec3(2.0f, 0.0f, -1.0f), kFalloff},
-               MagneticField{Vec3(0.5f, 2.5f, 1.0f), kFalloffPow},
-               f,
-               TargetVelocity{Vec3(0.0f, 1.0f, 0.0f), 0.2f},
-               Move{},
-               KillOld{}};
+               MagneticField{Vec3(0.5f, 2.5f, 1.0f), kFalloffPow}, f,
+               TargetVelocity{Vec3(0.0f, 1.0f, 0.0f), 0.2f}, Move{}, KillOld{}};
   l.setIntegrator(integrator);
   return l;
 }

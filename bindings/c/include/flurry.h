@@ -449,12 +449,12 @@ typedef struct flurry_death_event {
  * "source" has deaths), given as the JSON object an effect file's "deathEmitters" holds, e.g.
  * {"source": "rain", "count": 3, "cause": 0, "types": [{"velocity": [0, 2, 0]}]}. Bad fields
  * are FLURRY_ERROR_EFFECT naming "deathEmitter.FIELD"; the source is looked up when the
- * context steps (a missing one fails that step, before anything moves). CPU backend only. */
+ * context steps (a missing one fails that step, before anything moves). On a device, those
+ * on death and on collision run (on birth: the CPU backend only). */
 FLURRY_C_EXPORT flurry_status flurry_group_add_death_emitter(flurry_group* group, const char* json);
 
 /** Records each step's deaths, at most `per_step` a step (the first in particle order; the
- * rest counted in flurry_group_deaths' *dropped); 0 stops. CPU backend only: on a device
- * FLURRY_ERROR_OTHER says so. */
+ * rest counted in flurry_group_deaths' *dropped); 0 stops. Both backends record them. */
 FLURRY_C_EXPORT flurry_status flurry_group_record_deaths(flurry_group* group, size_t per_step);
 /** The last step's deaths (valid until the next step); *dropped (may be NULL) gets the deaths
  * not recorded for want of room, over the group's life. */
@@ -475,8 +475,7 @@ typedef struct flurry_collision_event {
 } flurry_collision_event;
 
 /** Records each step's collisions, at most `per_step` a step (the first in particle order; the
- * rest counted in flurry_group_collisions' *dropped); 0 stops. CPU backend only: on a device
- * FLURRY_ERROR_OTHER says so. */
+ * rest counted in flurry_group_collisions' *dropped); 0 stops. Both backends record them. */
 FLURRY_C_EXPORT flurry_status flurry_group_record_collisions(flurry_group* group, size_t per_step);
 /** The last step's collisions (valid until the next step); *dropped (may be NULL) gets those
  * not recorded for want of room, over the group's life. */

@@ -449,7 +449,7 @@ NB_MODULE(_flurry, m) {
           "record_deaths", [](GroupRef& pg, std::size_t perStep) { pg.g->recordDeaths(perStep); },
           "per_step"_a,
           "Records each step's deaths, at most per_step a step (the first in particle order; "
-          "the rest counted in stats.death_events_dropped); 0 stops. CPU backend only.")
+          "the rest counted in stats.death_events_dropped); 0 stops. Both backends.")
       .def(
           "deaths", [](const GroupRef& pg) { return eventArrays(pg.g->deaths()); },
           "The last step's deaths (record_deaths), copied: position (n, 3), velocity (n, 3), "
@@ -460,7 +460,7 @@ NB_MODULE(_flurry, m) {
           [](GroupRef& pg, std::size_t perStep) { pg.g->recordCollisions(perStep); }, "per_step"_a,
           "Records each step's collisions (each time a Bounce deflects a particle), at most "
           "per_step a step (the first in particle order; the rest counted in "
-          "stats.collision_events_dropped); 0 stops. CPU backend only.")
+          "stats.collision_events_dropped); 0 stops. Both backends.")
       .def(
           "collisions", [](const GroupRef& pg) { return eventArrays(pg.g->collisions()); },
           "The last step's collisions (record_collisions), copied: position (n, 3) of impact, "

@@ -292,8 +292,9 @@ class Group {
   /// order, the same on any thread count; the rest are counted in
   /// GroupStats::deathEventsDropped (while a DeathEmitter names the group, all of them are
   /// recorded for it). 0 stops it. The room is taken here, not per step, and
-  /// while off it costs nothing. Stores ids (the events carry them). The CPU backend
-  /// records them; a device backend throws Error (not yet there).
+  /// while off it costs nothing. Stores ids (the events carry them). Both backends record
+  /// the same events; on a device the host waits for each step it records and reads its
+  /// events back (what a step costs there while recording).
   Group& recordDeaths(std::size_t perStep);
   /// The deaths of the last step (empty when not recording), valid until the next step.
   std::span<const DeathEvent> deaths() const;
@@ -304,8 +305,8 @@ class Group {
   /// (while a collision emitter names the group, all of them are recorded for it). A
   /// particle left NaN or infinite is not reported (the step kills it). 0 stops it; while off it
   /// costs nothing. A particle resting on a floor is deflected, and reported, every step it rests
-  /// (filter by the speed). Stores ids. The CPU backend records them; a device backend throws
-  /// Error.
+  /// (filter by the speed). Stores ids. Both backends record them; on a device the host
+  /// waits for each step it records and reads its events back.
   Group& recordCollisions(std::size_t perStep);
   /// The collisions of the last step (empty when not recording), valid until the next step.
   std::span<const CollisionEvent> collisions() const;

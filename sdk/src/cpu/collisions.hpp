@@ -21,48 +21,6 @@ inline void keepState(const Lanes& L, std::size_t n, float* keep) {
   }
 }
 
-namespace collision {
-
-// When a straight path p + v·t meets a sphere (from outside: its first meeting; from inside:
-// its way out), within [0, dt]; the outward normal at that point.
-inline float sphereHit(Vec3 p, Vec3 v, const SphereDomain& s, bool inside, float dt, Vec3& n) {
-  const Vec3 d = p - s.center;
-  const float a = glm::dot(v, v), b = glm::dot(d, v),
-              c = glm::dot(d, d) - s.outerRadius * s.outerRadius;
-  const float disc = std::max(b * b - a * c, 0.0f);
-  float t = a > 0.0f ? (inside ? (-b + std::sqrt(disc)) / a : (-b - std::sqrt(disc)) / a) : 0.0f;
-  t = std::clamp(t, 0.0f, dt);
-  const Vec3 h = d + v * t;
-  const float len = glm::length(h);
-  n = len > 0.0f ? h / len : Vec3(0.0f, 1.0f, 0.0f);
-  return t;
-}
-
-// The same for a box: the face the path enters by (outside) or leaves by (inside); the
-// face's outward normal.
-inline float boxHit(Vec3 p, Vec3 v, const BoxDomain& box, bool inside, float dt, Vec3& n) {
-  float best = inside ? kInfinity : -kInfinity;
-  int axis = 0;
-  float sign = 1.0f;
-  for (int k = 0; k < 3; ++k) {
-    if (v[k] == 0.0f) continue;
-    const float t0 = (box.min[k] - p[k]) / v[k], t1 = (box.max[k] - p[k]) / v[k];
-    const float enter = std::min(t0, t1), leave = std::max(t0, t1);
-    // Outside: the latest entry; inside: the earliest exit.
-    if (inside ? leave < best : enter > best) {
-      best = inside ? leave : enter;
-      axis = k;
-      // The face met: max when moving + and leaving, or moving - and entering.
-      sign = (v[k] > 0.0f) == inside ? 1.0f : -1.0f;
-    }
-  }
-  n = Vec3(0.0f);
-  n[axis] = sign;
-  return std::isfinite(best) ? std::clamp(best, 0.0f, dt) : 0.0f;
-}
-
-}  // namespace collision
-
 /// flag[j] = 1 where particle j lives and its velocity (u) differs from what it was (v): a
 /// loop over __restrict parameters, which GCC vectorises (over a lambda's captures it does
 /// not).
@@ -134,10 +92,19 @@ inline void logCollisions(const Bounce& b, std::uint32_t action, const Lanes& L,
     const Vec3 p(px[i], py[i], pz[i]), v(vx[i], vy[i], vz[i]);
     Vec3 nrm(0.0f);
     float tau = 0.0f;
-    if (const auto* s = std::get_if<SphereDomain>(&shape))
-      tau = collision::sphereHit(p, v, *s, b.inside, dt, nrm);
-    else if (const auto* bx = std::get_if<BoxDomain>(&shape))
-      tau = collision::boxHit(p, v, *bx, b.inside, dt, nrm);
+    // (kernels/deflect.h: the device's events take the same)
+    if (const auto* s = std::get_if<SphereDomain>(&shape)) {
+      tau =
+          kernel::fl_sphere_hit(p.x, p.y, p.z, v.x, v.y, v.z, s->center.x, s->center.y, s->center.z,
+                                s->outerRadius, b.inside, dt, &nrm.x, &nrm.y, &nrm.z);
+    } else if (const auto* bx = std::get_if<BoxDomain>(&shape)) {
+      const float pa[3] = {p.x, p.y, p.z}, va[3] = {v.x, v.y, v.z};
+      const float lo[3] = {bx->min.x, bx->min.y, bx->min.z},
+                  hi[3] = {bx->max.x, bx->max.y, bx->max.z};
+      float na[3];
+      tau = kernel::fl_box_hit(pa, va, lo, hi, b.inside, dt, na);
+      nrm = Vec3(na[0], na[1], na[2]);
+    }
     CollisionEvent e;
     e.position = p + v * tau;
     e.normal = b.inside ? -nrm : nrm;  // towards where the particle came from

@@ -9,6 +9,7 @@
 //   fl_count     dead per tile                \  only when the list can kill;
 //   fl_scan      prefix over tiles, counts     > one launch (fl_scan_list) for groups of
 //   fl_list      hole and tail lists           /  a few tiles
+//   fl_deaths    the dead as events (Group::recordDeaths), before fl_tail
 //   fl_tail      closes holes from the tail
 // A small group's step is one launch: fl_small does all of it in one work-group.
 //
@@ -18,6 +19,7 @@
 #include "backend.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -49,6 +51,7 @@ constexpr std::size_t kSmallLocal = 64;  // count, list and tail
 constexpr std::size_t kMaxInFlight = 4;  // steps queued before the host waits for the oldest
 constexpr std::size_t kMaxFillItems = 1 << 12;  // PoCL pays ~1 us per work-group, even an idle one
 constexpr std::size_t kSmallTiles = 4;          // up to 4096 particles: count-scan-list in one item
+constexpr std::size_t kDeathEventBytes = 8 * 4;  // fl_deaths: position, velocity, id, code
 
 std::size_t roundUp(std::size_t x, std::size_t m) {
   return (x + m - 1) / m * m;
@@ -207,6 +210,38 @@ class ClGroup final : public DeviceMirror {
   }
 
   void hostChanged(GroupImpl&) override { hostDirty_ = true; }
+
+  // A death emitter's newborns: the device's count and next id, and then only the newborns
+  // go up (the particles before them stay where they are, on the device).
+  void beginAppend(GroupImpl& g) override {
+    if (hostDirty_ || !allocated_) return;  // the host's copy is the group's: it goes up whole
+    drain(g);
+    g.size = size_;
+    g.nextId = nextId_;
+  }
+  void endAppend(GroupImpl& g, std::size_t from) override {
+    if (hostDirty_ || !allocated_) {
+      hostDirty_ = true;
+      return;
+    }
+    const std::size_t n = g.size - from;
+    for (auto& lane : lanes_) {
+      if (n == 0) break;
+      const auto* src = static_cast<const char*>(
+          g.lanes[std::size_t(lane.ref.attribute)][lane.ref.component].data());
+      check(clEnqueueWriteBuffer(queue(), lane.mem.get(), CL_FALSE, from * 4, n * 4, src + from * 4,
+                                 0, nullptr, nullptr),
+            "clEnqueueWriteBuffer (newborns)");
+    }
+    // Blocking, after the lanes in the same in-order queue: the host's lanes are free again.
+    const std::uint32_t head[2] = {std::uint32_t(g.size), g.nextId};
+    static_assert(FL_STATE_SIZE == 0 && FL_STATE_NEXT_ID == 1);
+    check(clEnqueueWriteBuffer(queue(), state_.mem.get(), CL_TRUE, 0, sizeof head, head, 0, nullptr,
+                               nullptr),
+          "clEnqueueWriteBuffer (state)");
+    size_ = g.size;
+    nextId_ = g.nextId;
+  }
   // Steps in flight report their counts when they finish: wait for them, read no particles.
   void syncStats(GroupImpl& g) override { finish(g); }
 
@@ -225,7 +260,7 @@ class ClGroup final : public DeviceMirror {
   cl_context context() const { return shared_->runtime->context(); }
 
   void allocate(GroupImpl& g);
-  void buildProgram(GroupImpl& g, bool cull);
+  void buildProgram(GroupImpl& g, bool cull, bool hits);
   void upload(GroupImpl& g);
   void retire(GroupImpl& g, bool wait);
   void drain(GroupImpl& g) {
@@ -234,6 +269,8 @@ class ClGroup final : public DeviceMirror {
   void apply(GroupImpl& g, const std::vector<std::uint32_t>& state);
   void queueHair(GroupImpl& g, const StepParams& sp, std::size_t births);
   void readStrands(GroupImpl& g, std::size_t births);
+  void readDeaths(GroupImpl& g, std::size_t room, double t1);
+  void readCollisions(GroupImpl& g);
 
   std::shared_ptr<Shared> shared_;
   std::vector<DeviceLane> lanes_;
@@ -266,6 +303,11 @@ class ClGroup final : public DeviceMirror {
   std::vector<std::uint64_t> staticUploaded_;
   bool hairProgram_ = false;  // the program has fl_hair
   bool cullProgram_ = false;  // the program was generated for ContextOptions::cull
+  bool hitsProgram_ = false;  // ... to log collisions (Group::recordCollisions)
+  GrowBuffer hits_;           // fl_log_collision's count and events
+  std::size_t hitRoom_ = 0;   // the events hits_ holds; grows to the most a step had
+  std::vector<std::uint32_t> hitWords_;
+  std::vector<std::pair<std::uint64_t, CollisionEvent>> hitsSorted_;
   Kernel hair_, small_;
   GrowBuffer strandP_, strandC_, strandR_, strandCount_;
   std::uint32_t lastHairAlive_ = 0;
@@ -273,7 +315,7 @@ class ClGroup final : public DeviceMirror {
   std::uint32_t reachOff_ = 0;  // where the actions' reach boxes start in extra_host_
   std::vector<LaneRef> actLanes_;
   bool neighbours_ = false, substepsByDistance_ = false;
-  Kernel act_, count_, scan_, list_, scanList_, tailKernel_, maxSpeed_, birth_;
+  Kernel act_, count_, scan_, list_, scanList_, tailKernel_, maxSpeed_, birth_, deaths_;
   std::vector<cl::FlActionParams> params_host_, params_uploaded_;
   std::vector<float> extra_host_, extra_uploaded_;
 
@@ -283,6 +325,9 @@ class ClGroup final : public DeviceMirror {
   std::size_t size_ = 0;  // the device's live count at the last completed step
   std::uint32_t nextId_ = 0;
   std::uint32_t lastDropped_ = 0;
+  std::uint32_t lastDead_ = 0;  // the last retired step's dead
+  GrowBuffer events_;           // fl_deaths' events, kDeathEventBytes each
+  std::vector<std::uint32_t> deathWords_;
   std::vector<std::uint32_t> lastKills_;
   bool hostDirty_ = true;
   bool deviceNewer_ = false;
@@ -336,11 +381,11 @@ void ClGroup::allocate(GroupImpl& g) {
   programValid_ = false;
 }
 
-void ClGroup::buildProgram(GroupImpl& g, bool cull) {
+void ClGroup::buildProgram(GroupImpl& g, bool cull, bool hits) {
   // The emitter codes this step refreshed: the program and the planning agree on them.
   const GeneratedProgram gen =
       generateProgram(g.actions, g.stored, shared_->fp64(), emissionSource(emitterCodes_.variants),
-                      g.hair.enabled, cull);
+                      g.hair.enabled, cull, hits);
   emitterSignature_ = emitterSignature(emitterCodes_.variants);
   Program p(shared_->runtime->program(gen.source, gen.options));
   cl_int err = CL_SUCCESS;
@@ -351,7 +396,8 @@ void ClGroup::buildProgram(GroupImpl& g, bool cull) {
   };
   Kernel act = kernel("fl_act"), count = kernel("fl_count"), scan = kernel("fl_scan"),
          list = kernel("fl_list"), scanList = kernel("fl_scan_list"), tail = kernel("fl_tail"),
-         maxSpeed = kernel("fl_max_speed"), birth = kernel("fl_birth");
+         maxSpeed = kernel("fl_max_speed"), birth = kernel("fl_birth"),
+         deaths = kernel("fl_deaths");
   Kernel hair = g.hair.enabled ? kernel("fl_hair") : Kernel();
   Kernel small = gen.small ? kernel("fl_small") : Kernel();
   program_ = std::move(p);
@@ -363,10 +409,12 @@ void ClGroup::buildProgram(GroupImpl& g, bool cull) {
   tailKernel_ = std::move(tail);
   maxSpeed_ = std::move(maxSpeed);
   birth_ = std::move(birth);
+  deaths_ = std::move(deaths);
   hair_ = std::move(hair);
   small_ = std::move(small);
   hairProgram_ = g.hair.enabled;
   cullProgram_ = cull;
+  hitsProgram_ = hits && !g.hair.enabled;
   actLanes_ = gen.actLanes;
   neighbours_ = gen.neighbours;
   substepsByDistance_ = gen.substepsByDistance;
@@ -413,6 +461,19 @@ void ClGroup::buildProgram(GroupImpl& g, bool cull) {
     for (int c = 0; c < 3; ++c)
       setArg(maxSpeed_.get(), cl_uint(c), laneMem({Attribute::Velocity, c, ""}));
   }
+  // fl_deaths: its lanes (velocity aliases the position where not stored; the id is stored
+  // by every group that records deaths, Group::recordDeaths requires it).
+  setArg(deaths_.get(), 0, codes_.get());
+  setArg(deaths_.get(), 1, tileOff_.get());
+  const bool velocity = g.stored.has(Attribute::Velocity);
+  for (int c = 0; c < 3; ++c) {
+    setArg(deaths_.get(), cl_uint(3 + c), laneMem({Attribute::Position, c, ""}));
+    setArg(deaths_.get(), cl_uint(6 + c),
+           laneMem({velocity ? Attribute::Velocity : Attribute::Position, c, ""}));
+  }
+  setArg(deaths_.get(), 9, cl_uint(velocity));
+  const cl_mem id = laneMem({Attribute::Id, 0, ""});
+  setArg(deaths_.get(), 10, id ? id : laneMem({Attribute::Position, 0, ""}));
   params_uploaded_.clear();
   extra_uploaded_.clear();
   packedVersion_ = ~std::uint64_t(0);
@@ -450,6 +511,7 @@ void ClGroup::upload(GroupImpl& g) {
 void ClGroup::apply(GroupImpl& g, const std::vector<std::uint32_t>& s) {
   size_ = s[FL_STATE_SIZE];
   nextId_ = s[FL_STATE_NEXT_ID];
+  lastDead_ = s[FL_STATE_DEAD];
   // The device's counters are 32-bit and wrap; the host sums their deltas in 64 bits.
   g.stats.droppedAtCapacity += std::uint32_t(s[FL_STATE_DROPPED] - lastDropped_);
   lastDropped_ = s[FL_STATE_DROPPED];
@@ -608,7 +670,10 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   if (emitterCodes_.refresh(g) && programValid_ &&
       emitterSignature(emitterCodes_.variants) != emitterSignature_)
     programValid_ = false;
-  if (g.hair.enabled != hairProgram_ || sp.cull != cullProgram_) programValid_ = false;
+  // A group that records collisions runs a program that logs them (and only then).
+  const bool hits = g.collisionRoom() > 0 && !g.hair.enabled;
+  if (g.hair.enabled != hairProgram_ || sp.cull != cullProgram_ || hits != hitsProgram_)
+    programValid_ = false;
   if (programValid_ && programCheckedVersion_ != g.actionsVersion) {
     if (programCheckedStructure_ == g.actionsStructure) {
       moveKey(g.actions, moveKeyScratch_);
@@ -617,7 +682,7 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     if (programCheckedStructure_ != g.actionsStructure) {
       const GeneratedProgram gen =
           generateProgram(g.actions, g.stored, shared_->fp64(),
-                          emissionSource(emitterCodes_.variants), g.hair.enabled, sp.cull);
+                          emissionSource(emitterCodes_.variants), g.hair.enabled, sp.cull, hits);
       if (gen.source != programSource_ || gen.options != programOptions_) programValid_ = false;
       programActions_ = g.actions;
       programCheckedStructure_ = g.actionsStructure;
@@ -625,7 +690,7 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     }
     programCheckedVersion_ = g.actionsVersion;
   }
-  if (!programValid_) buildProgram(g, sp.cull);
+  if (!programValid_) buildProgram(g, sp.cull, hits);
 
   // The actions' constants: packed again only for a new list or a new dt (they hold
   // products with dt), and uploaded only when their bytes changed.
@@ -698,8 +763,9 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   for (std::size_t k = 0; k < inFlight_.size(); ++k) bound += inFlight_[k].births;
   const std::size_t nBound = std::min(bound + births, g.capacity);
   const bool acts = !g.actions.empty() && nBound > 0;
-  const bool kills = acts;           // the NaN guard can kill in any list
-  if (!acts && births == 0) return;  // nothing on the device changes
+  const bool kills = acts;                      // the NaN guard can kill in any list
+  const std::size_t deathRoom = g.deathRoom();  // Group::recordDeaths
+  if (!acts && births == 0) return;             // nothing on the device changes
 
   cl_command_queue q = queue();
   cl_mem state = state_.mem.get();
@@ -777,7 +843,8 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   };
   // A small group's step is one launch (fl_small) when its program has it.
   const std::size_t tiles = (nBound + FL_TILE - 1) / FL_TILE;
-  const bool oneLaunch = acts && small_ && tiles <= kSmallTiles && !g.hair.enabled;
+  const bool oneLaunch =
+      acts && small_ && tiles <= kSmallTiles && !g.hair.enabled && deathRoom == 0 && !hits;
   if (births > 0 && !oneLaunch) {
     birthArgs(birth_.get(), cl_uint(lanes_.size()) + 1, true);
     launch(birth_.get(), roundUp(births, kSmallLocal), kSmallLocal, "fl_birth");
@@ -838,6 +905,19 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     setArg(k, i++, cap);
     setArg(k, i++, t1Bits);
     setArg(k, i++, cl_uint(reachOff_));  // read only by a program that culls
+    if (hits && acts) {
+      // Room for every particle deflected once by each Bounce, or the most a step had.
+      std::size_t bounces = 0;
+      for (const Action& a : g.actions.actions()) bounces += std::holds_alternative<Bounce>(a);
+      hitRoom_ =
+          std::max({hitRoom_, g.capacity * std::max<std::size_t>(bounces, 1), std::size_t(1024)});
+      hits_.reserve(context(), (16 + 16 * hitRoom_) * 4);
+      const cl_uint zero = 0;
+      check(clEnqueueFillBuffer(q, hits_.mem.get(), &zero, 4, 0, 4, 0, nullptr, nullptr),
+            "clEnqueueFillBuffer (collisions)");
+      setArg(k, i++, hits_.mem.get());
+      setArg(k, i++, cl_uint(hitRoom_));
+    }
     if (oneLaunch) {
       setArg(k, i++, tileDead_.get());
       setArg(k, i++, tileOff_.get());
@@ -881,6 +961,16 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     setArg(scan_.get(), 6, cap);
     launch(scan_.get(), 1, 1, "fl_scan");
   }
+  if (kills && deathRoom > 0) {
+    // The dead as the pass left them, before the tail moves survivors into their slots.
+    events_.reserve(context(), std::min(deathRoom, g.capacity) * kDeathEventBytes);
+    cl_kernel k = deaths_.get();
+    setArg(k, 2, state);
+    setArg(k, 11, events_.mem.get());
+    setArg(k, 12, cl_uint(std::min(deathRoom, g.capacity)));
+    setArg(k, 13, cl_uint(tiles));
+    launch(k, roundUp(std::max<std::size_t>(tiles, 1), kSmallLocal), kSmallLocal, "fl_deaths");
+  }
   {
     if (kills && !oneLaunch) {
       cl_kernel k = tailKernel_.get();
@@ -915,6 +1005,73 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     const std::size_t before = inFlight_.size();
     retire(g, false);
     if (inFlight_.size() == before) break;
+  }
+  if (kills && deathRoom > 0) readDeaths(g, deathRoom, sp.time + sp.dt);
+  if (hits && acts) readCollisions(g);
+}
+
+void ClGroup::readCollisions(GroupImpl& g) {
+  drain(g);
+  std::uint32_t total = 0;
+  check(clEnqueueReadBuffer(queue(), hits_.mem.get(), CL_TRUE, 0, 4, &total, 0, nullptr, nullptr),
+        "clEnqueueReadBuffer (collision count)");
+  const std::size_t got = std::min<std::size_t>(total, hitRoom_);
+  hitWords_.resize(got * 16);
+  if (got > 0)
+    check(clEnqueueReadBuffer(queue(), hits_.mem.get(), CL_TRUE, 64, got * 64, hitWords_.data(), 0,
+                              nullptr, nullptr),
+          "clEnqueueReadBuffer (collisions)");
+  g.stats.bytesReadBack += 4 + got * 64;
+  // Appended in whatever order the device ran: in the CPU's (particle, sub-step, action).
+  hitsSorted_.resize(got);
+  for (std::size_t j = 0; j < got; ++j) {
+    const std::uint32_t* w = hitWords_.data() + 16 * j;
+    CollisionEvent e;
+    for (int c = 0; c < 3; ++c) {
+      e.position[c] = std::bit_cast<float>(w[2 + c]);
+      e.velocity[c] = std::bit_cast<float>(w[5 + c]);
+      e.normal[c] = std::bit_cast<float>(w[8 + c]);
+    }
+    e.id = w[11];
+    e.action = w[1] & 0xFFFFu;
+    e.time = shared_->fp64()
+                 ? std::bit_cast<double>(std::uint64_t(w[12]) | std::uint64_t(w[13]) << 32)
+                 : double(std::bit_cast<float>(w[12]));
+    hitsSorted_[j] = {std::uint64_t(w[0]) << 32 | w[1], e};
+  }
+  std::sort(hitsSorted_.begin(), hitsSorted_.end(),
+            [](const auto& x, const auto& y) { return x.first < y.first; });
+  const std::size_t kept = std::min(got, g.collisionRoom());
+  g.collisionEvents.clear();
+  for (std::size_t j = 0; j < kept; ++j) g.collisionEvents.push_back(hitsSorted_[j].second);
+  g.stats.collisionEventsDropped += total - kept;
+  // More than the room: this step kept an arbitrary `hitRoom_` of them; later steps have room
+  // for as many.
+  if (total > hitRoom_) hitRoom_ = total;
+}
+
+void ClGroup::readDeaths(GroupImpl& g, std::size_t room, double t1) {
+  // A game reads the events right after the step: this step's count, then its events.
+  drain(g);
+  const std::size_t kept = std::min<std::size_t>(lastDead_, std::min(room, g.capacity));
+  g.stats.deathEventsDropped += lastDead_ - kept;
+  g.deathEvents.resize(kept);  // within the room Group::recordDeaths reserved
+  if (kept == 0) return;
+  deathWords_.resize(kept * 8);
+  check(clEnqueueReadBuffer(queue(), events_.mem.get(), CL_TRUE, 0, kept * kDeathEventBytes,
+                            deathWords_.data(), 0, nullptr, nullptr),
+        "clEnqueueReadBuffer (death events)");
+  g.stats.bytesReadBack += kept * kDeathEventBytes;
+  for (std::size_t j = 0; j < kept; ++j) {
+    const std::uint32_t* w = deathWords_.data() + 8 * j;
+    DeathEvent& e = g.deathEvents[j];
+    for (int c = 0; c < 3; ++c) {
+      e.position[c] = std::bit_cast<float>(w[c]);
+      e.velocity[c] = std::bit_cast<float>(w[3 + c]);
+    }
+    e.id = w[6];
+    e.action = w[7] == FL_NON_FINITE_CODE ? DeathEvent::kNonFinite : w[7] - 1u;
+    e.time = t1;
   }
 }
 

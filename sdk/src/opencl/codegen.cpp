@@ -564,8 +564,10 @@ std::string cullingBody(const std::vector<Action>& acts, const std::string& body
 }  // namespace
 
 GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored, bool fp64,
-                                 const std::string& emitSource, bool hair, bool cull) {
+                                 const std::string& emitSource, bool hair, bool cull,
+                                 bool collisions) {
   GeneratedProgram g;
+  collisions = collisions && !hair;  // (fl_hair runs the plain list)
   // What the act kernel loads (reads) and stores (writes).
   AttributeSet reads, writes;
   const Integrator integrator = actions.integrator();
@@ -611,6 +613,26 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   // a Bounce on the curved path).
   std::vector<std::size_t> marks(acts.size() + 1, 0);
   std::vector<int> placed(acts.size(), 2);
+  // Collision events: a Bounce that changed a live particle's velocity logs it, from the
+  // state before it (`was`: fl_b_ on the curve, fl_c_ otherwise) and the acceleration it
+  // bounced with. A newborn's sub-step began (nsub - sub) of its sub-steps before t1.
+  if (collisions) reads.insert(Attribute::Id);
+  auto logCollision = [&](std::size_t k, const char* was, const std::string& acc) {
+    const auto& b = std::get<Bounce>(acts[k]);
+    const auto& shape = b.surface.shape();
+    const int solid = std::holds_alternative<SphereDomain>(shape) ? 1
+                      : std::holds_alternative<BoxDomain>(shape)  ? 2
+                                                                  : 0;
+    const std::string w = was;
+    std::ostringstream c;
+    c << "    if (i < n && dead == 0u && (vx != " << w << "vx || vy != " << w << "vy || vz != " << w
+      << "vz))\n      fl_log_collision((ap + " << k << "), " << solid << ", " << (b.inside ? 1 : 0)
+      << ", " << w << "px, " << w << "py, " << w << "pz, " << w << "vx, " << w << "vy, " << w
+      << "vz, " << acc << ", dt,\n"
+      << "          i >= n0 ? t1 - (fl_real)dt * (fl_real)(nsub - sub) : time, i, sub, " << k
+      << "u, id, fl_hits, fl_hitRoom);\n";
+    return c.str();
+  };
   for (std::size_t k = 0; k < acts.size(); ++k) {
     const Action& act = acts[k];
     ActionSource& src = sources[k];
@@ -638,6 +660,8 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
                   "fl_b_vy = vy, fl_b_vz = vz;\n    float fl_bounce_ax, fl_bounce_ay, "
                   "fl_bounce_az;\n    "
                << evaluate(curveForces[k], "fl_b_", "time", "fl_bounce_") << "    " << call
+               << (collisions ? logCollision(k, "fl_b_", "fl_bounce_ax, fl_bounce_ay, fl_bounce_az")
+                              : "")
                << "    }\n";
           continue;
         }
@@ -668,8 +692,13 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
       }
     }
     placed[k] = 1;
+    const bool logs = collisions && std::holds_alternative<Bounce>(act);
+    if (logs)
+      body << "    { const float fl_c_px = px, fl_c_py = py, fl_c_pz = pz, fl_c_vx = vx, "
+              "fl_c_vy = vy, fl_c_vz = vz;\n";
     std::istringstream lines(src.apply);
     for (std::string line; std::getline(lines, line);) body << "    " << line << "\n";
+    if (logs) body << logCollision(k, "fl_c_", "0.0f, 0.0f, 0.0f") << "    }\n";
   }
   marks[acts.size()] = std::size_t(body.tellp());
   // The NaN guard reads what it checks.
@@ -749,6 +778,7 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
       "    uint seedHi, uint fl_step, uint streamBase, uint nsubStep, uint snapStride,\n"
       "    __global float* restrict tau, uint births, uint capacity, ulong t1Bits,\n"
       "    uint reachOff";
+  const char* hitArgs = collisions ? ", __global uint* fl_hits, uint fl_hitRoom" : "";
   // [0, n0) lived before the step, [n0, n) are its newborns (fl_birth wrote them).
   const char* actPrologue =
       "  const uint n0 = state[FL_STATE_SIZE];\n"
@@ -767,7 +797,7 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
        "    uint fl_step, uint streamBase, uint nsubStep, uint snapStride,\n"
        "    __global float* restrict tau, uint i, uint n0, uint n, uint snapN, fl_real t0,\n"
        "    fl_real t1"
-    << (g.culls ? ", uint reachOff, uint fl_live, __local int* fl_red" : "")
+    << (g.culls ? ", uint reachOff, uint fl_live, __local int* fl_red" : "") << hitArgs
     << ") {\n"
        "  (void)state; (void)extra; (void)snap; (void)snapN; (void)snapStride; (void)seedLo;\n"
        "  (void)seedHi; (void)fl_step; (void)n;\n"
@@ -777,7 +807,9 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   call +=
       "codes, ap, state, extra, snap, dtBits, seedLo, seedHi, fl_step, streamBase, nsubStep,\n"
       "      snapStride, tau, i, n0, n, snapN, t0, t1";
-  call += g.culls ? ", reachOff, i < n, fl_red);\n" : ");\n";
+  if (g.culls) call += ", reachOff, i < n, fl_red";
+  if (collisions) call += ", fl_hits, fl_hitRoom";
+  call += ");\n";
   const std::string local = g.culls ? "  __local int fl_red[FL_CULL_LOCAL + " +
                                           std::to_string(2 * acts.size() + 1) +
                                           "]; /* the culling's reduction and decisions */\n"
@@ -785,7 +817,7 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   const char* size = g.culls ? "__attribute__((reqd_work_group_size(FL_ACT_LOCAL, 1, 1))) " : "";
   s << "/* ---- generated: the fused act kernel */\n__kernel " << size << "void fl_act(";
   for (const auto& l : g.actLanes) s << laneDecl(l) << ", ";
-  s << actArgs << ") {\n"
+  s << actArgs << hitArgs << ") {\n"
     << local << actPrologue << "  const uint i = get_global_id(0);\n"
     << (g.culls ? "" : "  if (i >= n) return;\n") << "  " << call << "}\n";
   // A small group's whole step in one launch of one work-group: births, act,
@@ -793,7 +825,7 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   // four.
   // Not for lists that read neighbours: their snapshot, copied before the act kernel, must
   // hold the newborns where they were born, so fl_birth runs before the copy.
-  g.small = !g.substepsByDistance && !hair && !g.neighbours;
+  g.small = !g.substepsByDistance && !hair && !g.neighbours && !collisions;
   // With culling, in whole passes of the work-group (n is the same for all): the barriers.
   const std::string loop = g.culls
                                ? "  for (uint fl_first = 0u; fl_first < n; fl_first += lsize) {\n"
