@@ -132,6 +132,12 @@ FL_NOINLINE float3 fl_sample_union(__global const float* v, FlRandom* rng,
   return fl_sample_u(v, kind, u + next);
 }
 
+/* The uniforms a sample of the domain takes (sampling.cpp drawCount): a union's are in its
+ * table. */
+FL_INLINE uint fl_domain_draws(__global const FlDomain* d, uint kind) {
+  return kind == FL_DOMAIN_UNION ? fl_word(d->v + 2) : fl_draw_count(kind);
+}
+
 /* fl_sample for every kind, meshes and unions too. */
 FL_INLINE float3 fl_sample_any(__global const FlDomain* d, uint kind, FlRandom* rng,
                                __global const float* shapes) {

@@ -1,4 +1,4 @@
-/* A step's newborns (sdk/src/emission.cpp, draw for draw), written before the act kernel
+/* A step's newborns (their draws placed by kernels/newborn.h, as on the CPU), written before the act kernel
  * where they were born (tail.cl fl_birth). Needs, from the generated prologue:
  *   FL_LANE_PARAMS / FL_LANE_ARGS  the stored lanes as parameters (l_px, l_vx, ...) / names
  *   FL_COPY_LANES(dst, src)        copies every stored lane's element
@@ -61,19 +61,52 @@ FL_INLINE uint fl_choose_type(__global const FlEmitter* em, __global const FlPar
   return em->typeCount - 1;
 }
 
-/* One newborn of type `type`: the draws in emission.cpp's order, skipping what is not
- * stored. The kinds and modes are literals; normalMode is 0 without Emitter::normalSpeed,
+/* One newborn of type `type`: each value from where kernels/newborn.h says its draws start
+ * (the CPU's newborns.cpp takes the same), skipping what is not stored. typeDraws is 1 when
+ * the emitter has several types (fl_choose_type drew first). The kinds and modes are
+ * literals (a fuzzy mode is its draw count); normalMode is 0 without Emitter::normalSpeed,
  * else 1 + its fuzzy mode. */
 FL_INLINE void fl_newborn(FL_LANE_PARAMS, uint slot, uint id, float3 at,
                           __global const FlEmitter* em, __global const FlParticleType* type,
-                          FlRandom* rng, __global const float* shapes, uint shapeKind,
-                          uint velKind, uint colorKind, uint upKind, uint rotKind,
+                          FlRandom* rng, __global const float* shapes, uint typeDraws,
+                          uint shapeKind, uint velKind, uint colorKind, uint upKind, uint rotKind,
                           uint normalMode, uint lifeMode, uint alphaMode, uint sizeMode,
                           uint massMode, uint chargeMode) {
+  uint nLife = 0u, nColor = 0u, nAlpha = 0u, nSize = 0u, nMass = 0u, nCharge = 0u, nUp = 0u,
+       nRot = 0u;
+#ifdef FL_HAS_LIFETIME
+  nLife = lifeMode;
+#endif
+#ifdef FL_HAS_COLOR
+  nColor = fl_domain_draws(&type->color, colorKind);
+  nAlpha = alphaMode;
+#endif
+#ifdef FL_HAS_SIZE
+  nSize = sizeMode;
+#endif
+#ifdef FL_HAS_MASS
+  nMass = massMode;
+#endif
+#ifdef FL_HAS_CHARGE
+  nCharge = chargeMode;
+#endif
+#ifdef FL_HAS_UP
+  nUp = fl_domain_draws(&type->up, upKind);
+#endif
+#ifdef FL_HAS_ROT_VELOCITY
+  nRot = fl_domain_draws(&type->rotVelocity, rotKind);
+#endif
+  const FlNewbornDraws from = fl_newborn_draws(
+      typeDraws, fl_domain_draws(&type->velocity, velKind), fl_domain_draws(&em->shape, shapeKind),
+      normalMode != 0u ? normalMode - 1u : 0u, nLife, nColor, nAlpha, nSize, nMass, nCharge, nUp,
+      nRot);
+  fl_seek(rng, from.velocity);
   float3 vel = fl_sample_any(&type->velocity, velKind, rng, shapes);
+  fl_seek(rng, from.shape);
   const float3 shape = fl_sample_any(&em->shape, shapeKind, rng, shapes);
   if (normalMode != 0) {
     /* Every face emits along its normal: the shape's normal where the particle was born. */
+    fl_seek(rng, from.normal);
     const float speed = fl_fuzzy(&em->normalSpeed, normalMode - 1, rng);
     vel = vel + fl_normal_at(&em->shape, shapeKind, shape, shapes) * speed;
   }
@@ -93,18 +126,22 @@ FL_INLINE void fl_newborn(FL_LANE_PARAMS, uint slot, uint id, float3 at,
   l_prevz[slot] = pos.z;
 #endif
 #ifdef FL_HAS_LIFETIME
+  fl_seek(rng, from.lifetime);
   l_life[slot] = fl_fuzzy_nonneg(&type->lifetime, lifeMode, rng);
 #endif
 #ifdef FL_HAS_COLOR
   {
+    fl_seek(rng, from.color);
     const float3 rgb = fl_sample_any(&type->color, colorKind, rng, shapes);
     l_r[slot] = rgb.x;
     l_g[slot] = rgb.y;
     l_b[slot] = rgb.z;
+    fl_seek(rng, from.alpha);
     l_a[slot] = fl_fuzzy(&type->alpha, alphaMode, rng);
   }
 #endif
 #ifdef FL_HAS_SIZE
+  fl_seek(rng, from.size);
   l_size[slot] = fl_fuzzy_nonneg(&type->size, sizeMode, rng);
 #endif
   /* What the curves over life scale (emission.cpp store). */
@@ -122,13 +159,16 @@ FL_INLINE void fl_newborn(FL_LANE_PARAMS, uint slot, uint id, float3 at,
   l_birthsize[slot] = 0.05f; /* Particle::size */
 #endif
 #ifdef FL_HAS_MASS
+  fl_seek(rng, from.mass);
   l_mass[slot] = fl_fuzzy(&type->mass, massMode, rng);
 #endif
 #ifdef FL_HAS_CHARGE
+  fl_seek(rng, from.charge);
   l_charge[slot] = fl_fuzzy(&type->charge, chargeMode, rng);
 #endif
 #ifdef FL_HAS_UP
   {
+    fl_seek(rng, from.up);
     const float3 up = fl_sample_any(&type->up, upKind, rng, shapes);
     l_upx[slot] = up.x;
     l_upy[slot] = up.y;
@@ -137,6 +177,7 @@ FL_INLINE void fl_newborn(FL_LANE_PARAMS, uint slot, uint id, float3 at,
 #endif
 #ifdef FL_HAS_ROT_VELOCITY
   {
+    fl_seek(rng, from.rot);
     const float3 w = fl_sample_any(&type->rotVelocity, rotKind, rng, shapes);
     l_rotx[slot] = w.x;
     l_roty[slot] = w.y;
@@ -166,5 +207,6 @@ FL_INLINE void fl_newborn(FL_LANE_PARAMS, uint slot, uint id, float3 at,
   l_vbz[slot] = 0.0f;
 #endif
   (void)colorKind, (void)upKind, (void)rotKind, (void)lifeMode, (void)alphaMode, (void)sizeMode;
-  (void)massMode, (void)chargeMode;
+  (void)massMode, (void)chargeMode, (void)nLife, (void)nColor, (void)nAlpha, (void)nSize;
+  (void)nMass, (void)nCharge, (void)nUp, (void)nRot;
 }

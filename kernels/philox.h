@@ -83,6 +83,23 @@ FL_INLINE uint fl_bits(FlRandom* r) {
 }
 
 FL_INLINE float fl_uniform(FlRandom* r) { return fl_uniform_bits(fl_bits(r)); }
+
+/* Moves the stream to its k-th number (where fl_newborn_draws says a value starts). Where it
+ * stands already, or in the same block, it computes nothing. */
+FL_INLINE void fl_seek(FlRandom* r, uint k) {
+  const uint block = k >> 2, word = k & 3u;
+  if (r->pos != 4 && r->counter == block + 1u) {
+    r->pos = (int)word;
+    return;
+  }
+  if (r->pos == 4 && r->counter == block && word == 0u) return;
+  r->counter = block;
+  r->pos = 4;
+  if (word != 0u) {
+    (void)fl_bits(r);
+    r->pos = (int)word;
+  }
+}
 #endif /* __OPENCL_VERSION__ */
 
 #endif /* FLURRY_KERNELS_PHILOX_H */

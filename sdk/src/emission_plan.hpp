@@ -74,17 +74,20 @@ inline const Emitter& emitterOf(const GroupImpl& g, const BirthRun& run) {
   return run.live ? g.live[run.index].emitter : g.emitters[run.index];
 }
 
-/// The type a newborn takes, by the types' weights: one uniform draw when there are several.
-inline std::size_t chooseType(const std::vector<ParticleType>& types, Random& rng) {
-  if (types.size() == 1) return 0;
+/// The type a newborn takes, by the types' weights, from the uniform u.
+inline std::size_t chooseType(const std::vector<ParticleType>& types, float u) {
   float total = 0;
   for (const auto& t : types) total += t.weight;
-  float u = rng.uniform() * total;
+  u *= total;
   for (std::size_t k = 0; k < types.size(); ++k) {
     if (u < types[k].weight) return k;
     u -= types[k].weight;
   }
   return types.size() - 1;
+}
+/// The same from rng's next draw, when there are several (one type draws nothing).
+inline std::size_t chooseType(const std::vector<ParticleType>& types, Random& rng) {
+  return types.size() == 1 ? 0 : chooseType(types, rng.uniform());
 }
 }  // namespace FLURRY_ISA_NAMESPACE
 

@@ -52,6 +52,7 @@ using std::sin;
 using std::sqrt;
 
 #include "../../kernels/math.h"
+#include "../../kernels/newborn.h"
 #include "../../kernels/path.h"
 #include "../../kernels/philox.h"
 

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "emission_plan.hpp"
+#include "kernel_compat.hpp"
 #include "sampling.hpp"
 
 #ifndef FLURRY_ISA
@@ -81,6 +82,20 @@ void store(const NewbornContext& nc, std::size_t slot, std::uint32_t id, const N
   if (L.user) L.user[slot] = 0.0f;
 }
 
+// Where a newborn of `type` from `em` starts each value's draws: the draw counts of what the
+// group stores, in kernels/newborn.h's order (the device's too).
+kernel::FlNewbornDraws newbornDraws(const Lanes& L, const Emitter& em, const ParticleType& type) {
+  const bool alongNormal = !(em.normalSpeed.constant() && em.normalSpeed.center == 0.0f);
+  auto n = [](bool stored, int draws) { return kernel::uint(stored ? draws : 0); };
+  return kernel::fl_newborn_draws(
+      n(em.types.size() > 1, 1), n(true, drawCount(type.velocity)), n(true, drawCount(em.shape)),
+      n(alongNormal, drawCount(em.normalSpeed)), n(L.lifetime, drawCount(type.lifetime)),
+      n(L.color[0], drawCount(type.color)), n(L.color[0], drawCount(type.alpha)),
+      n(L.size, drawCount(type.size)), n(L.mass, drawCount(type.mass)),
+      n(L.charge, drawCount(type.charge)), n(L.up[0], drawCount(type.up)),
+      n(L.rot[0], drawCount(type.rotVelocity)));
+}
+
 // Emitters with one particle type: every draw of a batch at once (see sampling.hpp).
 void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em, std::uint64_t q0,
                std::size_t i0, std::size_t m) {
@@ -106,17 +121,9 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
   const float* row[kMaxDraws];
   for (int k = 0; k < kMaxDraws; ++k) row[k] = rows[k];
 
-  // The draws in the order the one-by-one path makes them.
   const bool alongNormal = !(em.normalSpeed.constant() && em.normalSpeed.center == 0.0f);
-  int draws = drawCount(type.velocity) + drawCount(em.shape);
-  if (alongNormal) draws += drawCount(em.normalSpeed);
-  if (L.lifetime) draws += drawCount(type.lifetime);
-  if (L.color[0]) draws += drawCount(type.color) + drawCount(type.alpha);
-  if (L.size) draws += drawCount(type.size);
-  if (L.mass) draws += drawCount(type.mass);
-  if (L.charge) draws += drawCount(type.charge);
-  if (L.up[0]) draws += drawCount(type.up);
-  if (L.rot[0]) draws += drawCount(type.rotVelocity);
+  const kernel::FlNewbornDraws at = newbornDraws(L, em, type);
+  const int draws = int(at.total);
   const std::uint32_t firstId = nc.firstId + std::uint32_t(i0);
   // Drawn and shaped in whole vectors of the widest set (16 floats): a small group's few
   // newborns a step then run the vector loops alone, not their scalar remainders. Each
@@ -126,38 +133,32 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
     uniformBatch(nc.sp.seed, firstId, nc.g.streamKey(), stream::kEmission, std::uint32_t(blk), mv,
                  rows[4 * blk], rows[4 * blk + 1], rows[4 * blk + 2], rows[4 * blk + 3]);
 
-  int cur = 0;
-  auto vec = [&](const Domain& d, int a) {
-    sampleBatch(d, row + cur, mv, attr[a], attr[a + 1], attr[a + 2]);
-    cur += drawCount(d);
+  auto vec = [&](const Domain& d, kernel::uint from, int a) {
+    sampleBatch(d, row + from, mv, attr[a], attr[a + 1], attr[a + 2]);
   };
-  auto scalar = [&](const Fuzzy& f, int a) {
-    sampleBatch(f, row + cur, mv, attr[a]);
-    cur += drawCount(f);
+  auto scalar = [&](const Fuzzy& f, kernel::uint from, int a) {
+    sampleBatch(f, row + from, mv, attr[a]);
   };
-  vec(type.velocity, 0);  // attr 0-2
-  vec(em.shape, 3);       // 3-5
+  vec(type.velocity, at.velocity, 0);  // attr 0-2
+  vec(em.shape, at.shape, 3);          // 3-5
   if (alongNormal) {
     // Every face emits along its normal: the shape's normal where the particle was born.
-    scalar(em.normalSpeed, 15);
+    scalar(em.normalSpeed, at.normal, 15);
     for (std::size_t k = 0; k < m; ++k) {
       const Vec3 nrm = em.shape.normal(Vec3(attr[3][k], attr[4][k], attr[5][k]));
       for (int d = 0; d < 3; ++d) attr[d][k] += nrm[d] * attr[15][k];
     }
   }
-  if (L.lifetime) scalar(type.lifetime, 6);
+  if (L.lifetime) scalar(type.lifetime, at.lifetime, 6);
   if (L.color[0]) {
-    vec(type.color, 7);  // 7-9
-    scalar(type.alpha, 10);
+    vec(type.color, at.color, 7);  // 7-9
+    scalar(type.alpha, at.alpha, 10);
   }
-  if (L.size) scalar(type.size, 11);
-  if (L.mass) scalar(type.mass, 12);
-  if (L.charge) scalar(type.charge, 13);
-  if (L.up[0]) {
-    sampleBatch(type.up, row + cur, mv, up[0], up[1], up[2]);
-    cur += drawCount(type.up);
-  }
-  if (L.rot[0]) sampleBatch(type.rotVelocity, row + cur, mv, rot[0], rot[1], rot[2]);
+  if (L.size) scalar(type.size, at.size, 11);
+  if (L.mass) scalar(type.mass, at.mass, 12);
+  if (L.charge) scalar(type.charge, at.charge, 13);
+  if (L.up[0]) sampleBatch(type.up, row + at.up, mv, up[0], up[1], up[2]);
+  if (L.rot[0]) sampleBatch(type.rotVelocity, row + at.rot, mv, rot[0], rot[1], rot[2]);
 
   // Birth places: where the emitter was at the birth time; and the time left of the step.
   float* const px = attr[3];
@@ -206,36 +207,54 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
   if (L.user) std::fill_n(L.user + first, m, 0.0f);
 }
 
-// Several particle types: each newborn picks its type first, then draws as emitBatch does.
+// Several particle types: each newborn picks its type with its first draw, then takes its
+// values from its draws as emitBatch does (a batch of one).
 void emitOneByOne(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
                   std::uint64_t q0, std::size_t i0, std::size_t m) {
   const Lanes& L = nc.L;
   std::size_t key = 0;  // the path's key the last birth found
+  float u[kMaxDraws];
+  const float* row[kMaxDraws];
+  for (int d = 0; d < kMaxDraws; ++d) row[d] = u + d;
   for (std::size_t k = 0; k < m; ++k) {
     const std::uint32_t id = nc.firstId + std::uint32_t(i0 + k);
     Random rng(nc.sp.seed, id, nc.g.streamKey(), stream::kEmission);
-    const ParticleType& type = em.types[chooseType(em.types, rng)];
+    const float pick = rng.uniform();
+    const ParticleType& type = em.types[chooseType(em.types, pick)];
+    const kernel::FlNewbornDraws at = newbornDraws(L, em, type);
+    u[at.type] = pick;
+    for (kernel::uint d = at.type + 1; d < at.total; ++d) u[d] = rng.uniform();
     const double tb = birthTime(run, em, q0 + k);
     nc.remaining[i0 + k] = nc.left(tb);
     Newborn b{};
-    b.vel = type.velocity.sample(rng);
-    const Vec3 local = em.shape.sample(rng);
+    auto vec = [&](const Domain& dom, kernel::uint from) {
+      Vec3 r;
+      sampleBatch(dom, row + from, 1, &r.x, &r.y, &r.z);
+      return r;
+    };
+    auto scalar = [&](const Fuzzy& f, kernel::uint from) {
+      float r;
+      sampleBatch(f, row + from, 1, &r);
+      return r;
+    };
+    b.vel = vec(type.velocity, at.velocity);
+    const Vec3 local = vec(em.shape, at.shape);
     if (!(em.normalSpeed.constant() && em.normalSpeed.center == 0.0f))
-      b.vel += em.shape.normal(local) * em.normalSpeed.sample(rng);
+      b.vel += em.shape.normal(local) * scalar(em.normalSpeed, at.normal);
     b.pos = local + pathPositionAt(em, tb, key);
-    if (L.lifetime) b.lifetime = type.lifetime.sample(rng);
+    if (L.lifetime) b.lifetime = scalar(type.lifetime, at.lifetime);
     if (L.color[0]) {
-      const Vec3 rgb = type.color.sample(rng);
+      const Vec3 rgb = vec(type.color, at.color);
       b.r = rgb.x;
       b.gr = rgb.y;
       b.bl = rgb.z;
-      b.alpha = type.alpha.sample(rng);
+      b.alpha = scalar(type.alpha, at.alpha);
     }
-    if (L.size) b.size = type.size.sample(rng);
-    if (L.mass) b.mass = type.mass.sample(rng);
-    if (L.charge) b.charge = type.charge.sample(rng);
-    if (L.up[0]) b.up = type.up.sample(rng);
-    if (L.rot[0]) b.rot = type.rotVelocity.sample(rng);
+    if (L.size) b.size = scalar(type.size, at.size);
+    if (L.mass) b.mass = scalar(type.mass, at.mass);
+    if (L.charge) b.charge = scalar(type.charge, at.charge);
+    if (L.up[0]) b.up = vec(type.up, at.up);
+    if (L.rot[0]) b.rot = vec(type.rotVelocity, at.rot);
     store(nc, nc.slot(i0 + k), id, b);
   }
 }

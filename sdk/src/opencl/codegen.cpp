@@ -720,9 +720,10 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   s << " } while (0)\n#define FL_LANE_ARGS ";
   for (std::size_t k = 0; k < all.size(); ++k) s << (k ? ", " : "") << "l_" << all[k].name;
   s << "\n";
-  for (const char* f : {"compat_opencl.h", "math.h", "params.h", "philox.h", "noise.h", "deflect.h",
-                        "domain.h", "domain.cl", "path.h", "forces.h", "integrate.h", "absorb.h",
-                        "actions.cl", "forces.cl", "surfaces.cl", "compact.cl", "emit.cl"})
+  for (const char* f :
+       {"compat_opencl.h", "math.h", "params.h", "philox.h", "noise.h", "deflect.h", "domain.h",
+        "domain.cl", "path.h", "forces.h", "integrate.h", "absorb.h", "actions.cl", "forces.cl",
+        "surfaces.cl", "compact.cl", "newborn.h", "emit.cl"})
     s << "/* ---- " << f << " */\n" << embeddedKernel(f) << "\n";
 
   s << "/* ---- generated: emission */\n" << emitSource;

@@ -49,10 +49,11 @@ std::string newbornCall(const Emitter& e, std::size_t t) {
   const ParticleType& p = e.types[t];
   std::ostringstream c;
   c << "fl_newborn(FL_LANE_ARGS, slot, id, at, em, types + em->typeFirst + " << t
-    << "u, rng, shapes, " << kindOf(e.shape) << "u, " << kindOf(p.velocity) << "u, "
-    << kindOf(p.color) << "u, " << kindOf(p.up) << "u, " << kindOf(p.rotVelocity) << "u, "
-    << normalMode(e) << "u, " << fuzzyMode(p.lifetime) << "u, " << fuzzyMode(p.alpha) << "u, "
-    << fuzzyMode(p.size) << "u, " << fuzzyMode(p.mass) << "u, " << fuzzyMode(p.charge) << "u);";
+    << "u, rng, shapes, " << (e.types.size() > 1 ? 1 : 0) << "u, " << kindOf(e.shape) << "u, "
+    << kindOf(p.velocity) << "u, " << kindOf(p.color) << "u, " << kindOf(p.up) << "u, "
+    << kindOf(p.rotVelocity) << "u, " << normalMode(e) << "u, " << fuzzyMode(p.lifetime) << "u, "
+    << fuzzyMode(p.alpha) << "u, " << fuzzyMode(p.size) << "u, " << fuzzyMode(p.mass) << "u, "
+    << fuzzyMode(p.charge) << "u);";
   return c.str();
 }
 
