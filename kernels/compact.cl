@@ -145,6 +145,33 @@ __kernel void fl_scan_list(__global const uchar* codes, __global uint* tileDead,
   fl_scan_list_body(codes, tileDead, tileOff, holes, tail, state, births, capacity, tiles);
 }
 
+/* Birth events (a sub-emitter on birth; group.cpp recordBirths on the CPU): the step's
+ * newborns where fl_birth wrote them, before the act kernel moves them on. events[0] gets
+ * their count; newborn r is 8 words from events + 8 + 8r: position, velocity (zeros where
+ * `velocity` is 0: vx..vz then alias px), id and the part of the step it had left (tau). */
+__kernel void fl_births(__global const uint* state, uint births, uint capacity,
+                        __global const float* px, __global const float* py,
+                        __global const float* pz, __global const float* vx,
+                        __global const float* vy, __global const float* vz, uint velocity,
+                        __global const uint* id, __global const float* tau,
+                        __global uint* events) {
+  const uint r = get_global_id(0);
+  const uint n0 = state[FL_STATE_SIZE];
+  const uint born = fl_step_range(state, births, capacity) - n0;
+  if (r == 0u) events[0] = born;
+  if (r >= born) return;
+  const uint i = n0 + r;
+  __global uint* e = events + 8u + 8u * r;
+  e[0] = as_uint(px[i]);
+  e[1] = as_uint(py[i]);
+  e[2] = as_uint(pz[i]);
+  e[3] = velocity ? as_uint(vx[i]) : 0u;
+  e[4] = velocity ? as_uint(vy[i]) : 0u;
+  e[5] = velocity ? as_uint(vz[i]) : 0u;
+  e[6] = id[i];
+  e[7] = as_uint(tau[r]);
+}
+
 /* Death events (Group::recordDeaths; group.cpp recordDeaths on the CPU): the step's dead in
  * particle order, the first `room` of them, each as 8 words: position, velocity (zeros
  * where `velocity` is 0: vx..vz then alias px), id and kill code. After the scan (tileOff)

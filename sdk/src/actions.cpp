@@ -1,9 +1,9 @@
 #include <cmath>
 #include <type_traits>
 
-#include "flurry/actions.hpp"
 #include "action_traits.hpp"
 #include "effect/descriptors.hpp"
+#include "flurry/actions.hpp"
 #include "flurry/error.hpp"
 
 namespace flurry {
@@ -19,7 +19,9 @@ constexpr const char* nameOf() {
     return "Callback";
 }
 
-bool finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite(Vec3 v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
 struct Validator {
   std::string where;
@@ -28,7 +30,9 @@ struct Validator {
     if (!ok) throw InvalidArgument(where + "." + field, why);
   }
   void finiteVec(Vec3 v, const char* field) const { require(finite(v), field, "not finite"); }
-  void finiteNum(float x, const char* field) const { require(std::isfinite(x), field, "not finite"); }
+  void finiteNum(float x, const char* field) const {
+    require(std::isfinite(x), field, "not finite");
+  }
   void nonNegative(float x, const char* field) const {
     require(std::isfinite(x) && x >= 0, field, "must be finite and >= 0");
   }
@@ -183,7 +187,8 @@ struct Validator {
   }
   void operator()(const Bounce& a) const {
     const auto& s = a.surface.shape();
-    const bool closed = std::holds_alternative<SphereDomain>(s) || std::holds_alternative<BoxDomain>(s);
+    const bool closed =
+        std::holds_alternative<SphereDomain>(s) || std::holds_alternative<BoxDomain>(s);
     const bool ok = a.surface.isPlanar() || closed || std::holds_alternative<LineDomain>(s);
     if (!ok)
       throw InvalidArgument(where + ".surface",
@@ -203,8 +208,8 @@ struct Validator {
     }
   }
   void operator()(const Sink& a) const {
-    require(std::isfinite(a.passThrough) && a.passThrough >= 0 && a.passThrough <= 1,
-            "passThrough", "must be in [0, 1]");
+    require(std::isfinite(a.passThrough) && a.passThrough >= 0 && a.passThrough <= 1, "passThrough",
+            "must be in [0, 1]");
     require(a.mode != Sink::Mode::Hit || a.region.isPlanar(), "mode",
             "Hit needs a plane piece (plane, rectangle, disc, triangle)");
   }
@@ -288,7 +293,9 @@ struct Uses {
     return s;
   }
   AttributeSet operator()(const Restore&) const { return {A::Position, A::Velocity, A::PositionB}; }
-  AttributeSet operator()(const Callback& a) const { return AttributeSet{A::Position} | a.attributes; }
+  AttributeSet operator()(const Callback& a) const {
+    return AttributeSet{A::Position} | a.attributes;
+  }
 };
 
 }  // namespace
@@ -322,8 +329,8 @@ void checkExact(const std::vector<Action>& actions) {
     if (isForce(actions[i]) && !hasClosedForm(actions[i]))
       throw InvalidArgument("integrator",
                             "Exact needs forces with a closed form (Gravity, Damping, "
-                            "ElectricField); actions[" + std::to_string(i) + "] is " +
-                                actionName(actions[i]));
+                            "ElectricField); actions[" +
+                                std::to_string(i) + "] is " + actionName(actions[i]));
   for (const Action& a : actions) {
     const Falloff* f = nullptr;
     if (const auto* g = std::get_if<Gravity>(&a)) f = &g->falloff;
@@ -338,11 +345,16 @@ void checkExact(const std::vector<Action>& actions) {
 
 const char* integratorName(Integrator i) {
   switch (i) {
-    case Integrator::SemiImplicitEuler: return "SemiImplicitEuler";
-    case Integrator::ExplicitEuler: return "ExplicitEuler";
-    case Integrator::VelocityVerlet: return "VelocityVerlet";
-    case Integrator::RK4: return "RK4";
-    case Integrator::Exact: return "Exact";
+    case Integrator::SemiImplicitEuler:
+      return "SemiImplicitEuler";
+    case Integrator::ExplicitEuler:
+      return "ExplicitEuler";
+    case Integrator::VelocityVerlet:
+      return "VelocityVerlet";
+    case Integrator::RK4:
+      return "RK4";
+    case Integrator::Exact:
+      return "Exact";
   }
   return "?";
 }
@@ -370,7 +382,8 @@ std::string actionName(const Action& a) {
 }
 
 ActionList& ActionList::add(Action action) {
-  const std::string where = "actions[" + std::to_string(actions_.size()) + "]." + actionName(action);
+  const std::string where =
+      "actions[" + std::to_string(actions_.size()) + "]." + actionName(action);
   if (actions_.size() >= 250)
     throw InvalidArgument("actions", "an action list holds at most 250 actions");
   std::visit(Validator{where}, action);

@@ -375,14 +375,14 @@ void Context::Impl::feedDeathEmitters() {
       if (!source)
         throw Error("group '" + gi.name + "': deathEmitters[" + std::to_string(k) +
                     "].source: no group named '" + gi.deathEmitters[k].source + "' in the context");
+      // A device's hair group keeps strands of the step's own newborns only (fl_hair).
+      if (backendKind != Backend::Cpu && gi.hair.enabled)
+        throw Error("group '" + gi.name + "': deathEmitters[" + std::to_string(k) +
+                    "]: a group in hair mode takes no sub-emitter's newborns on the device yet "
+                    "(the CPU backend runs it)");
       if (gi.deathEmitters[k].on == DeathEmitter::Trigger::Collision) {
         source->impl_->collisionsFeed = true;  // records them all for it
       } else if (gi.deathEmitters[k].on == DeathEmitter::Trigger::Birth) {
-        // The device's newborns are its own: their births are not read back.
-        if (backendKind != Backend::Cpu)
-          throw Error("group '" + gi.name + "': deathEmitters[" + std::to_string(k) +
-                      "]: a sub-emitter on birth does not run on the device yet (the CPU "
-                      "backend runs it; on death and on collision run on both)");
         source->impl_->birthsFeed = true;
       } else
         source->impl_->feedDeaths();

@@ -474,8 +474,8 @@ template <class Event>
 void emitFrom(GroupImpl& g, std::size_t k, std::span<const Event> events, std::uint64_t seed) {
   const DeathEmitter& de = g.deathEmitters[k];
   if (events.empty()) return;
-  g.ensureStorage();
   if (g.mirror) g.mirror->beginAppend(g);  // a device's group: its count, then only the newborns
+  g.ensureStorage();
   const Lanes L = g.lanePointers();
   const std::size_t before = g.size;
   for (const Event& event : events) {

@@ -904,7 +904,8 @@ void detail::GroupImpl::endCollisions(std::size_t blocks) {
 namespace {
 // Events carry the particles' ids (both backends record them).
 void startRecording(Group& g, std::size_t perStep) {
-  if (perStep > 0) g.require({Attribute::Id});
+  // (require syncs a device's group both ways even when nothing changes)
+  if (perStep > 0 && !g.attributes().has(Attribute::Id)) g.require({Attribute::Id});
 }
 }  // namespace
 

@@ -22,7 +22,9 @@ constexpr std::size_t kNewbornsPerTask = 8192;  // a multiple of kBatch
 
 constexpr std::size_t kBatch = 256;
 static_assert(kBatch % 16 == 0, "a batch pads its newborns to whole vectors of 16");
-constexpr int kMaxDraws = 48;
+// The most draws a newborn takes (kernels/newborn.h): its type's, five domains of at most
+// kMaxDomainDraws each and six fuzzy values of at most two.
+constexpr int kMaxDraws = 1 + 5 * kMaxDomainDraws + 6 * 2;
 
 struct NewbornContext {
   GroupImpl& g;

@@ -230,7 +230,7 @@ TEST(OpenCLBackend, ClearAndRequireBetweenSteps) {
 // What the device does not run yet is a clear error, not a silent difference; the group steps
 // on. (Death and collision events and sub-emitters on them run on the device:
 // OpenCLCore.DeathEventsAsOnTheCpu, CollisionEventsAsOnTheCpu,
-// SubEmittersOnDeathAndCollisionAsOnTheCpu.)
+// SubEmittersOnDeathCollisionAndBirthAsOnTheCpu.)
 TEST(OpenCLBackend, WhatTheDeviceDoesNotRunIsAClearError) {
   FLURRY_REQUIRE_OPENCL();
   Context ctx(openclOptions());
@@ -246,6 +246,18 @@ TEST(OpenCLBackend, WhatTheDeviceDoesNotRunIsAClearError) {
   ctx.setParticleBudget(0);
   ctx.run(5);
   EXPECT_GT(g.size(), 0u);
+  // A hair group taking a sub-emitter's newborns: refused when the context steps.
+  Group& strands = ctx.createGroup("strands", 1000);
+  strands.setHair({.enabled = true});
+  DeathEmitter de;
+  de.source = g.name();
+  strands.addDeathEmitter(de);
+  try {
+    ctx.step();
+    FAIL() << "a hair group took a sub-emitter's newborns on the device";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("hair"), std::string::npos) << e.what();
+  }
 }
 
 // A group larger than one device buffer may be: a clear error, and the group stays usable.

@@ -449,8 +449,7 @@ typedef struct flurry_death_event {
  * "source" has deaths), given as the JSON object an effect file's "deathEmitters" holds, e.g.
  * {"source": "rain", "count": 3, "cause": 0, "types": [{"velocity": [0, 2, 0]}]}. Bad fields
  * are FLURRY_ERROR_EFFECT naming "deathEmitter.FIELD"; the source is looked up when the
- * context steps (a missing one fails that step, before anything moves). On a device, those
- * on death and on collision run (on birth: the CPU backend only). */
+ * context steps (a missing one fails that step, before anything moves). Both backends. */
 FLURRY_C_EXPORT flurry_status flurry_group_add_death_emitter(flurry_group* group, const char* json);
 
 /** Records each step's deaths, at most `per_step` a step (the first in particle order; the

@@ -142,7 +142,8 @@ struct PrimeEmitter {
 /// the whole action list. Deaths are taken in the source's particle order and the newborns
 /// written in that order, so the result is the same on any thread count. `shape` and the
 /// types' domains are in the world's frame, as Gravity is: a splash rises whichever way an
-/// instance turns. The CPU backend runs them (a device context refuses to add one).
+/// instance turns. Both backends run them (the host makes the newborns and a device takes only
+/// those; a device context refuses them for a group in hair mode).
 ///
 /// With `on` = Trigger::Collision it emits where the source's particles are deflected by a
 /// Bounce instead (a sub-emitter on collision: sparks where a grinder's chips hit a wall):

@@ -235,7 +235,7 @@ class Group {
   /// Emitters spawned by prime emitters and still alive.
   std::size_t liveEmitterCount() const;
   /// Adds an emitter fed by a group's deaths (validated; the source is looked up when the
-  /// context steps). Throws Error in a device context (death events are the CPU's).
+  /// context steps). Both backends run it (a device context refuses one for a hair group).
   DeathEmitter& addDeathEmitter(DeathEmitter emitter);
   /// The death emitters; edits through the span take effect at the next step.
   std::span<DeathEmitter> deathEmitters();

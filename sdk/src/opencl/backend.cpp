@@ -271,6 +271,9 @@ class ClGroup final : public DeviceMirror {
   void readStrands(GroupImpl& g, std::size_t births);
   void readDeaths(GroupImpl& g, std::size_t room, double t1);
   void readCollisions(GroupImpl& g);
+  // The most collision events one buffer holds on this device.
+  std::size_t mostHits() const { return shared_->runtime->device().info.maxAllocation / 64 - 1; }
+  void readBirths(GroupImpl& g, double t1);
 
   std::shared_ptr<Shared> shared_;
   std::vector<DeviceLane> lanes_;
@@ -315,7 +318,8 @@ class ClGroup final : public DeviceMirror {
   std::uint32_t reachOff_ = 0;  // where the actions' reach boxes start in extra_host_
   std::vector<LaneRef> actLanes_;
   bool neighbours_ = false, substepsByDistance_ = false;
-  Kernel act_, count_, scan_, list_, scanList_, tailKernel_, maxSpeed_, birth_, deaths_;
+  Kernel act_, count_, scan_, list_, scanList_, tailKernel_, maxSpeed_, birth_, deaths_,
+      birthEvents_;
   std::vector<cl::FlActionParams> params_host_, params_uploaded_;
   std::vector<float> extra_host_, extra_uploaded_;
 
@@ -327,6 +331,7 @@ class ClGroup final : public DeviceMirror {
   std::uint32_t lastDropped_ = 0;
   std::uint32_t lastDead_ = 0;  // the last retired step's dead
   GrowBuffer events_;           // fl_deaths' events, kDeathEventBytes each
+  GrowBuffer births_;           // fl_births' count and events
   std::vector<std::uint32_t> deathWords_;
   std::vector<std::uint32_t> lastKills_;
   bool hostDirty_ = true;
@@ -397,7 +402,7 @@ void ClGroup::buildProgram(GroupImpl& g, bool cull, bool hits) {
   Kernel act = kernel("fl_act"), count = kernel("fl_count"), scan = kernel("fl_scan"),
          list = kernel("fl_list"), scanList = kernel("fl_scan_list"), tail = kernel("fl_tail"),
          maxSpeed = kernel("fl_max_speed"), birth = kernel("fl_birth"),
-         deaths = kernel("fl_deaths");
+         deaths = kernel("fl_deaths"), birthEvents = kernel("fl_births");
   Kernel hair = g.hair.enabled ? kernel("fl_hair") : Kernel();
   Kernel small = gen.small ? kernel("fl_small") : Kernel();
   program_ = std::move(p);
@@ -410,11 +415,12 @@ void ClGroup::buildProgram(GroupImpl& g, bool cull, bool hits) {
   maxSpeed_ = std::move(maxSpeed);
   birth_ = std::move(birth);
   deaths_ = std::move(deaths);
+  birthEvents_ = std::move(birthEvents);
   hair_ = std::move(hair);
   small_ = std::move(small);
   hairProgram_ = g.hair.enabled;
   cullProgram_ = cull;
-  hitsProgram_ = hits && !g.hair.enabled;
+  hitsProgram_ = hits;
   actLanes_ = gen.actLanes;
   neighbours_ = gen.neighbours;
   substepsByDistance_ = gen.substepsByDistance;
@@ -474,6 +480,15 @@ void ClGroup::buildProgram(GroupImpl& g, bool cull, bool hits) {
   setArg(deaths_.get(), 9, cl_uint(velocity));
   const cl_mem id = laneMem({Attribute::Id, 0, ""});
   setArg(deaths_.get(), 10, id ? id : laneMem({Attribute::Position, 0, ""}));
+  // fl_births: the same lanes, and the newborns' time left.
+  for (int c = 0; c < 3; ++c) {
+    setArg(birthEvents_.get(), cl_uint(3 + c), laneMem({Attribute::Position, c, ""}));
+    setArg(birthEvents_.get(), cl_uint(6 + c),
+           laneMem({velocity ? Attribute::Velocity : Attribute::Position, c, ""}));
+  }
+  setArg(birthEvents_.get(), 9, cl_uint(velocity));
+  setArg(birthEvents_.get(), 10, id ? id : laneMem({Attribute::Position, 0, ""}));
+  setArg(birthEvents_.get(), 11, tau_.get());
   params_uploaded_.clear();
   extra_uploaded_.clear();
   packedVersion_ = ~std::uint64_t(0);
@@ -671,7 +686,7 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
       emitterSignature(emitterCodes_.variants) != emitterSignature_)
     programValid_ = false;
   // A group that records collisions runs a program that logs them (and only then).
-  const bool hits = g.collisionRoom() > 0 && !g.hair.enabled;
+  const bool hits = g.collisionRoom() > 0;
   if (g.hair.enabled != hairProgram_ || sp.cull != cullProgram_ || hits != hitsProgram_)
     programValid_ = false;
   if (programValid_ && programCheckedVersion_ != g.actionsVersion) {
@@ -766,6 +781,19 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   const bool kills = acts;                      // the NaN guard can kill in any list
   const std::size_t deathRoom = g.deathRoom();  // Group::recordDeaths
   if (!acts && births == 0) return;             // nothing on the device changes
+  if (hits && acts) {
+    // Room for every particle deflected by each Bounce in each sub-step, or the most a step
+    // had, within one buffer the device allows; taken before anything of the step is queued.
+    std::size_t bounces = 0;
+    for (const Action& a : g.actions.actions()) bounces += std::holds_alternative<Bounce>(a);
+    const std::size_t substeps =
+        substepsByDistance_ ? g.actions.substeps().maxSubsteps : stepSubsteps(g.actions, sp.dt);
+    hitRoom_ = std::min(mostHits(), std::max({hitRoom_,
+                                              g.capacity * std::max<std::size_t>(bounces, 1) *
+                                                  std::max<std::size_t>(substeps, 1),
+                                              std::size_t(1024)}));
+    hits_.reserve(context(), (16 + 16 * hitRoom_) * 4);
+  }
 
   cl_command_queue q = queue();
   cl_mem state = state_.mem.get();
@@ -843,11 +871,21 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   };
   // A small group's step is one launch (fl_small) when its program has it.
   const std::size_t tiles = (nBound + FL_TILE - 1) / FL_TILE;
-  const bool oneLaunch =
-      acts && small_ && tiles <= kSmallTiles && !g.hair.enabled && deathRoom == 0 && !hits;
+  const bool oneLaunch = acts && small_ && tiles <= kSmallTiles && !g.hair.enabled &&
+                         deathRoom == 0 && !hits && !g.birthsFeed;
   if (births > 0 && !oneLaunch) {
     birthArgs(birth_.get(), cl_uint(lanes_.size()) + 1, true);
     launch(birth_.get(), roundUp(births, kSmallLocal), kSmallLocal, "fl_birth");
+  }
+  if (births > 0 && g.birthsFeed) {
+    // Where they were born, before the act kernel moves them (a sub-emitter on birth).
+    births_.reserve(context(), (8 + 8 * std::size_t(births)) * 4);
+    cl_kernel k = birthEvents_.get();
+    setArg(k, 0, state);
+    setArg(k, 1, cl_uint(births));
+    setArg(k, 2, cap);
+    setArg(k, 12, births_.mem.get());
+    launch(k, roundUp(births, kSmallLocal), kSmallLocal, "fl_births");
   }
   if (acts) {
     cl_kernel k = act_.get();
@@ -906,12 +944,6 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     setArg(k, i++, t1Bits);
     setArg(k, i++, cl_uint(reachOff_));  // read only by a program that culls
     if (hits && acts) {
-      // Room for every particle deflected once by each Bounce, or the most a step had.
-      std::size_t bounces = 0;
-      for (const Action& a : g.actions.actions()) bounces += std::holds_alternative<Bounce>(a);
-      hitRoom_ =
-          std::max({hitRoom_, g.capacity * std::max<std::size_t>(bounces, 1), std::size_t(1024)});
-      hits_.reserve(context(), (16 + 16 * hitRoom_) * 4);
       const cl_uint zero = 0;
       check(clEnqueueFillBuffer(q, hits_.mem.get(), &zero, 4, 0, 4, 0, nullptr, nullptr),
             "clEnqueueFillBuffer (collisions)");
@@ -1008,6 +1040,33 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   }
   if (kills && deathRoom > 0) readDeaths(g, deathRoom, sp.time + sp.dt);
   if (hits && acts) readCollisions(g);
+  if (births > 0 && g.birthsFeed) readBirths(g, sp.time + sp.dt);
+}
+
+void ClGroup::readBirths(GroupImpl& g, double t1) {
+  drain(g);
+  std::uint32_t born = 0;
+  check(clEnqueueReadBuffer(queue(), births_.mem.get(), CL_TRUE, 0, 4, &born, 0, nullptr, nullptr),
+        "clEnqueueReadBuffer (birth count)");
+  deathWords_.resize(std::size_t(born) * 8);
+  if (born > 0)
+    check(clEnqueueReadBuffer(queue(), births_.mem.get(), CL_TRUE, 32, std::size_t(born) * 32,
+                              deathWords_.data(), 0, nullptr, nullptr),
+          "clEnqueueReadBuffer (births)");
+  g.stats.bytesReadBack += 4 + std::size_t(born) * 32;
+  if (g.birthEvents.capacity() < g.capacity) g.birthEvents.reserve(g.capacity);  // once
+  g.birthEvents.resize(born);
+  for (std::size_t r = 0; r < born; ++r) {
+    const std::uint32_t* w = deathWords_.data() + 8 * r;
+    DeathEvent& e = g.birthEvents[r];
+    for (int c = 0; c < 3; ++c) {
+      e.position[c] = std::bit_cast<float>(w[c]);
+      e.velocity[c] = std::bit_cast<float>(w[3 + c]);
+    }
+    e.id = w[6];
+    e.action = 0;
+    e.time = t1 - double(std::bit_cast<float>(w[7]));
+  }
 }
 
 void ClGroup::readCollisions(GroupImpl& g) {
@@ -1047,7 +1106,7 @@ void ClGroup::readCollisions(GroupImpl& g) {
   g.stats.collisionEventsDropped += total - kept;
   // More than the room: this step kept an arbitrary `hitRoom_` of them; later steps have room
   // for as many.
-  if (total > hitRoom_) hitRoom_ = total;
+  if (total > hitRoom_) hitRoom_ = std::min<std::size_t>(total, mostHits());
 }
 
 void ClGroup::readDeaths(GroupImpl& g, std::size_t room, double t1) {

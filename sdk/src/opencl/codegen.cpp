@@ -567,7 +567,6 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
                                  const std::string& emitSource, bool hair, bool cull,
                                  bool collisions) {
   GeneratedProgram g;
-  collisions = collisions && !hair;  // (fl_hair runs the plain list)
   // What the act kernel loads (reads) and stores (writes).
   AttributeSet reads, writes;
   const Integrator integrator = actions.integrator();
@@ -625,12 +624,13 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
                                                                   : 0;
     const std::string w = was;
     std::ostringstream c;
-    c << "    if (i < n && dead == 0u && (vx != " << w << "vx || vy != " << w << "vy || vz != " << w
-      << "vz))\n      fl_log_collision((ap + " << k << "), " << solid << ", " << (b.inside ? 1 : 0)
-      << ", " << w << "px, " << w << "py, " << w << "pz, " << w << "vx, " << w << "vy, " << w
-      << "vz, " << acc << ", dt,\n"
+    // (FL_LOG_HITS: in fl_act_one only; fl_hair runs the list without it)
+    c << "#ifdef FL_LOG_HITS\n    if (i < n && dead == 0u && (vx != " << w << "vx || vy != " << w
+      << "vy || vz != " << w << "vz))\n      fl_log_collision((ap + " << k << "), " << solid << ", "
+      << (b.inside ? 1 : 0) << ", " << w << "px, " << w << "py, " << w << "pz, " << w << "vx, " << w
+      << "vy, " << w << "vz, " << acc << ", dt,\n"
       << "          i >= n0 ? t1 - (fl_real)dt * (fl_real)(nsub - sub) : time, i, sub, " << k
-      << "u, id, fl_hits, fl_hitRoom);\n";
+      << "u, id, fl_hits, fl_hitRoom);\n#endif\n";
     return c.str();
   };
   for (std::size_t k = 0; k < acts.size(); ++k) {
@@ -790,6 +790,7 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
       "  const fl_real t0 = fl_real_from_bits(timeBits), t1 = fl_real_from_bits(t1Bits);\n";
   // The per-particle part once, as a function both kernels call: PoCL compiles the action
   // list's body once per program instead of once per kernel (cold start, issue #11).
+  if (collisions) s << "#define FL_LOG_HITS 1\n";
   s << "/* ---- generated: one particle's step */\nFL_INLINE void fl_act_one(";
   for (const auto& l : g.actLanes) s << laneDecl(l) << ", ";
   s << "__global uchar* restrict codes, __global const FlActionParams* restrict ap,\n"
@@ -803,6 +804,7 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
        "  (void)state; (void)extra; (void)snap; (void)snapN; (void)snapStride; (void)seedLo;\n"
        "  (void)seedHi; (void)fl_step; (void)n;\n"
     << one.str() << "}\n";
+  if (collisions) s << "#undef FL_LOG_HITS\n";
   std::string call = "fl_act_one(";
   for (const auto& l : g.actLanes) call += std::string("l_") + l.name + ", ";
   call +=

@@ -40,8 +40,9 @@ struct GeneratedProgram {
 /// (emission.hpp emissionSource), placed before tail.cl. With `hair`, the program also has
 /// fl_hair, which runs each newborn's whole life as a strand (hair mode). With `cull`,
 /// fl_act and fl_small skip actions out of a work-group's reach (ContextOptions::cull). With
-/// `collisions` (and not `hair`), fl_act logs each Bounce's deflections into its last two
-/// arguments (fl_hits, fl_hitRoom: surfaces.cl fl_log_collision), and there is no fl_small.
+/// `collisions`, fl_act logs each Bounce's deflections into its last two arguments (fl_hits,
+/// fl_hitRoom: surfaces.cl fl_log_collision), and there is no fl_small (fl_hair logs none,
+/// as the CPU's hair mode records only its birth step's).
 GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored, bool fp64,
                                  const std::string& emitSource, bool hair = false,
                                  bool cull = false, bool collisions = false);
