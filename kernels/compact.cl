@@ -145,6 +145,20 @@ __kernel void fl_scan_list(__global const uchar* codes, __global uint* tileDead,
   fl_scan_list_body(codes, tileDead, tileOff, holes, tail, state, births, capacity, tiles);
 }
 
+/* An event's first six words (fl_births, fl_deaths): particle i's position and velocity
+ * (zeros where `velocity` is 0). */
+FL_INLINE void fl_event_motion(__global uint* e, uint i, __global const float* px,
+                               __global const float* py, __global const float* pz,
+                               __global const float* vx, __global const float* vy,
+                               __global const float* vz, uint velocity) {
+  e[0] = as_uint(px[i]);
+  e[1] = as_uint(py[i]);
+  e[2] = as_uint(pz[i]);
+  e[3] = velocity ? as_uint(vx[i]) : 0u;
+  e[4] = velocity ? as_uint(vy[i]) : 0u;
+  e[5] = velocity ? as_uint(vz[i]) : 0u;
+}
+
 /* Birth events (a sub-emitter on birth; group.cpp recordBirths on the CPU): the step's
  * newborns where fl_birth wrote them, before the act kernel moves them on. events[0] gets
  * their count; newborn r is 8 words from events + 8 + 8r: position, velocity (zeros where
@@ -162,12 +176,7 @@ __kernel void fl_births(__global const uint* state, uint births, uint capacity,
   if (r >= born) return;
   const uint i = n0 + r;
   __global uint* e = events + 8u + 8u * r;
-  e[0] = as_uint(px[i]);
-  e[1] = as_uint(py[i]);
-  e[2] = as_uint(pz[i]);
-  e[3] = velocity ? as_uint(vx[i]) : 0u;
-  e[4] = velocity ? as_uint(vy[i]) : 0u;
-  e[5] = velocity ? as_uint(vz[i]) : 0u;
+  fl_event_motion(e, i, px, py, pz, vx, vy, vz, velocity);
   e[6] = id[i];
   e[7] = as_uint(tau[r]);
 }
@@ -192,12 +201,7 @@ __kernel void fl_deaths(__global const uchar* codes, __global const uint* tileOf
     const uint code = codes[i];
     if (code == 0u) continue;
     __global uint* e = events + 8u * at;
-    e[0] = as_uint(px[i]);
-    e[1] = as_uint(py[i]);
-    e[2] = as_uint(pz[i]);
-    e[3] = velocity ? as_uint(vx[i]) : 0u;
-    e[4] = velocity ? as_uint(vy[i]) : 0u;
-    e[5] = velocity ? as_uint(vz[i]) : 0u;
+    fl_event_motion(e, i, px, py, pz, vx, vy, vz, velocity);
     e[6] = id[i];
     e[7] = code;
     ++at;

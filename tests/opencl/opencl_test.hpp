@@ -58,14 +58,20 @@ inline RunResult resultOf(const Group& g) {
 }
 
 using Build = std::function<Group&(Context&)>;
-inline RunResult runEffect(Backend backend, const Build& build, int steps, std::uint64_t seed = 7,
-                           double dt = 1.0 / 30.0) {
+/// The options parity runs take: one seed and step on both backends, two threads.
+inline ContextOptions parityOptions(Backend backend, std::uint64_t seed = 7,
+                                    double dt = 1.0 / 30.0) {
   ContextOptions o;
   o.seed = seed;
   o.dt = dt;
   o.threads = 2;
   o.backend = backend;
-  Context ctx(o);
+  return o;
+}
+
+inline RunResult runEffect(Backend backend, const Build& build, int steps, std::uint64_t seed = 7,
+                           double dt = 1.0 / 30.0) {
+  Context ctx(parityOptions(backend, seed, dt));
   Group& g = build(ctx);
   ctx.run(std::size_t(steps));
   return resultOf(g);

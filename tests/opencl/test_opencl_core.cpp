@@ -252,12 +252,7 @@ TEST(OpenCLCore, ACallbackMayNotReturn) {
 TEST(OpenCLCore, DeathEventsAsOnTheCpu) {
   FLURRY_REQUIRE_OPENCL();
   auto run = [](Backend backend, double rate, std::size_t room, bool velocity) {
-    ContextOptions o;
-    o.seed = 7;
-    o.dt = 1.0 / 30.0;
-    o.threads = 2;
-    o.backend = backend;
-    Context ctx(o);
+    Context ctx(parityOptions(backend));
     Group& g = ctx.createGroup("deaths", 40000);
     g.addEmitter(spray(Vec3(0.0f, 1.0f, 0.0f), rate));
     // Killed below the floor (Sink, action 1) or by age (KillOld, action 3).
@@ -328,12 +323,7 @@ TEST(OpenCLCore, DeathEventsAsOnTheCpu) {
 TEST(OpenCLCore, CollisionEventsAsOnTheCpu) {
   FLURRY_REQUIRE_OPENCL();
   auto run = [](Backend backend, Integrator integrator, std::size_t room) {
-    ContextOptions o;
-    o.seed = 7;
-    o.dt = 1.0 / 30.0;
-    o.threads = 2;
-    o.backend = backend;
-    Context ctx(o);
+    Context ctx(parityOptions(backend));
     Group& g = ctx.createGroup("hits", 20000);
     g.addEmitter(spray(Vec3(0.0f, 1.0f, 0.0f), 3000));
     ActionList list{Gravity{kDown},

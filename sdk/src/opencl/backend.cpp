@@ -53,6 +53,14 @@ constexpr std::size_t kMaxFillItems = 1 << 12;  // PoCL pays ~1 us per work-grou
 constexpr std::size_t kSmallTiles = 4;          // up to 4096 particles: count-scan-list in one item
 constexpr std::size_t kDeathEventBytes = 8 * 4;  // fl_deaths: position, velocity, id, code
 
+// An event's position and velocity from its first six words (compact.cl fl_event_motion).
+void motionFromWords(const std::uint32_t* w, DeathEvent& e) {
+  for (int c = 0; c < 3; ++c) {
+    e.position[c] = std::bit_cast<float>(w[c]);
+    e.velocity[c] = std::bit_cast<float>(w[3 + c]);
+  }
+}
+
 std::size_t roundUp(std::size_t x, std::size_t m) {
   return (x + m - 1) / m * m;
 }
@@ -1059,10 +1067,7 @@ void ClGroup::readBirths(GroupImpl& g, double t1) {
   for (std::size_t r = 0; r < born; ++r) {
     const std::uint32_t* w = deathWords_.data() + 8 * r;
     DeathEvent& e = g.birthEvents[r];
-    for (int c = 0; c < 3; ++c) {
-      e.position[c] = std::bit_cast<float>(w[c]);
-      e.velocity[c] = std::bit_cast<float>(w[3 + c]);
-    }
+    motionFromWords(w, e);
     e.id = w[6];
     e.action = 0;
     e.time = t1 - double(std::bit_cast<float>(w[7]));
@@ -1124,10 +1129,7 @@ void ClGroup::readDeaths(GroupImpl& g, std::size_t room, double t1) {
   for (std::size_t j = 0; j < kept; ++j) {
     const std::uint32_t* w = deathWords_.data() + 8 * j;
     DeathEvent& e = g.deathEvents[j];
-    for (int c = 0; c < 3; ++c) {
-      e.position[c] = std::bit_cast<float>(w[c]);
-      e.velocity[c] = std::bit_cast<float>(w[3 + c]);
-    }
+    motionFromWords(w, e);
     e.id = w[6];
     e.action = w[7] == FL_NON_FINITE_CODE ? DeathEvent::kNonFinite : w[7] - 1u;
     e.time = t1;
