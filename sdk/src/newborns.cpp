@@ -88,14 +88,15 @@ void store(const NewbornContext& nc, std::size_t slot, std::uint32_t id, const N
 // group stores, in kernels/newborn.h's order (the device's too).
 kernel::FlNewbornDraws newbornDraws(const Lanes& L, const Emitter& em, const ParticleType& type) {
   const bool alongNormal = !(em.normalSpeed.constant() && em.normalSpeed.center == 0.0f);
-  auto n = [](bool stored, int draws) { return kernel::uint(stored ? draws : 0); };
+  // (a domain's count is a visit: taken only for what is stored)
+  auto n = [](bool stored, const auto& value) {
+    return kernel::uint(stored ? drawCount(value) : 0);
+  };
   return kernel::fl_newborn_draws(
-      n(em.types.size() > 1, 1), n(true, drawCount(type.velocity)), n(true, drawCount(em.shape)),
-      n(alongNormal, drawCount(em.normalSpeed)), n(L.lifetime, drawCount(type.lifetime)),
-      n(L.color[0], drawCount(type.color)), n(L.color[0], drawCount(type.alpha)),
-      n(L.size, drawCount(type.size)), n(L.mass, drawCount(type.mass)),
-      n(L.charge, drawCount(type.charge)), n(L.up[0], drawCount(type.up)),
-      n(L.rot[0], drawCount(type.rotVelocity)));
+      em.types.size() > 1 ? 1u : 0u, n(true, type.velocity), n(true, em.shape),
+      n(alongNormal, em.normalSpeed), n(L.lifetime, type.lifetime), n(L.color[0], type.color),
+      n(L.color[0], type.alpha), n(L.size, type.size), n(L.mass, type.mass),
+      n(L.charge, type.charge), n(L.up[0], type.up), n(L.rot[0], type.rotVelocity));
 }
 
 // Emitters with one particle type: every draw of a batch at once (see sampling.hpp).
