@@ -1103,9 +1103,11 @@ void ClGroup::readCollisions(GroupImpl& g) {
                  : double(std::bit_cast<float>(w[12]));
     hitsSorted_[j] = {std::uint64_t(w[0]) << 32 | w[1], e};
   }
-  std::sort(hitsSorted_.begin(), hitsSorted_.end(),
-            [](const auto& x, const auto& y) { return x.first < y.first; });
+  // Only the first `kept` in the CPU's order are wanted (keys are unique: one order).
   const std::size_t kept = std::min(got, g.collisionRoom());
+  std::partial_sort(hitsSorted_.begin(), hitsSorted_.begin() + std::ptrdiff_t(kept),
+                    hitsSorted_.end(),
+                    [](const auto& x, const auto& y) { return x.first < y.first; });
   g.collisionEvents.clear();
   for (std::size_t j = 0; j < kept; ++j) g.collisionEvents.push_back(hitsSorted_[j].second);
   g.stats.collisionEventsDropped += total - kept;
