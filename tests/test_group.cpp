@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstring>
 #include <map>
@@ -1833,6 +1834,43 @@ TEST(Group, AnUpdateIntervalCatchesUpExactly) {
     EXPECT_EQ(lod.stats().emitted, every.stats().emitted);
     EXPECT_THROW(lod.setUpdateInterval(0), InvalidArgument);
     EXPECT_THROW(lod.setUpdateInterval(257), InvalidArgument);
+  }
+}
+
+// A group sitting steps out is not looked at by the step (the context keeps the schedule):
+// still, what another call did to it between steps is undone when it sits out, and an
+// interval changed between steps takes effect at once.
+TEST(Group, ASkippedStepClearsWhatAPrewarmLeft) {
+  for (unsigned threads : {1u, 2u}) {
+    ContextOptions o;
+    o.dt = 0.05;
+    o.threads = threads;
+    Context ctx(o);
+    Group& g = ctx.createGroup("g", 400);
+    Emitter e;
+    e.shape = Domain::point(Vec3(0.0f));
+    e.rate = 100.0f;
+    e.types[0].lifetime = 0.1f;
+    g.addEmitter(e);
+    g.setActions(ActionList{Move{}, KillOld{}});
+    g.recordDeaths(1000);
+    g.setUpdateInterval(3);
+    ctx.run(30);
+    // Between its two skips a prewarm steps it once, with deaths.
+    int due = 0;
+    while (std::abs(ctx.time(g) - ctx.time()) > 1e-9 || due++ == 0) ctx.step();
+    ASSERT_NEAR(ctx.time(g), ctx.time(), 1e-9);  // it just stepped; the next two it sits out
+    ctx.step();                                  // the first (which clears the step's events)
+    ASSERT_TRUE(g.deaths().empty());
+    ctx.prewarm(std::span<Group* const>(std::array<Group*, 1>{&g}), 0.05);
+    ASSERT_FALSE(g.deaths().empty());
+    ctx.step();
+    EXPECT_TRUE(g.deaths().empty()) << threads;
+    EXPECT_EQ(ctx.stats().lastStepParts.act, 0.0) << threads;
+    // Every step again, from the next on.
+    g.setUpdateInterval(1);
+    ctx.step();
+    EXPECT_FALSE(g.deaths().empty()) << threads;
   }
 }
 

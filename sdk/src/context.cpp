@@ -37,8 +37,22 @@ struct Context::Impl {
   // The groups as Context::step takes them, found again only when a group is created or
   // destroyed (groupsVersion): a large one steps on all threads, the small ones (effect
   // instances) many at once, one per thread, each inline.
-  std::vector<detail::GroupImpl*> largeGroups, smallGroups;
+  // Each with its update interval and phase, so that a step decides which groups sit it out
+  // without reaching into them: a game's ten thousand instances out of sight, stepped once
+  // every few frames, cost it no walk over their states.
+  struct Scheduled {
+    detail::GroupImpl* group;
+    std::uint32_t interval, phase;
+    bool due(std::uint64_t step) const { return interval <= 1 || (step + phase) % interval == 0; }
+    /// It stepped since its last skip (or may have: the list is new): its next skip clears
+    /// that step's events and times and starts its clock; the skips after only count.
+    bool stepped;
+  };
+  std::vector<Scheduled> largeGroups, smallGroups;
   std::uint64_t splitVersion = ~std::uint64_t(0);
+  // Bumped by Group::setUpdateInterval and by whatever steps groups outside Context::step
+  // (prewarm): the lists above are made again.
+  std::uint64_t scheduleVersion = 0, splitSchedule = ~std::uint64_t(0);
   void splitGroups();
   // Context::step or prewarm is running: a Callback may not create or destroy groups (the
   // step holds them) nor step again.
@@ -213,6 +227,7 @@ Group& Context::createGroup(std::string name, std::size_t capacity) {
   gi->updatePhase = gi->index;  // Group::setUpdateInterval's stagger
   gi->onDevice = impl_->backendKind != Backend::Cpu;
   gi->contextDeathEmitters = &impl_->deathEmitters;
+  gi->contextSchedule = &impl_->scheduleVersion;
   gi->ensureStorage();
   impl_->groups.reserve(impl_->groups.size() + 1);  // nothing below throws
   impl_->byName.reserve(impl_->byName.size() + 1);
@@ -322,7 +337,7 @@ void stepGroup(detail::BackendImpl& backend, detail::GroupImpl& gi, const detail
 }  // namespace
 
 void Context::Impl::splitGroups() {
-  if (splitVersion == groupsVersion) return;
+  if (splitVersion == groupsVersion && splitSchedule == scheduleVersion) return;
   // On the CPU a group is independent of every other and its result does not depend on the
   // thread that steps it: a group too small to share out its own pass steps inline on one
   // thread while others step theirs, a large one on all.
@@ -331,9 +346,11 @@ void Context::Impl::splitGroups() {
   smallGroups.clear();
   for (const auto& g : groups) {
     detail::GroupImpl* gi = g->impl_.get();
-    (spread && gi->capacity <= kSmallGroupCapacity ? smallGroups : largeGroups).push_back(gi);
+    (spread && gi->capacity <= kSmallGroupCapacity ? smallGroups : largeGroups)
+        .push_back({gi, gi->updateInterval, gi->updatePhase, true});
   }
   splitVersion = groupsVersion;
+  splitSchedule = scheduleVersion;
 }
 
 detail::StepParams Context::Impl::params() const {
@@ -432,23 +449,36 @@ void Context::step() {
   // Steps `list[from, to)` in order, asking the memory for a group's state two groups before
   // its step and for what that points to one group before: a game's thousands of groups are
   // each out of cache by their next step, and would otherwise wait on one miss after another.
-  auto stepInOrder = [&](const std::vector<detail::GroupImpl*>& list, std::size_t from,
-                         std::size_t to, const detail::StepParams& params) {
+  // (A group that sits this step out needs only its count of skipped steps, and after a step
+  // of its own a few more lines of its state.)
+  auto stepInOrder = [&](std::vector<Impl::Scheduled>& list, std::size_t from, std::size_t to,
+                         const detail::StepParams& params) {
     for (std::size_t i = from; i < to; ++i) {
-      if (i + 2 < to) list[i + 2]->prefetchSelf();
-      // (A group that sits this step out needs nothing but its own state.)
-      if (i + 1 < to && list[i + 1]->dueAt(params.step)) list[i + 1]->prefetchData();
-      detail::GroupImpl& gi = *list[i];
-      if (!gi.dueAt(params.step)) {
-        skipGroup(gi, groupStep(params, gi, impl_->timeAtDtChange, impl_->stepsSinceDtChange, 0));
+      if (i + 2 < to) {
+        const Impl::Scheduled& next = list[i + 2];
+        if (next.due(params.step) || next.stepped)
+          next.group->prefetchSelf();
+        else
+          next.group->prefetchSkip();
+      }
+      if (i + 1 < to && list[i + 1].due(params.step)) list[i + 1].group->prefetchData();
+      Impl::Scheduled& at = list[i];
+      detail::GroupImpl& gi = *at.group;
+      if (!at.due(params.step)) {
+        if (at.stepped)
+          skipGroup(gi, groupStep(params, gi, impl_->timeAtDtChange, impl_->stepsSinceDtChange, 0));
+        else
+          ++gi.skippedSteps;  // (its clock started at its first skip; no events are left)
+        at.stepped = false;
         continue;
       }
       stepGroup(*impl_->backend, gi,
                 groupStep(params, gi, impl_->timeAtDtChange, impl_->stepsSinceDtChange, 0));
+      at.stepped = true;
     }
   };
   stepInOrder(impl_->largeGroups, 0, impl_->largeGroups.size(), sp);
-  const auto& small = impl_->smallGroups;
+  auto& small = impl_->smallGroups;
   if (!small.empty()) {
     detail::StepParams alone = sp;
     alone.pool = &impl_->inlinePool;
@@ -482,6 +512,7 @@ std::uint64_t Context::prewarm(std::span<Group* const> groups, double seconds) {
   if (n > 0 && double(n - 1) >= q * (1.0 - 1e-9)) --n;
   const detail::StepParams sp = impl_->params();
   if (n > 0) impl_->feedDeathEmitters();
+  if (n > 0) ++impl_->scheduleVersion;  // its steps leave events and times to clear
   for (std::uint64_t i = 0; i < n; ++i) {
     impl_->shareBudget();
     for (Group* g : groups) {

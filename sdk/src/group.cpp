@@ -483,6 +483,7 @@ double Group::timeScale() const {
 Group& Group::setUpdateInterval(std::uint32_t interval) {
   if (interval < 1 || interval > 256) throw InvalidArgument("interval", "must be 1 to 256");
   impl_->updateInterval = interval;
+  if (impl_->contextSchedule) ++*impl_->contextSchedule;
   return *this;
 }
 

@@ -318,6 +318,8 @@ struct GroupImpl {
   std::vector<FoundSource> deathSources;
   /// The context's count of death emitters in all its groups (0: Context::step skips them).
   std::size_t* contextDeathEmitters = nullptr;
+  /// The context's schedule version: Group::setUpdateInterval bumps it.
+  std::uint64_t* contextSchedule = nullptr;
   GroupStats::StepSeconds lastStepParts;  ///< the last step's (the CPU backend's clock)
   std::size_t collisionsPerStep = 0;      ///< Group::recordCollisions; 0: not recording
   /// A collision emitter names this group (set by Context::step): it records every collision.
@@ -401,9 +403,6 @@ struct GroupImpl {
     }
     clockUnits += units;
   }
-  bool dueAt(std::uint64_t contextStep) const {
-    return updateInterval <= 1 || (contextStep + updatePhase) % updateInterval == 0;
-  }
 
   /// Brings the live count and `attributes` (default: all; before the host writes, all) up
   /// to date on the host.
@@ -433,6 +432,8 @@ struct GroupImpl {
   /// small group's worth).
   void prefetchSelf() const;
   void prefetchData() const;
+  /// What a step it sits out touches after its first (skippedSteps).
+  void prefetchSkip() const { __builtin_prefetch(&skippedSteps); }
 
   /// The attributes the group must store now. The action list's share is kept for its
   /// actionsVersion by ensureStorage: every step asks, and an idle group's step is little
