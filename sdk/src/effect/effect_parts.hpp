@@ -14,6 +14,15 @@
 
 namespace flurry::detail {
 
+/// JSON paths in errors: join("groups[0]", "rate") is "groups[0].rate", index("groups", 2)
+/// is "groups[2]".
+inline std::string join(const std::string& path, const std::string& key) {
+  return path.empty() ? key : path + "." + key;
+}
+inline std::string index(const std::string& path, std::size_t i) {
+  return path + "[" + std::to_string(i) + "]";
+}
+
 /// Throws EffectError at `path`.type unless `type` names an action an effect file can hold
 /// (with the nearest name as a suggestion), e.g. "actions[2].type: unknown action ...".
 void checkEffectActionType(const std::string& type, const std::string& fileName,
