@@ -1,7 +1,9 @@
 #include <cmath>
+#include <string>
 #include <type_traits>
 
 #include "action_traits.hpp"
+#include "effect/check_fields.hpp"
 #include "effect/descriptors.hpp"
 #include "flurry/actions.hpp"
 #include "flurry/error.hpp"
@@ -19,9 +21,8 @@ constexpr const char* nameOf() {
     return "Callback";
 }
 
-bool finite(Vec3 v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
+// Each field against its descriptor's limit (effect/check_fields.hpp), then what no single
+// field says (the Validator).
 
 struct Validator {
   std::string where;
@@ -29,162 +30,24 @@ struct Validator {
   void require(bool ok, const char* field, const std::string& why) const {
     if (!ok) throw InvalidArgument(where + "." + field, why);
   }
-  void finiteVec(Vec3 v, const char* field) const { require(finite(v), field, "not finite"); }
-  void finiteNum(float x, const char* field) const {
-    require(std::isfinite(x), field, "not finite");
-  }
-  void nonNegative(float x, const char* field) const {
-    require(std::isfinite(x) && x >= 0, field, "must be finite and >= 0");
-  }
-  void positive(float x, const char* field) const {
-    require(std::isfinite(x) && x > 0, field, "must be finite and > 0");
-  }
-  // A radius may be infinite ("no limit") but must be > 0.
-  void radius(float x, const char* field) const {
-    require(!std::isnan(x) && x > 0, field, "must be > 0 (infinity: no limit)");
-  }
-  void axis(Vec3 v, const char* field) const {
-    finiteVec(v, field);
-    require(glm::dot(v, v) > 0, field, "zero length");
-  }
-  void falloff(const Falloff& f) const {
-    finiteVec(f.center, "falloff.center");
-    radius(f.radius, "falloff.radius");
-    nonNegative(f.power, "falloff.power");
-  }
-  void rate(Vec3 r, const char* field) const {
-    finiteVec(r, field);
-    require(r.x >= 0 && r.y >= 0 && r.z >= 0, field, "must be >= 0");
-  }
-  void orbit(float magnitude, float epsilon, float maxRadius) const {
-    finiteNum(magnitude, "magnitude");
-    positive(epsilon, "epsilon");  // softening: finite at r = 0
-    radius(maxRadius, "maxRadius");
-  }
-
-  void operator()(const Gravity& a) const {
-    finiteVec(a.acceleration, "acceleration");
-    falloff(a.falloff);
-  }
-  void operator()(const Damping& a) const {
-    rate(a.rate, "rate");
-    falloff(a.falloff);
-  }
-  void operator()(const RotDamping& a) const { rate(a.rate, "rate"); }
-  void operator()(const OrbitPoint& a) const {
-    finiteVec(a.center, "center");
-    orbit(a.magnitude, a.epsilon, a.maxRadius);
-  }
-  void operator()(const OrbitLine& a) const {
-    finiteVec(a.point, "point");
-    axis(a.axis, "axis");
-    orbit(a.magnitude, a.epsilon, a.maxRadius);
-  }
-  void operator()(const Gravitate& a) const { orbit(a.magnitude, a.epsilon, a.maxRadius); }
-  void operator()(const Vortex& a) const {
-    finiteVec(a.center, "center");
-    axis(a.axis, "axis");
-    finiteNum(a.aroundSpeed, "aroundSpeed");
-    positive(a.coreRadius, "coreRadius");
-    nonNegative(a.tightness, "tightness");
-    finiteNum(a.inSpeed, "inSpeed");
-    finiteNum(a.upSpeed, "upSpeed");
-    nonNegative(a.responsiveness, "responsiveness");
-    radius(a.maxRadius, "maxRadius");
-  }
-  void operator()(const Jet& a) const {
-    finiteVec(a.center, "center");
-    radius(a.radius, "radius");
-  }
-  void operator()(const Explosion& a) const {
-    finiteVec(a.center, "center");
-    nonNegative(a.speed, "speed");
-    finiteNum(a.magnitude, "magnitude");
-    positive(a.stddev, "stddev");
-    positive(a.epsilon, "epsilon");
-    finiteNum(a.time, "time");
-  }
-  void operator()(const RandomAccel& a) const { falloff(a.falloff); }
-  void operator()(const RandomDisplace&) const {}
-  void operator()(const RandomVelocity&) const {}
-  void operator()(const RandomRotVelocity&) const {}
-  void operator()(const Turbulence& a) const {
-    finiteNum(a.amplitude, "amplitude");
-    positive(a.frequency, "frequency");
-    require(a.octaves >= 1 && a.octaves <= 8, "octaves", "must be in [1, 8]");
-    finiteVec(a.drift, "drift");
-    falloff(a.falloff);
-  }
-  void operator()(const ElectricField& a) const {
-    finiteVec(a.field, "field");
-    falloff(a.falloff);
-  }
-  void operator()(const MagneticField& a) const {
-    finiteVec(a.field, "field");
-    falloff(a.falloff);
-  }
+  template <class A>
+  void operator()(const A&) const {}  // its fields say all
   void operator()(const SampledField& a) const {
     require(a.field != nullptr, "field", "no field given");
     a.field->validate((where + ".field").c_str());
-    finiteNum(a.strength, "strength");
-    nonNegative(a.responsiveness, "responsiveness");
-    falloff(a.falloff);
-  }
-  void operator()(const Avoid& a) const {
-    finiteNum(a.magnitude, "magnitude");
-    positive(a.epsilon, "epsilon");
-    nonNegative(a.lookAhead, "lookAhead");
-  }
-  void operator()(const Follow& a) const { orbit(a.magnitude, a.epsilon, a.maxRadius); }
-  void operator()(const MatchVelocity& a) const { orbit(a.magnitude, a.epsilon, a.maxRadius); }
-  void operator()(const MatchRotVelocity& a) const { orbit(a.magnitude, a.epsilon, a.maxRadius); }
-  void operator()(const TargetVelocity& a) const {
-    finiteVec(a.velocity, "velocity");
-    nonNegative(a.rate, "rate");
-  }
-  void operator()(const TargetRotVelocity& a) const {
-    finiteVec(a.rotVelocity, "rotVelocity");
-    nonNegative(a.rate, "rate");
-  }
-  void operator()(const TargetColor& a) const {
-    finiteVec(a.color, "color");
-    finiteNum(a.alpha, "alpha");
-    nonNegative(a.rate, "rate");
-  }
-  void operator()(const TargetSize& a) const {
-    nonNegative(a.size, "size");
-    nonNegative(a.rate, "rate");
   }
   void operator()(const SpeedClamp& a) const {
-    nonNegative(a.minSpeed, "minSpeed");
-    require(!std::isnan(a.maxSpeed) && a.maxSpeed >= a.minSpeed, "maxSpeed", "must be >= minSpeed");
+    require(a.maxSpeed >= a.minSpeed, "maxSpeed", "must be >= minSpeed");
   }
+  // (Each key's fields are checked by their descriptors.)
   template <class Keys>
   void keys(const Keys& k) const {
     require(!k.empty(), "keys", "needs at least one key");
-    for (std::size_t i = 0; i < k.size(); ++i) {
-      require(std::isfinite(k[i].t) && k[i].t >= 0 && k[i].t <= 1, "keys",
-              "key " + std::to_string(i) + ": t must be in [0, 1]");
-      require(i == 0 || k[i].t >= k[i - 1].t, "keys", "key times must not decrease");
-    }
+    for (std::size_t i = 1; i < k.size(); ++i)
+      require(k[i].t >= k[i - 1].t, "keys", "key times must not decrease");
   }
-  void overLifeMode(OverLifeMode m) const {
-    require(m == OverLifeMode::Multiply || m == OverLifeMode::Replace, "mode",
-            "must be Multiply or Replace");
-  }
-  void operator()(const ColorOverLife& a) const {
-    overLifeMode(a.mode);
-    keys(a.keys);
-    for (const auto& k : a.keys)
-      require(std::isfinite(k.color.r) && std::isfinite(k.color.g) && std::isfinite(k.color.b) &&
-                  std::isfinite(k.color.a),
-              "keys", "a color is not finite");
-  }
-  void operator()(const SizeOverLife& a) const {
-    overLifeMode(a.mode);
-    keys(a.keys);
-    for (const auto& k : a.keys) nonNegative(k.size, "keys");
-  }
+  void operator()(const ColorOverLife& a) const { keys(a.keys); }
+  void operator()(const SizeOverLife& a) const { keys(a.keys); }
   void operator()(const Bounce& a) const {
     const auto& s = a.surface.shape();
     const bool closed =
@@ -196,35 +59,15 @@ struct Validator {
                                 " cannot deflect (use a plane, rectangle, disc, triangle, sphere, "
                                 "box, or a line segment in 2-D)");
     require(!a.inside || closed, "inside", "only a sphere or a box can keep particles inside");
-    nonNegative(a.restitution, "restitution");
-    require(std::isfinite(a.friction) && a.friction >= 0 && a.friction <= 1, "friction",
-            "must be in [0, 1]");
-    nonNegative(a.cutoff, "cutoff");
     if (std::holds_alternative<LineDomain>(s)) {
-      axis(a.planeNormal, "planeNormal");
       const auto& l = std::get<LineDomain>(s);
       const Vec3 n = glm::cross(l.p1 - l.p0, a.planeNormal);
       require(glm::dot(n, n) > 0, "planeNormal", "the segment lies along the plane's normal");
     }
   }
   void operator()(const Sink& a) const {
-    require(std::isfinite(a.passThrough) && a.passThrough >= 0 && a.passThrough <= 1, "passThrough",
-            "must be in [0, 1]");
     require(a.mode != Sink::Mode::Hit || a.region.isPlanar(), "mode",
             "Hit needs a plane piece (plane, rectangle, disc, triangle)");
-  }
-  void operator()(const SinkVelocity&) const {}
-  void operator()(const Block&) const {}
-  void operator()(const KillOld&) const {}
-  void operator()(const Move&) const {}
-  void operator()(const Constrain2D& a) const {
-    finiteVec(a.point, "point");
-    axis(a.normal, "normal");
-  }
-  void operator()(const CopyVertexB&) const {}
-  void operator()(const Restore& a) const {
-    finiteNum(a.start, "start");
-    positive(a.duration, "duration");
   }
   void operator()(const Callback& a) const {
     require(bool(a.function), "function", "no function given");
@@ -386,7 +229,12 @@ ActionList& ActionList::add(Action action) {
       "actions[" + std::to_string(actions_.size()) + "]." + actionName(action);
   if (actions_.size() >= 250)
     throw InvalidArgument("actions", "an action list holds at most 250 actions");
-  std::visit(Validator{where}, action);
+  std::visit(
+      [&](const auto& a) {
+        if constexpr (desc::Described<std::decay_t<decltype(a)>>) desc::checkFields(a, where);
+        Validator{where}(a);
+      },
+      action);
   if (integrator_ == Integrator::Exact) {
     std::vector<Action> next = actions_;
     next.push_back(action);

@@ -1,18 +1,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "effect/check_fields.hpp"
 #include "emission_plan.hpp"
 #include "flurry/emitter.hpp"
 #include "flurry/error.hpp"
 #include "kernel_compat.hpp"
 
 namespace flurry {
-
-namespace {
-bool finite(Vec3 v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-}  // namespace
 
 namespace detail {
 Vec3 pathPositionAt(Vec3 position, Vec3 velocity, double start, const std::vector<Keyframe>& path,
@@ -49,15 +44,15 @@ Vec3 Emitter::positionAt(double t) const {
   return detail::pathPositionAt(position, velocity, start, path, pathLoop, t, key);
 }
 
+// Each field against its descriptor (effect/check_fields.hpp), then what no single field
+// says.
+
 void DeathEmitter::validate(const std::string& where) const {
   if (source.empty()) throw InvalidArgument(where + ".source", "names no group");
-  count.validate((where + ".count").c_str());
+  desc::checkFields(*this, where);
   if (count.center < 0) throw InvalidArgument(where + ".count", "must be >= 0");
   if (count.center + count.spread > 1e6f)
     throw InvalidArgument(where + ".count", "more than a million newborns a death");
-  if (!std::isfinite(inheritVelocity))
-    throw InvalidArgument(where + ".inheritVelocity", "not finite");
-  if (cause < -1) throw InvalidArgument(where + ".cause", "must be an action's index or -1");
   if (on == Trigger::Birth && cause != -1)
     throw InvalidArgument(where + ".cause",
                           "a birth has no cause: -1 (births emit whatever kills)");
@@ -66,55 +61,42 @@ void DeathEmitter::validate(const std::string& where) const {
   e.validate(where);
 }
 
-void Emitter::validate(const std::string& where) const {
+namespace {
+// What an emitter and a prime emitter share beyond their fields: when and along what path.
+template <class E>
+void checkCounting(const E& e, const std::string& where) {
   auto fail = [&](const std::string& field, const std::string& why) {
     throw InvalidArgument(where + "." + field, why);
   };
-  if (!std::isfinite(rate) || rate < 0) fail("rate", "must be finite and >= 0");
-  if (!finite(position)) fail("position", "not finite");
-  if (!finite(velocity)) fail("velocity", "not finite");
-  if (!std::isfinite(start)) fail("start", "not finite");
-  if (std::isnan(stop) || stop < start) fail("stop", "must be >= start");
-  for (std::size_t i = 0; i < bursts.size(); ++i) {
-    const Burst& b = bursts[i];
-    const std::string f = "bursts[" + std::to_string(i) + "]";
-    if (!std::isfinite(b.time)) fail(f + ".time", "not finite");
-    if (!std::isfinite(b.interval) || b.interval < 0) fail(f + ".interval", "must be >= 0");
-    if (b.repeat > 1 && b.interval <= 0) fail(f + ".interval", "must be > 0 to repeat");
-  }
-  for (std::size_t i = 0; i < path.size(); ++i) {
-    const std::string f = "path[" + std::to_string(i) + "]";
-    if (!std::isfinite(path[i].time) || !finite(path[i].position)) fail(f, "not finite");
-    if (i > 0 && path[i].time <= path[i - 1].time)
-      fail(f + ".time", "keyframe times must increase");
-  }
-  if (pathLoop && path.size() < 2) fail("pathLoop", "a looping path needs at least two keys");
-  if (types.empty()) fail("types", "an emitter needs at least one particle type");
+  if (std::isnan(e.stop) || e.stop < e.start) fail("stop", "must be >= start");
+  for (std::size_t i = 0; i < e.bursts.size(); ++i)
+    if (e.bursts[i].repeat > 1 && e.bursts[i].interval <= 0)
+      fail("bursts[" + std::to_string(i) + "].interval", "must be > 0 to repeat");
+  for (std::size_t i = 1; i < e.path.size(); ++i)
+    if (e.path[i].time <= e.path[i - 1].time)
+      fail("path[" + std::to_string(i) + "].time", "keyframe times must increase");
+  if (e.pathLoop && e.path.size() < 2) fail("pathLoop", "a looping path needs at least two keys");
+}
+}  // namespace
+
+void Emitter::validate(const std::string& where) const {
+  desc::checkFields(*this, where);
+  checkCounting(*this, where);
+  if (types.empty())
+    throw InvalidArgument(where + ".types", "an emitter needs at least one particle type");
   double total = 0;
   for (std::size_t i = 0; i < types.size(); ++i) {
-    const ParticleType& t = types[i];
-    const std::string f = "types[" + std::to_string(i) + "]";
-    if (!std::isfinite(t.weight) || t.weight < 0) fail(f + ".weight", "must be finite and >= 0");
-    total += t.weight;
-    const std::string fs[] = {f + ".alpha", f + ".size", f + ".mass", f + ".lifetime",
-                              f + ".charge"};
-    const Fuzzy* vals[] = {&t.alpha, &t.size, &t.mass, &t.lifetime, &t.charge};
-    for (int k = 0; k < 5; ++k) vals[k]->validate((where + "." + fs[k]).c_str());
-    if (t.lifetime.center <= 0) fail(f + ".lifetime", "must be > 0");
+    if (types[i].lifetime.center <= 0)
+      throw InvalidArgument(where + ".types[" + std::to_string(i) + "].lifetime", "must be > 0");
+    total += types[i].weight;
   }
-  if (!(total > 0)) fail("types", "the weights add up to 0");
-  if (!std::isfinite(spacing) || spacing < 0) fail("spacing", "must be finite and >= 0");
-  normalSpeed.validate((where + ".normalSpeed").c_str());
+  if (!(total > 0)) throw InvalidArgument(where + ".types", "the weights add up to 0");
 }
 
 void EmitterSpec::validate(const std::string& where) const {
+  desc::checkFields(*this, where);
   emitter.validate(where + ".emitter");
-  lifetime.validate((where + ".lifetime").c_str());
   if (lifetime.center <= 0) throw InvalidArgument(where + ".lifetime", "must be > 0");
-  if (!finite(acceleration)) throw InvalidArgument(where + ".acceleration", "not finite");
-  if (!std::isfinite(drag) || drag < 0) throw InvalidArgument(where + ".drag", "must be >= 0");
-  if (!std::isfinite(inheritVelocity))
-    throw InvalidArgument(where + ".inheritVelocity", "not finite");
   if (deathChildren > 0 && !next)
     throw InvalidArgument(where + ".next", "deathChildren > 0 needs a next level");
   // Showers of showers, but not forever: a cycle of levels would never end.
@@ -130,17 +112,8 @@ Vec3 PrimeEmitter::positionAt(double t) const {
 }
 
 void PrimeEmitter::validate(const std::string& where) const {
-  Emitter e;  // the counting and motion fields are an emitter's
-  e.rate = rate;
-  e.bursts = bursts;
-  e.position = position;
-  e.velocity = velocity;
-  e.path = path;
-  e.pathLoop = pathLoop;
-  e.start = start;
-  e.stop = stop;
-  e.validate(where);
-  if (maxEmitters < 1) throw InvalidArgument(where + ".maxEmitters", "must be >= 1");
+  desc::checkFields(*this, where);
+  checkCounting(*this, where);
   child.validate(where + ".child");
 }
 

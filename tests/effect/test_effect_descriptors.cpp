@@ -32,12 +32,17 @@ A validAction() {
   return a;
 }
 
-/// The InvalidArgument parameter ActionList::add throws for `a`, or "" if it accepts it.
+/// The InvalidArgument parameter ActionList::add throws for `a` (for an emitter part, its
+/// validate("e")), or "" if it accepts it.
 template <class A>
 std::string rejected(const A& a) {
   try {
-    ActionList list;
-    list.add(a);
+    if constexpr (requires { a.validate(std::string("e")); }) {
+      a.validate("e");
+    } else {
+      ActionList list;
+      list.add(a);
+    }
   } catch (const InvalidArgument& e) {
     return e.parameter();
   }
@@ -67,17 +72,18 @@ std::vector<float> goodValues(const desc::Limit& l) {
 /// Checks each checked field of `part` (reached from the action `base` through `at`) against
 /// validation: bad values are refused naming the field, good ones accepted.
 template <class A, class S, class At>
-void checkLimits(const A& base, const std::string& prefix, At at) {
-  const std::string name = desc::Describe<A>::name;
+void checkLimits(const A& base, const std::string& root, const std::string& prefix, At at) {
   desc::forEachField<S>([&](const auto& f) {
     using T = typename std::decay_t<decltype(f)>::Type;
-    const std::string path = "actions[0]." + name + "." + prefix + f.name;
+    const std::string path = root + prefix + f.name;
     if constexpr (desc::Described<T>) {
-      checkLimits<A, T>(base, prefix + f.name + ".", [&](A& a) -> T& { return at(a).*f.member; });
-    } else if constexpr (std::is_same_v<T, float> || std::is_same_v<T, int>) {
+      checkLimits<A, T>(base, root, prefix + f.name + ".",
+                        [&](A& a) -> T& { return at(a).*f.member; });
+    } else if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>) {
       if (!f.limit.checked) return;
       for (float bad : badValues(f.limit)) {
-        if (std::is_same_v<T, int> && !std::isfinite(bad)) continue;
+        if (std::is_integral_v<T> && !std::isfinite(bad)) continue;
+        if (std::is_unsigned_v<T> && bad < 0) continue;
         A a = base;
         at(a).*f.member = T(bad);
         EXPECT_EQ(rejected(a), path) << "value " << bad;
@@ -113,10 +119,37 @@ TEST(EffectDescriptors, LimitsAgreeWithValidation) {
     SCOPED_TRACE(desc::Describe<A>::name);
     const A base = validAction<A>();
     ASSERT_EQ(rejected(base), "") << "the defaults are valid";
-    checkLimits<A, A>(base, "", [](A& a) -> A& { return a; });
+    checkLimits<A, A>(base, "actions[0]." + std::string(desc::Describe<A>::name) + ".", "",
+                      [](A& a) -> A& { return a; });
     ++checked;
   });
   EXPECT_EQ(checked, int(std::variant_size_v<Action>) - 1);  // all but Callback
+}
+
+// The emitters' parts are validated from their descriptors too (a burst and a key of a path
+// through their lists).
+TEST(EffectDescriptors, EmitterLimitsAgreeWithValidation) {
+  Emitter e;
+  e.bursts.push_back(Burst{});
+  e.path = {Keyframe{0.0f, Vec3(0.0f)}};
+  e.types.push_back(ParticleType{});  // a weight of 0 leaves the other
+  ASSERT_EQ(rejected(e), "");
+  checkLimits<Emitter, Emitter>(e, "e.", "", [](Emitter& x) -> Emitter& { return x; });
+  checkLimits<Emitter, Burst>(e, "e.bursts[0].", "",
+                              [](Emitter& x) -> Burst& { return x.bursts[0]; });
+  checkLimits<Emitter, Keyframe>(e, "e.path[0].", "",
+                                 [](Emitter& x) -> Keyframe& { return x.path[0]; });
+  checkLimits<Emitter, ParticleType>(e, "e.types[0].", "",
+                                     [](Emitter& x) -> ParticleType& { return x.types[0]; });
+  PrimeEmitter p;
+  ASSERT_EQ(rejected(p), "");
+  checkLimits<PrimeEmitter, PrimeEmitter>(p, "e.", "",
+                                          [](PrimeEmitter& x) -> PrimeEmitter& { return x; });
+  DeathEmitter d;
+  d.source = "sparks";
+  ASSERT_EQ(rejected(d), "");
+  checkLimits<DeathEmitter, DeathEmitter>(d, "e.", "",
+                                          [](DeathEmitter& x) -> DeathEmitter& { return x; });
 }
 
 namespace {

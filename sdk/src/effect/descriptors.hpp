@@ -569,9 +569,9 @@ struct Describe<Burst> {
   static constexpr const char* name = "Burst";
   static constexpr const char* doc = "count particles at once, repeated.";
   static constexpr auto fields = std::tuple{
-      field("time", &Burst::time, "s", kAny, "when"),
+      field("time", &Burst::time, "s", kFinite, "when"),
       field("count", &Burst::count, "", kAny, "how many", kRequired),
-      field("interval", &Burst::interval, "s", kAny, "between repeats"),
+      field("interval", &Burst::interval, "s", kNonNegative, "between repeats"),
       field("repeat", &Burst::repeat, "", kAny, "how many bursts"),
   };
 };
@@ -580,8 +580,8 @@ struct Describe<Keyframe> {
   static constexpr const char* name = "Keyframe";
   static constexpr const char* doc = "A point of an emitter's path.";
   static constexpr auto fields = std::tuple{
-      field("time", &Keyframe::time, "s", kAny, "when", kRequired),
-      field("position", &Keyframe::position, "units", kAny, "where", kRequired),
+      field("time", &Keyframe::time, "s", kFinite, "when", kRequired),
+      field("position", &Keyframe::position, "units", kFinite, "where", kRequired),
   };
 };
 template <>
@@ -589,7 +589,7 @@ struct Describe<ParticleType> {
   static constexpr const char* name = "ParticleType";
   static constexpr const char* doc = "What an emitter's particles are born with.";
   static constexpr auto fields = std::tuple{
-      field("weight", &ParticleType::weight, "", kAny, "relative share of this type"),
+      field("weight", &ParticleType::weight, "", kNonNegative, "relative share of this type"),
       field("velocity", &ParticleType::velocity, "units/s", kAny, "initial velocity"),
       field("color", &ParticleType::color, "", kAny, "rgb"),
       field("alpha", &ParticleType::alpha, "", kAny, "opacity"),
@@ -608,13 +608,13 @@ constexpr auto countingFields() {
   return std::tuple{
       field("name", &E::name, "", kAny, "names it in statistics"),
       field("shape", &E::shape, "units", kAny, "where particles are born"),
-      field("rate", &E::rate, "1/s", kAny, "births per second"),
+      field("rate", &E::rate, "1/s", kNonNegative, "births per second"),
       field("bursts", &E::bursts, "", kAny, "births at given times"),
-      field("position", &E::position, "units", kAny, "offset of the shape"),
-      field("velocity", &E::velocity, "units/s", kAny, "the emitter's own motion"),
+      field("position", &E::position, "units", kFinite, "offset of the shape"),
+      field("velocity", &E::velocity, "units/s", kFinite, "the emitter's own motion"),
       field("path", &E::path, "", kAny, "keyframed positions"),
       field("pathLoop", &E::pathLoop, "", kAny, "repeat the path after its last key"),
-      field("start", &E::start, "s", kAny, "emits from"),
+      field("start", &E::start, "s", kFinite, "emits from"),
       field("stop", &E::stop, "s", kAny, "emits until (inf: for ever)"),
   };
 }
@@ -626,7 +626,7 @@ struct Describe<Emitter> {
       countingFields<Emitter>(),
       std::tuple{
           field("types", &Emitter::types, "", kAny, "particle types, drawn by weight"),
-          field("spacing", &Emitter::spacing, "units", kAny, "a birth per distance moved"),
+          field("spacing", &Emitter::spacing, "units", kNonNegative, "a birth per distance moved"),
           field("normalSpeed", &Emitter::normalSpeed, "units/s", kAny,
                 "speed along the shape's normal"),
       });
@@ -638,11 +638,11 @@ struct Describe<EmitterSpec> {
   static constexpr auto fields = std::tuple{
       field("emitter", &EmitterSpec::emitter, "", kAny, "what each spawned emitter emits"),
       field("velocity", &EmitterSpec::velocity, "units/s", kAny, "initial velocity"),
-      field("inheritVelocity", &EmitterSpec::inheritVelocity, "", kAny,
+      field("inheritVelocity", &EmitterSpec::inheritVelocity, "", kFinite,
             "fraction of the parent's velocity"),
       field("lifetime", &EmitterSpec::lifetime, "s", kAny, "lifetime"),
-      field("acceleration", &EmitterSpec::acceleration, "units/s²", kAny, "acceleration"),
-      field("drag", &EmitterSpec::drag, "1/s", kAny, "linear drag rate"),
+      field("acceleration", &EmitterSpec::acceleration, "units/s²", kFinite, "acceleration"),
+      field("drag", &EmitterSpec::drag, "1/s", kNonNegative, "linear drag rate"),
       field("deathBurst", &EmitterSpec::deathBurst, "", kAny, "particles emitted at death"),
       field("deathChildren", &EmitterSpec::deathChildren, "", kAny,
             "next-level emitters spawned at death"),
@@ -654,12 +654,12 @@ struct Describe<PrimeEmitter> {
   static constexpr const char* name = "PrimeEmitter";
   static constexpr const char* doc = "Emits emitters.";
   static constexpr auto fields = std::tuple_cat(
-      countingFields<PrimeEmitter>(),
-      std::tuple{
-          field("child", &PrimeEmitter::child, "", kAny, "the emitters it emits",
-                "the emitters it emits"),
-          field("maxEmitters", &PrimeEmitter::maxEmitters, "", kAny, "live emitters at most"),
-      });
+      countingFields<PrimeEmitter>(), std::tuple{
+                                          field("child", &PrimeEmitter::child, "", kAny,
+                                                "the emitters it emits", "the emitters it emits"),
+                                          field("maxEmitters", &PrimeEmitter::maxEmitters, "",
+                                                Limit{.min = 1}, "live emitters at most"),
+                                      });
 };
 
 template <>
