@@ -10,6 +10,14 @@ bool isForce(const Action& a);
 /// A force with a closed-form step (constant acceleration, linear drag).
 bool hasClosedForm(const Action& a);
 
+/// What an action reads and writes of each particle it runs on: the attributes a group stores
+/// for it (ActionList::attributes, their union), and the lanes a device's kernel loads and
+/// stores for it (codegen.cpp; Move adds what its integration keeps up to date there).
+struct AttributeAccess {
+  AttributeSet reads, writes;
+};
+AttributeAccess attributeAccess(const Action& a);
+
 /// The kill code that marks particles whose position or velocity became NaN or infinite.
 inline constexpr std::uint32_t kNonFiniteCode = 255;
 

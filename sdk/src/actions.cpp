@@ -76,74 +76,93 @@ struct Validator {
 
 using A = Attribute;
 
-struct Uses {
-  AttributeSet operator()(const Gravity&) const { return {A::Position, A::Velocity}; }
-  AttributeSet operator()(const Damping&) const { return {A::Position, A::Velocity}; }
-  AttributeSet operator()(const RotDamping&) const { return {A::RotVelocity}; }
-  AttributeSet operator()(const OrbitPoint&) const { return {A::Position, A::Velocity}; }
-  AttributeSet operator()(const OrbitLine&) const { return {A::Position, A::Velocity}; }
-  AttributeSet operator()(const Gravitate&) const { return {A::Position, A::Velocity}; }
-  AttributeSet operator()(const Vortex&) const { return {A::Position, A::Velocity}; }
-  AttributeSet operator()(const Jet&) const { return {A::Position, A::Velocity, A::Id}; }
-  AttributeSet operator()(const Explosion&) const { return {A::Position, A::Velocity}; }
-  AttributeSet operator()(const RandomAccel&) const { return {A::Position, A::Velocity, A::Id}; }
-  AttributeSet operator()(const RandomDisplace&) const { return {A::Position, A::Id}; }
-  AttributeSet operator()(const RandomVelocity&) const { return {A::Velocity, A::Id}; }
-  AttributeSet operator()(const RandomRotVelocity&) const { return {A::RotVelocity, A::Id}; }
-  AttributeSet operator()(const Turbulence&) const { return {A::Position, A::Velocity}; }
-  AttributeSet operator()(const ElectricField&) const {
-    return {A::Position, A::Velocity, A::Charge, A::Mass};
+// Reads, then writes.
+struct Access {
+  using R = detail::AttributeAccess;
+  // A force on the velocity, where the particle is.
+  static R velocityForce(AttributeSet more = {}) {
+    return {AttributeSet{A::Position, A::Velocity} | more, {A::Velocity}};
   }
-  AttributeSet operator()(const MagneticField&) const {
-    return {A::Position, A::Velocity, A::Charge, A::Mass};
+  R operator()(const Gravity&) const { return velocityForce(); }
+  R operator()(const Damping&) const { return velocityForce(); }
+  R operator()(const RotDamping&) const { return {{A::RotVelocity}, {A::RotVelocity}}; }
+  R operator()(const OrbitPoint&) const { return velocityForce(); }
+  R operator()(const OrbitLine&) const { return velocityForce(); }
+  R operator()(const Gravitate&) const { return velocityForce(); }
+  R operator()(const Vortex&) const { return velocityForce(); }
+  R operator()(const Jet&) const { return velocityForce({A::Id}); }
+  R operator()(const Explosion&) const { return velocityForce(); }
+  R operator()(const RandomAccel&) const { return velocityForce({A::Id}); }
+  R operator()(const RandomDisplace&) const { return {{A::Position, A::Id}, {A::Position}}; }
+  R operator()(const RandomVelocity&) const { return {{A::Id}, {A::Velocity}}; }
+  R operator()(const RandomRotVelocity&) const { return {{A::Id}, {A::RotVelocity}}; }
+  R operator()(const Turbulence&) const { return velocityForce(); }
+  R operator()(const ElectricField&) const { return velocityForce({A::Charge, A::Mass}); }
+  R operator()(const MagneticField&) const { return velocityForce({A::Charge, A::Mass}); }
+  R operator()(const SampledField&) const { return velocityForce(); }
+  R operator()(const Avoid&) const { return velocityForce(); }
+  R operator()(const Follow&) const { return velocityForce(); }
+  R operator()(const MatchVelocity&) const { return velocityForce(); }
+  R operator()(const MatchRotVelocity&) const {
+    return {{A::Position, A::RotVelocity}, {A::RotVelocity}};
   }
-  AttributeSet operator()(const SampledField&) const { return {A::Position, A::Velocity}; }
-  AttributeSet operator()(const Avoid&) const { return {A::Position, A::Velocity}; }
-  AttributeSet operator()(const Follow&) const { return {A::Position, A::Velocity}; }
-  AttributeSet operator()(const MatchVelocity&) const { return {A::Position, A::Velocity}; }
-  AttributeSet operator()(const MatchRotVelocity&) const { return {A::Position, A::RotVelocity}; }
-  AttributeSet operator()(const TargetVelocity&) const { return {A::Velocity}; }
-  AttributeSet operator()(const TargetRotVelocity&) const { return {A::RotVelocity}; }
-  AttributeSet operator()(const TargetColor&) const { return {A::Color}; }
-  AttributeSet operator()(const TargetSize&) const { return {A::Size}; }
-  AttributeSet operator()(const SpeedClamp&) const { return {A::Velocity}; }
+  R operator()(const TargetVelocity&) const { return {{A::Velocity}, {A::Velocity}}; }
+  R operator()(const TargetRotVelocity&) const { return {{A::RotVelocity}, {A::RotVelocity}}; }
+  R operator()(const TargetColor&) const { return {{A::Color}, {A::Color}}; }
+  R operator()(const TargetSize&) const { return {{A::Size}, {A::Size}}; }
+  R operator()(const SpeedClamp&) const { return {{A::Velocity}, {A::Velocity}}; }
   // Multiply reads the birth value: stored only for the lists that multiply.
-  AttributeSet operator()(const ColorOverLife& a) const {
-    AttributeSet s{A::Color, A::Age, A::Lifetime};
-    if (a.mode == OverLifeMode::Multiply) s.insert(A::BirthColor);
-    return s;
+  R operator()(const ColorOverLife& a) const {
+    AttributeSet r{A::Age, A::Lifetime};
+    if (a.mode == OverLifeMode::Multiply) r.insert(A::BirthColor);
+    return {r, {A::Color}};
   }
-  AttributeSet operator()(const SizeOverLife& a) const {
-    AttributeSet s{A::Size, A::Age, A::Lifetime};
-    if (a.mode == OverLifeMode::Multiply) s.insert(A::BirthSize);
-    return s;
+  R operator()(const SizeOverLife& a) const {
+    AttributeSet r{A::Age, A::Lifetime};
+    if (a.mode == OverLifeMode::Multiply) r.insert(A::BirthSize);
+    return {r, {A::Size}};
   }
-  AttributeSet operator()(const Bounce&) const { return {A::Position, A::Velocity}; }
-  AttributeSet operator()(const Sink& a) const {
-    AttributeSet s{A::Position};
-    if (a.mode == Sink::Mode::Enter || a.mode == Sink::Mode::Leave || a.mode == Sink::Mode::Hit)
-      s.insert(A::Velocity);
-    return s;
+  R operator()(const Bounce&) const {
+    return {{A::Position, A::Velocity}, {A::Position, A::Velocity}};
   }
-  AttributeSet operator()(const SinkVelocity&) const { return {A::Velocity}; }
-  AttributeSet operator()(const Block&) const { return {A::Position, A::Visible}; }
-  AttributeSet operator()(const KillOld&) const { return {A::Age, A::Lifetime}; }
-  AttributeSet operator()(const Move&) const { return {A::Position, A::Velocity}; }
-  AttributeSet operator()(const Constrain2D&) const { return {A::Position, A::Velocity}; }
-  AttributeSet operator()(const CopyVertexB& a) const {
-    AttributeSet s{A::Position, A::PositionB};
-    if (a.copyVelocity) s.insert(A::Velocity).insert(A::VelocityB);
-    return s;
+  R operator()(const Sink& a) const {
+    AttributeSet r{A::Position};
+    if (a.mode != Sink::Mode::Inside && a.mode != Sink::Mode::Outside) r.insert(A::Velocity);
+    if (a.passThrough > 0.0f) r.insert(A::Id);  // a draw per particle
+    return {r, {}};
   }
-  AttributeSet operator()(const Restore&) const { return {A::Position, A::Velocity, A::PositionB}; }
-  AttributeSet operator()(const Callback& a) const {
-    return AttributeSet{A::Position} | a.attributes;
+  R operator()(const SinkVelocity&) const { return {{A::Velocity}, {}}; }
+  R operator()(const Block&) const { return {{A::Position, A::Visible}, {A::Visible}}; }
+  R operator()(const KillOld&) const { return {{A::Age, A::Lifetime}, {}}; }
+  R operator()(const Move&) const { return {{A::Position, A::Velocity}, {A::Position}}; }
+  R operator()(const Constrain2D&) const {
+    return {{A::Position, A::Velocity}, {A::Position, A::Velocity}};
+  }
+  R operator()(const CopyVertexB& a) const {
+    R r;
+    if (a.copyPosition) r = {{A::Position}, {A::PositionB}};
+    if (a.copyVelocity) r.reads.insert(A::Velocity), r.writes.insert(A::VelocityB);
+    return r;
+  }
+  R operator()(const Restore&) const {
+    return {{A::Position, A::Velocity, A::PositionB}, {A::Position, A::Velocity}};
+  }
+  // Its declared lanes, all written back but the id (Position is always stored).
+  R operator()(const Callback& a) const {
+    AttributeSet w;
+    for (int i = 0; i < int(A::Count); ++i)
+      if (a.attributes.has(A(i)) && A(i) != A::Id) w.insert(A(i));
+    return {a.attributes, w};
   }
 };
 
 }  // namespace
 
 namespace detail {
+
+AttributeAccess attributeAccess(const Action& a) {
+  return std::visit(Access{}, a);
+}
 
 bool isForce(const Action& a) {
   return std::holds_alternative<Gravity>(a) || std::holds_alternative<Damping>(a) ||
@@ -246,7 +265,10 @@ ActionList& ActionList::add(Action action) {
 
 AttributeSet ActionList::attributes() const {
   AttributeSet s;
-  for (const Action& a : actions_) s.insert(std::visit(Uses{}, a));
+  for (const Action& a : actions_) {
+    const detail::AttributeAccess use = detail::attributeAccess(a);
+    s.insert(use.reads | use.writes);
+  }
   return s;
 }
 

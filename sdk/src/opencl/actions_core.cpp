@@ -11,14 +11,11 @@ namespace flurry::detail::ocl {
 bool generateCoreAction(const Action& act, ActionSource& s) {
   const AttributeSet& stored = s.in.stored;
   if (std::holds_alternative<KillOld>(act)) {
-    s.reads.insert({Attribute::Age, Attribute::Lifetime});
     s.apply = "fl_kill_old(age, life, " + s.in.code + ", &dead);\n";
     return true;
   }
   if (std::holds_alternative<Move>(act)) {
     // Semi-implicit Euler; codegen.cpp writes the other integrators' Move itself.
-    s.reads.insert({Attribute::Position, Attribute::Velocity});
-    s.writes.insert(Attribute::Position);
     if (stored.has(Attribute::PrevPosition)) {
       s.writes.insert(Attribute::PrevPosition);
       s.apply += "prevx = px; prevy = py; prevz = pz;\n";
@@ -38,20 +35,14 @@ bool generateCoreAction(const Action& act, ActionSource& s) {
   }
   if (const auto* c = std::get_if<CopyVertexB>(&act)) {
     if (c->copyPosition) {
-      s.reads.insert(Attribute::Position);
-      s.writes.insert(Attribute::PositionB);
       s.apply += "pbx = px; pby = py; pbz = pz;\n";
     }
     if (c->copyVelocity) {
-      s.reads.insert(Attribute::Velocity);
-      s.writes.insert(Attribute::VelocityB);
       s.apply += "vbx = vx; vby = vy; vbz = vz;\n";
     }
     return true;
   }
   if (std::holds_alternative<Restore>(act)) {
-    s.reads.insert({Attribute::Position, Attribute::Velocity, Attribute::PositionB});
-    s.writes.insert({Attribute::Position, Attribute::Velocity});
     s.apply =
         "fl_restore(" + s.in.params + ", dt, time, &px, &py, &pz, &vx, &vy, &vz, pbx, pby, pbz);\n";
     return true;
@@ -61,12 +52,8 @@ bool generateCoreAction(const Action& act, ActionSource& s) {
       notOnDevice(
           "a Callback without an OpenCL body (Callback::opencl; its C++ function "
           "cannot run on the device)");
-    // The user's statements see the lanes it declared by their kernel names; the block keeps
-    // its locals its own.
-    s.reads.insert(c->attributes);
-    for (int a = 0; a < int(Attribute::Count); ++a)
-      if (c->attributes.has(Attribute(a)) && Attribute(a) != Attribute::Id)
-        s.writes.insert(Attribute(a));
+    // The user's statements see the lanes it declared by their kernel names (attributeAccess:
+    // all written back but the id); the block keeps its locals its own.
     // A `return` would leave the whole kernel (in fl_small, before its barriers): refused.
     static const std::regex kReturn("\\breturn\\b");
     if (std::regex_search(c->opencl, kReturn))

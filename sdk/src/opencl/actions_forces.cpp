@@ -58,12 +58,7 @@ const std::string kP = "px, py, pz", kV = "vx, vy, vz", kPV = "&vx, &vy, &vz",
 bool generateForceAction(const Action& act, ActionSource& s) {
   const std::string& ap = s.in.params;
   const std::string apDt = ap + ", dt";
-  auto velocityForce = [&] {
-    s.reads.insert({A::Position, A::Velocity});
-    s.writes.insert(A::Velocity);
-  };
   if (const auto* g = std::get_if<Gravity>(&act)) {
-    velocityForce();
     // Without a falloff the CPU adds a·dt (kernels.hpp addLoop), with one a·(dt·w).
     s.apply = g->falloff.radius < kInfinity
                   ? call("fl_gravity_falloff", apDt + ", " + kP + ", " + kPV)
@@ -72,7 +67,6 @@ bool generateForceAction(const Action& act, ActionSource& s) {
     return true;
   }
   if (const auto* d = std::get_if<Damping>(&act)) {
-    velocityForce();
     // Without a falloff the CPU scales by exp(-rate·dt) made once per step (the host's).
     s.apply = d->falloff.radius < kInfinity
                   ? call("fl_damping_falloff", apDt + ", " + kP + ", " + kPV)
@@ -81,32 +75,25 @@ bool generateForceAction(const Action& act, ActionSource& s) {
     return true;
   }
   if (std::holds_alternative<RotDamping>(act)) {
-    s.reads.insert(A::RotVelocity);
-    s.writes.insert(A::RotVelocity);
     s.apply = call("fl_damping", apDt + ", &rotx, &roty, &rotz");
     return true;
   }
   if (std::holds_alternative<OrbitPoint>(act)) {
-    velocityForce();
     s.apply = call("fl_orbit_point", apDt + ", " + kP + ", " + kPV);
     s.accel = acc("fl_orbit_point_acc", ap + ", " + kP);
     return true;
   }
   if (std::holds_alternative<OrbitLine>(act)) {
-    velocityForce();
     s.apply = call("fl_orbit_line", apDt + ", " + kP + ", " + kPV);
     s.accel = acc("fl_orbit_line_acc", ap + ", " + kP);
     return true;
   }
   if (std::holds_alternative<Vortex>(act)) {
-    velocityForce();
     s.apply = call("fl_vortex", apDt + ", " + kP + ", " + kPV);
     s.accel = acc("fl_vortex_acc", ap + ", " + kP + ", " + kV);
     return true;
   }
   if (const auto* j = std::get_if<Jet>(&act)) {
-    velocityForce();
-    s.reads.insert(A::Id);
     const std::string kind = kindOf(j->acceleration);
     s.apply = call("fl_jet",
                    ap + ", " + kind + ", dt, " + kP + ", " + kPV + ", " + rngArgs(s) + ", extra");
@@ -114,14 +101,11 @@ bool generateForceAction(const Action& act, ActionSource& s) {
     return true;
   }
   if (std::holds_alternative<Explosion>(act)) {
-    velocityForce();
     s.apply = call("fl_explosion", apDt + ", time, " + kP + ", " + kPV);
     s.accel = acc("fl_explosion_acc", ap + ", t, " + kP);
     return true;
   }
   if (const auto* r = std::get_if<RandomAccel>(&act)) {
-    velocityForce();
-    s.reads.insert(A::Id);
     const std::string kind = kindOf(r->acceleration);
     s.apply = call("fl_random_accel",
                    ap + ", " + kind + ", dt, " + kP + ", " + kPV + ", " + rngArgs(s) + ", extra");
@@ -130,88 +114,63 @@ bool generateForceAction(const Action& act, ActionSource& s) {
     return true;
   }
   if (const auto* r = std::get_if<RandomDisplace>(&act)) {
-    s.reads.insert({A::Position, A::Id});
-    s.writes.insert(A::Position);
     s.apply = call("fl_random_displace", ap + ", " + kindOf(r->displacement) + ", dt, " + kPP +
                                              ", " + rngArgs(s) + ", extra");
     return true;
   }
   if (const auto* r = std::get_if<RandomVelocity>(&act)) {
-    s.reads.insert(A::Id);
-    s.writes.insert(A::Velocity);
     s.apply = call("fl_random_set",
                    ap + ", " + kindOf(r->velocity) + ", " + kPV + ", " + rngArgs(s) + ", extra");
     return true;
   }
   if (const auto* r = std::get_if<RandomRotVelocity>(&act)) {
-    s.reads.insert(A::Id);
-    s.writes.insert(A::RotVelocity);
     s.apply = call("fl_random_set", ap + ", " + kindOf(r->rotVelocity) + ", &rotx, &roty, &rotz, " +
                                         rngArgs(s) + ", extra");
     return true;
   }
   if (std::holds_alternative<Turbulence>(act)) {
-    velocityForce();
     s.apply = call("fl_turbulence", apDt + ", time, " + kP + ", " + kPV);
     s.accel = acc("fl_turbulence_acc", ap + ", t, " + kP);
     return true;
   }
   if (std::holds_alternative<ElectricField>(act)) {
-    velocityForce();
-    s.reads.insert({A::Charge, A::Mass});
     s.apply = call("fl_electric", apDt + ", " + kP + ", " + kPV + ", charge, mass");
     s.accel = acc("fl_electric_acc", ap + ", " + kP + ", charge, mass");
     return true;
   }
   if (std::holds_alternative<MagneticField>(act)) {
-    velocityForce();
-    s.reads.insert({A::Charge, A::Mass});
     s.apply = call("fl_magnetic", apDt + ", " + kP + ", " + kPV + ", charge, mass");
     s.accel = acc("fl_magnetic_acc", ap + ", " + kP + ", " + kV + ", charge, mass");
     return true;
   }
   if (std::holds_alternative<SampledField>(act)) {
-    velocityForce();
     s.apply = call("fl_sampled_field", ap + ", extra, dt, " + kP + ", " + kPV);
     s.accel = acc("fl_sampled_field_acc", ap + ", extra, " + kP + ", " + kV);
     return true;
   }
   if (std::holds_alternative<TargetVelocity>(act)) {
-    s.reads.insert(A::Velocity);
-    s.writes.insert(A::Velocity);
     s.apply = call("fl_target3", apDt + ", " + kPV);
     return true;
   }
   if (std::holds_alternative<TargetRotVelocity>(act)) {
-    s.reads.insert(A::RotVelocity);
-    s.writes.insert(A::RotVelocity);
     s.apply = call("fl_target3", apDt + ", &rotx, &roty, &rotz");
     return true;
   }
   if (std::holds_alternative<TargetColor>(act)) {
-    s.reads.insert(A::Color);
-    s.writes.insert(A::Color);
     s.apply = call("fl_target_color", apDt + ", &r, &g, &b, &a");
     return true;
   }
   if (std::holds_alternative<TargetSize>(act)) {
-    s.reads.insert(A::Size);
-    s.writes.insert(A::Size);
     s.apply = call("fl_target_size", apDt + ", &size");
     return true;
   }
   if (std::holds_alternative<SpeedClamp>(act)) {
-    s.reads.insert(A::Velocity);
-    s.writes.insert(A::Velocity);
     s.apply = call("fl_speed_clamp", ap + ", " + kPV);
     return true;
   }
   // Multiply scales the birth value, Replace sets the curve's (actions_more.hpp).
   if (const auto* c = std::get_if<ColorOverLife>(&act)) {
-    s.reads.insert({A::Age, A::Lifetime});
-    s.writes.insert(A::Color);
     if (c->mode == OverLifeMode::Multiply) {
-      s.reads.insert(A::BirthColor);
       s.apply = call("fl_color_over_life_scaled",
                      ap + ", extra, age, life, birthr, birthg, birthb, birtha, &r, &g, &b, &a");
     } else {
@@ -220,10 +179,7 @@ bool generateForceAction(const Action& act, ActionSource& s) {
     return true;
   }
   if (const auto* c = std::get_if<SizeOverLife>(&act)) {
-    s.reads.insert({A::Age, A::Lifetime});
-    s.writes.insert(A::Size);
     if (c->mode == OverLifeMode::Multiply) {
-      s.reads.insert(A::BirthSize);
       s.apply = call("fl_size_over_life_scaled", ap + ", extra, age, life, birthsize, &size");
     } else {
       s.apply = call("fl_size_over_life", ap + ", extra, age, life, &size");

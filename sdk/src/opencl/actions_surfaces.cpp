@@ -107,8 +107,6 @@ bool generateSurfaceAction(const Action& act, ActionSource& s) {
   const std::string& ap = s.in.params;
   const std::string pv = "&px, &py, &pz, &vx, &vy, &vz);\n";
   if (const auto* b = std::get_if<Bounce>(&act)) {
-    s.reads.insert({Attribute::Position, Attribute::Velocity});
-    s.writes.insert({Attribute::Position, Attribute::Velocity});
     const auto& shape = b->surface.shape();
     const std::string in = b->inside ? "1" : "0";
     if (std::holds_alternative<SphereDomain>(shape))
@@ -125,21 +123,17 @@ bool generateSurfaceAction(const Action& act, ActionSource& s) {
   if (const auto* k = std::get_if<Sink>(&act)) {
     using M = Sink::Mode;
     const std::string kind = kindOf(k->region);
-    s.reads.insert(Attribute::Position);
     if (k->mode == M::Inside || k->mode == M::Outside) {
       s.apply = "fl_sink(" + ap + ", " + kind + ", " + (k->mode == M::Inside ? "1" : "0") +
                 ", px, py, pz, " + s.in.code + ", &dead, extra);\n";
     } else if (k->mode == M::Enter || k->mode == M::Leave) {
-      s.reads.insert(Attribute::Velocity);
       s.apply = "fl_sink_motion(" + ap + ", " + kind + ", " + (k->mode == M::Enter ? "1" : "0") +
                 ", dt, px, py, pz, vx, vy, vz, " + s.in.code + ", &dead, extra);\n";
     } else {  // Hit: validation makes the region a plane piece
-      s.reads.insert(Attribute::Velocity);
       s.apply = "fl_sink_hit(" + ap + ", " + kind + ", dt, px, py, pz, vx, vy, vz, " + s.in.code +
                 ", &dead, extra);\n";
     }
     if (k->passThrough > 0.0f) {
-      s.reads.insert(Attribute::Id);
       // Keyed by the group's streamBase (without the sub-step) and the index: once per particle.
       s.apply += "fl_sink_pass(" + ap + ", id, " + s.in.code +
                  ", &dead, seedLo, seedHi, (streamBase + " + std::to_string(s.in.index) + "u));\n";
@@ -147,14 +141,11 @@ bool generateSurfaceAction(const Action& act, ActionSource& s) {
     return true;
   }
   if (const auto* k = std::get_if<SinkVelocity>(&act)) {
-    s.reads.insert(Attribute::Velocity);
     s.apply = "fl_sink(" + ap + ", " + kindOf(k->velocity) + ", " + (k->killInside ? "1" : "0") +
               ", vx, vy, vz, " + s.in.code + ", &dead, extra);\n";
     return true;
   }
   if (const auto* b = std::get_if<Block>(&act)) {
-    s.reads.insert({Attribute::Position, Attribute::Visible});
-    s.writes.insert(Attribute::Visible);
     // The list's first blocker starts from "visible" (the CPU's BlockContext.firstBlocker).
     // The generator sees one action at a time; the preprocessor, reading the kernel in list
     // order, meets the first Block first and keeps its index (also when the step's code is
@@ -166,15 +157,11 @@ bool generateSurfaceAction(const Action& act, ActionSource& s) {
     return true;
   }
   if (const auto* k = std::get_if<Avoid>(&act)) {
-    s.reads.insert({Attribute::Position, Attribute::Velocity});
-    s.writes.insert(Attribute::Velocity);
     s.apply = "fl_avoid(" + ap + ", " + kindOf(k->obstacle) +
               ", dt, px, py, pz, &vx, &vy, &vz, extra);\n";
     return true;
   }
   if (std::holds_alternative<Constrain2D>(act)) {
-    s.reads.insert({Attribute::Position, Attribute::Velocity});
-    s.writes.insert({Attribute::Position, Attribute::Velocity});
     s.apply = "fl_constrain2d(" + ap + ", " + pv;
     return true;
   }
@@ -182,8 +169,6 @@ bool generateSurfaceAction(const Action& act, ActionSource& s) {
     const std::string fn =
         std::holds_alternative<Gravitate>(act) ? "fl_gravitate_acc(" : "fl_follow_acc(";
     s.neighbours = true;
-    s.reads.insert({Attribute::Position, Attribute::Velocity});
-    s.writes.insert(Attribute::Velocity);
     const std::string acc = fn + ap + ", " + kSnapArgs + ", (float3)(px, py, pz))";
     s.apply = "fl_add_accel(" + acc + ", dt, &vx, &vy, &vz);\n";
     // integrate.hpp accumulate(): this force's acceleration, then added to the sum.
@@ -192,16 +177,12 @@ bool generateSurfaceAction(const Action& act, ActionSource& s) {
   }
   if (std::holds_alternative<MatchVelocity>(act)) {
     s.neighbours = true;
-    s.reads.insert({Attribute::Position, Attribute::Velocity});
-    s.writes.insert(Attribute::Velocity);
     s.apply =
         "fl_match_toward_mean(" + ap + ", " + kSnapArgs + ", 1u, dt, px, py, pz, &vx, &vy, &vz);\n";
     return true;
   }
   if (std::holds_alternative<MatchRotVelocity>(act)) {
     s.neighbours = true;
-    s.reads.insert({Attribute::Position, Attribute::RotVelocity});
-    s.writes.insert(Attribute::RotVelocity);
     s.apply = "fl_match_toward_mean(" + ap + ", " + kSnapArgs +
               ", 2u, dt, px, py, pz, &rotx, &roty, &rotz);\n";
     return true;

@@ -585,6 +585,9 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
     src.in.params = "(ap + " + std::to_string(k) + ")";
     src.in.code = std::to_string(k + 1) + "u";
     src.in.stream = "(streamSub + " + std::to_string(k) + "u)";
+    const AttributeAccess use = attributeAccess(act);  // the CPU's, stated once
+    src.reads = use.reads;
+    src.writes = use.writes;
     if (!generateCoreAction(act, src) && !generateForceAction(act, src) &&
         !generateSurfaceAction(act, src))
       notOnDevice("action '" + actionName(act) + "' (actions[" + std::to_string(k) + "])");
