@@ -168,7 +168,6 @@ bool generateSurfaceAction(const Action& act, ActionSource& s) {
   if (std::holds_alternative<Gravitate>(act) || std::holds_alternative<Follow>(act)) {
     const std::string fn =
         std::holds_alternative<Gravitate>(act) ? "fl_gravitate_acc(" : "fl_follow_acc(";
-    s.neighbours = true;
     const std::string acc = fn + ap + ", " + kSnapArgs + ", (float3)(px, py, pz))";
     s.apply = "fl_add_accel(" + acc + ", dt, &vx, &vy, &vz);\n";
     // integrate.hpp accumulate(): this force's acceleration, then added to the sum.
@@ -176,13 +175,11 @@ bool generateSurfaceAction(const Action& act, ActionSource& s) {
     return true;
   }
   if (std::holds_alternative<MatchVelocity>(act)) {
-    s.neighbours = true;
     s.apply =
         "fl_match_toward_mean(" + ap + ", " + kSnapArgs + ", 1u, dt, px, py, pz, &vx, &vy, &vz);\n";
     return true;
   }
   if (std::holds_alternative<MatchRotVelocity>(act)) {
-    s.neighbours = true;
     s.apply = "fl_match_toward_mean(" + ap + ", " + kSnapArgs +
               ", 2u, dt, px, py, pz, &rotx, &roty, &rotz);\n";
     return true;

@@ -567,6 +567,7 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
                                  const std::string& emitSource, bool hair, bool cull,
                                  bool collisions) {
   GeneratedProgram g;
+  g.neighbours = actions.readsNeighbours();
   // What the act kernel loads (reads) and stores (writes).
   AttributeSet reads, writes;
   const Integrator integrator = actions.integrator();
@@ -642,7 +643,6 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
     marks[k] = std::size_t(body.tellp());
     reads.insert(src.reads);
     writes.insert(src.writes);
-    g.neighbours |= src.neighbours;
     body << "    /* " << k << ": " << actionName(act) << " */\n";
     if (integrator != Integrator::SemiImplicitEuler) {
       // Forces before a Move are evaluated by its integrator (fused_pass.cpp makePlan).

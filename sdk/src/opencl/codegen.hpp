@@ -79,7 +79,6 @@ struct ActionSource {
   /// (px..vz, t) to ax, ay, az, used by the integrators other than semi-implicit Euler.
   /// They must read the state through the names px py pz vx vy vz and fl_real t only.
   std::string accel;
-  bool neighbours = false;  ///< reads snap (the backend then copies the lanes each step)
 };
 
 /// The constants of one action for a step of dt seconds.
