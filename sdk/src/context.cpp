@@ -118,6 +118,7 @@ void Context::Impl::shareBudget() {
             !gi.deathEmitters.empty());
   };
   for (auto& g : groups) {
+    g->impl_->syncCount();  // a device's: its count after the last step
     live += g->impl_->size;
     if (emits(*g->impl_)) asked += double(g->impl_->lastDemand) + 1.0;
   }
@@ -332,6 +333,7 @@ void stepGroup(detail::BackendImpl& backend, detail::GroupImpl& gi, const detail
   if (gi.stats.killedByAction.size() != gi.actions.size())
     gi.stats.killedByAction.assign(gi.actions.size(), 0);
   backend.step(gi, sp);
+  if (gi.mirror) gi.trimToBudget(sp);  // (the CPU's step trims in its own pass)
 }
 
 }  // namespace
@@ -423,15 +425,11 @@ void Context::Impl::runDeathEmitters(std::span<Group* const> only) {
         detail::emitFromDeaths(gi, k, *source->impl_, gi.ownSeed ? gi.seed : options.seed);
     }
     // Under a budget, a DropOldest group makes room for these newborns too.
-    if (gi.size > gi.keepAtMost) gi.dropOldest(gi.size - gi.keepAtMost, params());
+    gi.trimToBudget(params());
   }
 }
 
 void Context::setParticleBudget(std::size_t particles) {
-  if (particles > 0 && impl_->backendKind != Backend::Cpu)
-    throw Error(
-        "setParticleBudget: a particle budget does not run on the device yet (the CPU "
-        "backend keeps it)");
   impl_->budget = particles;
 }
 std::size_t Context::particleBudget() const {

@@ -406,6 +406,23 @@ void thinRuns(std::vector<BirthRun>& runs, std::uint64_t fit) {
 }
 }  // namespace
 
+std::size_t fitBirths(GroupImpl& g, std::uint64_t total, std::vector<BirthRun>& runs) {
+  std::size_t accepted = std::size_t(std::min<std::uint64_t>(total, g.capacity - g.size));
+  g.lastDemand = accepted;  // what a budget's share could be used for (death emitters add)
+  g.stats.droppedAtCapacity += total - accepted;
+  // Past the group's share of the context's budget (DropOldest makes them all and trims
+  // after the step).
+  if (g.budgetPolicy != BudgetPolicy::DropOldest && accepted > g.birthAllowance) {
+    const std::size_t fit = std::size_t(g.birthAllowance);
+    g.stats.droppedAtBudget += accepted - fit;
+    if (g.budgetPolicy == BudgetPolicy::ScaleEmission) thinRuns(runs, fit);
+    accepted = fit;
+  }
+  if (g.birthAllowance != ~std::uint64_t(0))
+    g.birthAllowance -= std::min<std::uint64_t>(accepted, g.birthAllowance);
+  return accepted;
+}
+
 void emitNewborns(GroupImpl& g, const StepParams& sp) {
   const double t1 = sp.time + sp.dt;
   g.bornFirst = g.size;
@@ -421,19 +438,7 @@ void emitNewborns(GroupImpl& g, const StepParams& sp) {
   runs.clear();
   const std::uint64_t total = planBirths(g, sp, runs);
   g.stats.emitted += total;
-  std::size_t accepted = std::size_t(std::min<std::uint64_t>(total, g.capacity - g.size));
-  g.lastDemand = accepted;  // what a budget's share could be used for (death emitters add)
-  g.stats.droppedAtCapacity += total - accepted;
-  // Past the group's share of the context's budget (DropOldest makes them all and trims
-  // after the step).
-  if (g.budgetPolicy != BudgetPolicy::DropOldest && accepted > g.birthAllowance) {
-    const std::size_t fit = std::size_t(g.birthAllowance);
-    g.stats.droppedAtBudget += accepted - fit;
-    if (g.budgetPolicy == BudgetPolicy::ScaleEmission) thinRuns(runs, fit);
-    accepted = fit;
-  }
-  if (g.birthAllowance != ~std::uint64_t(0))
-    g.birthAllowance -= std::min<std::uint64_t>(accepted, g.birthAllowance);
+  const std::size_t accepted = fitBirths(g, total, runs);
 
   // 2. The newborns, in parallel: each one's attributes depend only on its id.
   if (accepted > 0) {

@@ -32,6 +32,11 @@ struct BirthRun {
 /// hold at most `capacity` of them one by one, so a step costs the same whatever the
 /// bursts' `repeat`, rates and spacings.
 std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, std::vector<BirthRun>& runs);
+/// Of `total` planned births, those the step makes: at most the room left (capacity - size),
+/// and under a particle budget the group's share (BudgetPolicy: DropNewest drops the rest,
+/// ScaleEmission thins every run of `runs` alike, DropOldest makes them all and is trimmed
+/// after the step). Counts what it gives up in the stats; the host must know the live count.
+std::size_t fitBirths(GroupImpl& g, std::uint64_t total, std::vector<BirthRun>& runs);
 
 /// Where an emitter (or a prime emitter) is at time t: Emitter::positionAt's definition, with
 /// the search for the path's keys starting from `key`, the one found by the last call (0:

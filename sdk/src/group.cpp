@@ -690,6 +690,15 @@ void detail::GroupImpl::dropOldest(std::size_t excess, const StepParams& params)
   compact(*this, params);
 }
 
+void detail::GroupImpl::trimToBudget(const StepParams& params) {
+  if (keepAtMost == ~std::size_t(0)) return;
+  syncCount();
+  if (size <= keepAtMost) return;
+  syncHost();
+  dropOldest(size - keepAtMost, params);
+  hostChanged();
+}
+
 Group& Group::setTrail(const TrailOptions& options) {
   auto& g = *impl_;
   options.validate();

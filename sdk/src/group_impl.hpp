@@ -277,6 +277,10 @@ struct GroupImpl {
   std::uint64_t lastDemand = 0;  ///< births the emitters planned in the last step
   /// Kills the `excess` first-born particles (smallest ids) and closes their holes.
   void dropOldest(std::size_t excess, const StepParams& params);
+  /// Under a DropOldest budget, after a step or a sub-emitter's newborns: drops the first-born
+  /// past keepAtMost. A device's group comes to the host for it and goes back whole (seldom:
+  /// only past its share).
+  void trimToBudget(const StepParams& params);
   /// The trails' ring (Group::setTrail): x, y, z lanes of slot k at 3k .. 3k + 2, length
   /// slots; slot trailHead holds the positions at the end of the last step, the slots before
   /// it (cyclically) the steps before. Moved with the particles by compaction.

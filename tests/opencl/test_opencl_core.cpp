@@ -414,3 +414,61 @@ TEST(OpenCLCore, SubEmittersOnDeathCollisionAndBirthAsOnTheCpu) {
   };
   checkParity(build, 90);
 }
+
+// A particle budget on the device: the context brings the groups' counts up to date before it
+// shares the room out, the host fits each group's births as the CPU does (DropNewest,
+// ScaleEmission), and a DropOldest group past its share is trimmed on the host and goes back
+// whole. The same shares, counts and particles as on the CPU, step after step, also when the
+// budget is lowered below what lives.
+TEST(OpenCLCore, AParticleBudgetAsOnTheCpu) {
+  FLURRY_REQUIRE_OPENCL();
+  auto run = [](Backend backend) {
+    Context ctx(parityOptions(backend));
+    auto group = [&](const char* name, BudgetPolicy policy, std::vector<float> xs, float life) {
+      Group& g = ctx.createGroup(name, 6000);
+      for (float x : xs) {
+        Emitter e = spray(Vec3(x, 1.0f, 0.0f), 1800);
+        e.types[0].lifetime = life;
+        g.addEmitter(e);
+      }
+      g.setActions({Gravity{kDown}, Move{}, KillOld{}});
+      g.setBudgetPolicy(policy);
+      return &g;
+    };
+    const std::vector<Group*> groups{
+        group("newest", BudgetPolicy::DropNewest, {0.0f}, 1.5f),
+        group("scaled", BudgetPolicy::ScaleEmission, {-3.0f, 3.0f}, 1.5f),
+        group("oldest", BudgetPolicy::DropOldest, {6.0f}, 100.0f)};
+    ctx.setParticleBudget(4000);
+    std::vector<std::vector<std::size_t>> sizes;
+    for (int s = 0; s < 60; ++s) {
+      if (s == 40) ctx.setParticleBudget(1500);  // below what lives: DropOldest shrinks at once
+      ctx.step();
+      // Not every step: asking a device group's size brings its count to the host, which the
+      // context must do itself.
+      if (s % 10 != 9) continue;
+      sizes.emplace_back();
+      for (Group* g : groups) sizes.back().push_back(g->size());
+    }
+    std::vector<RunResult> results;
+    for (Group* g : groups) results.push_back(resultOf(*g));
+    return std::pair(sizes, results);
+  };
+  const auto [cpuSizes, cpu] = run(Backend::Cpu);
+  const auto [clSizes, cl] = run(Backend::OpenCL);
+  for (std::size_t s = 0; s < cpuSizes.size(); ++s)
+    ASSERT_EQ(cpuSizes[s], clSizes[s]) << "step " << 10 * s + 9;
+  for (std::size_t k = 0; k < cpu.size(); ++k) {
+    SCOPED_TRACE("group " + std::to_string(k));
+    expectSame(cpu[k], cl[k]);
+    EXPECT_EQ(cpu[k].stats.droppedAtBudget, cl[k].stats.droppedAtBudget);
+    EXPECT_EQ(cpu[k].stats.killedByBudget, cl[k].stats.killedByBudget);
+  }
+  // Each policy gave up what it says.
+  EXPECT_GT(cpu[0].stats.droppedAtBudget, 0u);
+  EXPECT_GT(cpu[1].stats.droppedAtBudget, 0u);
+  EXPECT_GT(cpu[2].stats.killedByBudget, 0u);
+  std::size_t last = 0;
+  for (std::size_t n : cpuSizes.back()) last += n;
+  EXPECT_LE(last, 1500u);
+}

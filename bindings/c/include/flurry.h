@@ -183,7 +183,7 @@ typedef enum flurry_budget_policy {
   FLURRY_BUDGET_SCALE_EMISSION = 2, /**< every emitter keeps the same fraction of its births */
 } flurry_budget_policy;
 /** The most particles all groups together hold (0: none); the room under it is shared each
- * step among the groups that emit (flurry::Context::setParticleBudget). CPU backend only. */
+ * step among the groups that emit (flurry::Context::setParticleBudget), on either backend. */
 FLURRY_C_EXPORT flurry_status flurry_context_set_particle_budget(flurry_context* ctx,
                                                                  size_t particles);
 /** `policy`: a flurry_budget_policy (an int, so that a value outside it is an error, not

@@ -291,8 +291,11 @@ std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, StepTables& t, Emit
   thread_local std::vector<BirthRun> runsStore;
   auto& runs = runsStore;
   runs.clear();
-  const std::uint64_t total = detail::planBirths(g, sp, runs);
+  std::uint64_t total = detail::planBirths(g, sp, runs);
   g.stats.emitted += total;
+  // Under a particle budget the context brought the live count up to date (shareBudget): the
+  // host fits the births as the CPU does. Otherwise the device drops what does not fit.
+  if (g.birthAllowance != ~std::uint64_t(0)) total = detail::fitBirths(g, total, runs);
   t.runs.clear();
   t.emitters.clear();
   t.types.clear();
