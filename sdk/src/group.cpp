@@ -702,9 +702,6 @@ void detail::GroupImpl::trimToBudget(const StepParams& params) {
 Group& Group::setTrail(const TrailOptions& options) {
   auto& g = *impl_;
   options.validate();
-  if (options.length > 0 && g.onDevice)
-    throw Error("setTrail: group '" + g.name +
-                "': a trail does not run on the device yet (the CPU backend keeps it)");
   g.syncHost();
   if (options.length != g.trail.length) {
     // Built aside and swapped in: a failed allocation leaves the old trail as it was.
@@ -725,6 +722,7 @@ Group& Group::setTrail(const TrailOptions& options) {
     g.trailHead = 0;
     g.trail = options;
     g.startTrails(0, g.size);
+    g.hostChanged();  // a device's group takes the new ring up with its particles
   }
   g.trail = options;
   return *this;
@@ -736,7 +734,7 @@ const TrailOptions& Group::trail() const {
 
 std::size_t Group::trail(std::size_t i, std::span<Vec3> out) const {
   auto& g = *impl_;
-  g.syncCount();
+  g.syncHost({Attribute::Position});  // a device's trails come with its positions
   if (i >= g.size)
     throw InvalidArgument("index",
                           std::to_string(i) + " is past the live count " + std::to_string(g.size));

@@ -228,20 +228,24 @@ TEST(OpenCLBackend, ClearAndRequireBetweenSteps) {
 }
 
 // What the device does not run yet is a clear error, not a silent difference; the group steps
-// on. (Death and collision events and sub-emitters on them run on the device:
-// OpenCLCore.DeathEventsAsOnTheCpu, CollisionEventsAsOnTheCpu,
-// SubEmittersOnDeathCollisionAndBirthAsOnTheCpu.)
+// on. (Death and collision events, sub-emitters on them, trails and a particle budget run on
+// the device: OpenCLCore.DeathEventsAsOnTheCpu, CollisionEventsAsOnTheCpu,
+// SubEmittersOnDeathCollisionAndBirthAsOnTheCpu, TrailsAsOnTheCpu, AParticleBudgetAsOnTheCpu.)
 TEST(OpenCLBackend, WhatTheDeviceDoesNotRunIsAClearError) {
   FLURRY_REQUIRE_OPENCL();
   Context ctx(openclOptions());
   Group& g = samples::buildFountain(ctx, 2000, 3000, 0.2f);
+  // A trail in hair mode: refused when the group steps.
+  Group& hairy = ctx.createGroup("hairy", 1000);
+  hairy.setHair({.enabled = true});
+  hairy.setTrail({.length = 4});
   try {
-    g.setTrail({.length = 8});  // trails are the CPU pass's
-    FAIL() << "a trail on a device context did not throw";
+    ctx.step();
+    FAIL() << "a trail in hair mode stepped on the device";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("device"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("trail"), std::string::npos) << e.what();
   }
-  g.setTrail({});  // none is fine
+  ctx.destroyGroup(hairy);
   ctx.run(5);
   EXPECT_GT(g.size(), 0u);
   // A hair group taking a sub-emitter's newborns: refused when the context steps.

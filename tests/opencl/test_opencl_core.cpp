@@ -472,3 +472,70 @@ TEST(OpenCLCore, AParticleBudgetAsOnTheCpu) {
   for (std::size_t n : cpuSizes.back()) last += n;
   EXPECT_LE(last, 1500u);
 }
+
+// Trails on the device: the ring starts at each newborn's birth place, moves with its
+// particle when the dead's holes are filled, turns each step, and comes to the host with the
+// positions. The same trails as on the CPU, point for point, for particles born by emitters
+// and by a sub-emitter (appended on the host), for a trail set on live particles midway, and
+// after the trail is lengthened.
+TEST(OpenCLCore, TrailsAsOnTheCpu) {
+  FLURRY_REQUIRE_OPENCL();
+  using Trails = std::map<std::uint32_t, std::vector<Vec3>>;
+  auto trailsOf = [](const Group& g) {
+    Trails out;
+    std::vector<Vec3> points(64);
+    for (std::size_t i = 0; i < g.size(); ++i) {
+      const std::size_t n = g.trail(i, points);
+      out[g.particle(i).id].assign(points.begin(), points.begin() + std::ptrdiff_t(n));
+    }
+    return out;
+  };
+  auto run = [&](Backend backend) {
+    Context ctx(parityOptions(backend));
+    Group& sparks = ctx.createGroup("sparks", 6000);
+    sparks.addEmitter(spray(Vec3(0.0f, 1.0f, 0.0f), 1500));
+    // Killed below the floor's edge (a Sink) and by age: holes to fill every step.
+    sparks.setActions(
+        {Gravity{kDown}, Bounce{Domain::disc(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f), 2.0f), 0.5f, 0.1f},
+         Sink{.region = Domain::box(Vec3(-50.0f), Vec3(50.0f, -1.0f, 50.0f))}, Move{}, KillOld{}});
+    sparks.setTrail({.length = 6});
+    Group& splash = ctx.createGroup("splash", 8000);
+    DeathEmitter de;
+    de.source = "sparks";
+    de.count = 1.5f;
+    de.types[0].velocity = Domain::sphere(Vec3(0.0f, 2.0f, 0.0f), 1.0f);
+    de.types[0].lifetime = 0.7f;
+    splash.addDeathEmitter(de);
+    splash.setActions({Gravity{kDown}, Move{}, KillOld{}});
+    std::vector<std::pair<Trails, Trails>> seen;
+    for (int s = 0; s < 75; ++s) {
+      if (s == 20) splash.setTrail({.length = 4});  // on live particles
+      if (s == 45) sparks.setTrail({.length = 9});  // a new ring, begun where they are
+      ctx.step();
+      if (s % 6 == 5) seen.emplace_back(trailsOf(sparks), trailsOf(splash));
+    }
+    return seen;
+  };
+  const auto cpu = run(Backend::Cpu);
+  const auto cl = run(Backend::OpenCL);
+  ASSERT_EQ(cpu.size(), cl.size());
+  std::size_t points = 0, longest = 0;
+  for (std::size_t s = 0; s < cpu.size(); ++s) {
+    for (int which = 0; which < 2; ++which) {
+      const Trails& a = which ? cpu[s].second : cpu[s].first;
+      const Trails& b = which ? cl[s].second : cl[s].first;
+      ASSERT_EQ(a.size(), b.size()) << "sample " << s << ", group " << which;
+      for (const auto& [id, ta] : a) {
+        const auto it = b.find(id);
+        ASSERT_NE(it, b.end()) << "particle " << id;
+        ASSERT_EQ(ta.size(), it->second.size()) << "particle " << id << ", sample " << s;
+        for (std::size_t k = 0; k < ta.size(); ++k)
+          for (int c = 0; c < 3; ++c) expectClose(ta[k][c], it->second[k][c], "trail", id, c);
+        points += ta.size();
+        longest = std::max(longest, ta.size());
+      }
+    }
+  }
+  EXPECT_GT(points, 10000u);
+  EXPECT_EQ(longest, 9u);  // the lengthened ring filled up
+}

@@ -530,8 +530,8 @@ typedef struct flurry_trail_options {
   uint32_t length;
   float width, taper, fade;
 } flurry_trail_options;
-/** Sets the group's trail (FLURRY_ERROR_INVALID_ARGUMENT naming "trail.length", ...; on a
- * device context FLURRY_ERROR). */
+/** Sets the group's trail (FLURRY_ERROR_INVALID_ARGUMENT naming "trail.length", ...), on
+ * either backend. */
 FLURRY_C_EXPORT flurry_status flurry_group_set_trail(flurry_group* group,
                                                      const flurry_trail_options* options);
 /** Packs the visible live particles' trails as ribbons: vertices of FLURRY_INSTANCE_STRIDE

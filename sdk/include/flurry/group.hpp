@@ -251,8 +251,9 @@ class Group {
   /// Keeps each particle's last `options.length` positions (TrailOptions), from the next
   /// step on: particles alive now start their trail where they are. Throws InvalidArgument
   /// naming the field ("trail.length" past kMaxLength, a width, taper or fade that is
-  /// negative or not finite), and Error in a device context (trails are the CPU backend's).
-  /// Costs one memory pass over the positions a step, and the trail's lanes in compaction.
+  /// negative or not finite). Both backends keep trails alike (a device's come to the host
+  /// with the positions; hair mode refuses one there). Costs one memory pass over the
+  /// positions a step, and the trail's lanes in compaction.
   Group& setTrail(const TrailOptions& options);
   const TrailOptions& trail() const;
   /// Particle i's trail, newest first: its position at the end of the last step, then of

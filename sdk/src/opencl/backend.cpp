@@ -210,11 +210,25 @@ class ClGroup final : public DeviceMirror {
       g.stats.bytesReadBack += size_ * 4;
       read = true;
     }
+    // The trails come with the positions (Group::trail reads them so).
+    if (trailSlots_ > 0 && want.has(Attribute::Position) && !trailFresh_ && size_ > 0) {
+      for (std::size_t k = 0; k < 3 * std::size_t(trailSlots_); ++k)
+        check(clEnqueueReadBuffer(queue(), trail_.get(), CL_FALSE, k * g.capacity * 4, size_ * 4,
+                                  g.trailLanes[k].data(), 0, nullptr, nullptr),
+              "clEnqueueReadBuffer (trails)");
+      check(clEnqueueReadBuffer(queue(), trailCount_.get(), CL_FALSE, 0, size_ * 4,
+                                g.trailCount.data(), 0, nullptr, nullptr),
+            "clEnqueueReadBuffer (trails)");
+      g.stats.bytesReadBack += (3 * std::size_t(trailSlots_) + 1) * size_ * 4;
+      read = true;
+    }
     if (read) check(clFinish(queue()), "clFinish");
     for (auto& lane : lanes_)
       if (want.has(lane.ref.attribute)) fresh_.insert(lane.ref.attribute);
+    if (want.has(Attribute::Position)) trailFresh_ = true;
     // Every stored lane is the device's now (an empty group: nothing to read).
-    if (size_ == 0 || fresh_.contains(laneSet_)) deviceNewer_ = false;
+    if (size_ == 0 || (fresh_.contains(laneSet_) && (trailSlots_ == 0 || trailFresh_)))
+      deviceNewer_ = false;
   }
 
   void hostChanged(GroupImpl&) override { hostDirty_ = true; }
@@ -241,6 +255,7 @@ class ClGroup final : public DeviceMirror {
                                  0, nullptr, nullptr),
             "clEnqueueWriteBuffer (newborns)");
     }
+    if (trailSlots_ > 0) queueTrails(g, from, g.size);  // where the host started them
     // Blocking, after the lanes in the same in-order queue: the host's lanes are free again.
     const std::uint32_t head[2] = {std::uint32_t(g.size), g.nextId};
     static_assert(FL_STATE_SIZE == 0 && FL_STATE_NEXT_ID == 1);
@@ -342,6 +357,20 @@ class ClGroup final : public DeviceMirror {
   GrowBuffer births_;           // fl_births' count and events
   std::vector<std::uint32_t> deathWords_;
   std::vector<std::uint32_t> lastKills_;
+  // Group::setTrail: the ring on the device (trail.cl), trailSlots_ positions a particle, and
+  // whether the host's copy of it is the device's (as fresh_ for the lanes).
+  Program trailProgram_;
+  Kernel trailStart_, trailTail_, trailRecord_;
+  Mem trail_, trailCount_;
+  std::uint32_t trailSlots_ = 0;
+  bool trailFresh_ = false;
+  void allocateTrails(GroupImpl& g);
+  void queueTrails(GroupImpl& g, std::size_t from, std::size_t to);  // host -> device
+  cl_mem positionLane(int c) const {
+    for (const auto& l : lanes_)
+      if (l.ref.attribute == Attribute::Position && l.ref.component == c) return l.mem.get();
+    return nullptr;
+  }
   bool hostDirty_ = true;
   bool deviceNewer_ = false;
   // While deviceNewer_: the attributes whose host lanes already hold the device's particles.
@@ -392,6 +421,65 @@ void ClGroup::allocate(GroupImpl& g) {
   laneSet_ = g.stored;
   allocated_ = true;
   programValid_ = false;
+}
+
+void ClGroup::allocateTrails(GroupImpl& g) {
+  const std::size_t rows = 3 * std::size_t(g.trail.length);
+  if (rows == 0) {
+    trail_ = Mem();
+    trailCount_ = Mem();
+    trailSlots_ = 0;
+    return;
+  }
+  const auto& dev = shared_->runtime->device();
+  const std::size_t floats = rows * g.capacity;
+  if (floats * 4 > dev.info.maxAllocation || floats > std::size_t(0xFFFFFFFFu))
+    throw OpenCLError(CL_INVALID_BUFFER_SIZE,
+                      "OpenCL: group '" + g.name + "': a trail of " +
+                          std::to_string(g.trail.length) + " positions for a capacity of " +
+                          std::to_string(g.capacity) + " needs " + std::to_string(floats * 4) +
+                          " bytes in one buffer; " + dev.info.name + " allows " +
+                          std::to_string(dev.info.maxAllocation) +
+                          " (a shorter trail, a smaller capacity or the CPU backend)");
+  cl_int err = CL_SUCCESS;
+  Mem trail(clCreateBuffer(context(), CL_MEM_READ_WRITE, floats * 4, nullptr, &err));
+  check(err, "clCreateBuffer (trails)");
+  Mem count(clCreateBuffer(context(), CL_MEM_READ_WRITE, g.capacity * 4, nullptr, &err));
+  check(err, "clCreateBuffer (trails)");
+  if (!trailProgram_) {
+    Program p(shared_->runtime->program(trailProgramSource(shared_->fp64()), kProgramOptions));
+    auto kernel = [&](const char* name) {
+      Kernel k(clCreateKernel(p.get(), name, &err));
+      check(err, "clCreateKernel");
+      return k;
+    };
+    trailStart_ = kernel("fl_trail_start");
+    trailTail_ = kernel("fl_trail_tail");
+    trailRecord_ = kernel("fl_trail_record");
+    trailProgram_ = std::move(p);
+  }
+  // Zeroed, as on the CPU: no slot ever holds what the device's memory had.
+  const cl_uint zero = 0;
+  check(clEnqueueFillBuffer(queue(), trail.get(), &zero, 4, 0, floats * 4, 0, nullptr, nullptr),
+        "clEnqueueFillBuffer (trails)");
+  check(clEnqueueFillBuffer(queue(), count.get(), &zero, 4, 0, g.capacity * 4, 0, nullptr, nullptr),
+        "clEnqueueFillBuffer (trails)");
+  trail_ = std::move(trail);
+  trailCount_ = std::move(count);
+  trailSlots_ = g.trail.length;
+  trailFresh_ = false;
+}
+
+void ClGroup::queueTrails(GroupImpl& g, std::size_t from, std::size_t to) {
+  if (to <= from) return;
+  const std::size_t n = to - from;
+  for (std::size_t k = 0; k < 3 * std::size_t(trailSlots_); ++k)
+    check(clEnqueueWriteBuffer(queue(), trail_.get(), CL_FALSE, (k * g.capacity + from) * 4, n * 4,
+                               g.trailLanes[k].f() + from, 0, nullptr, nullptr),
+          "clEnqueueWriteBuffer (trails)");
+  check(clEnqueueWriteBuffer(queue(), trailCount_.get(), CL_FALSE, from * 4, n * 4,
+                             g.trailCount.u() + from, 0, nullptr, nullptr),
+        "clEnqueueWriteBuffer (trails)");
 }
 
 void ClGroup::buildProgram(GroupImpl& g, bool cull, bool hits) {
@@ -513,6 +601,7 @@ void ClGroup::upload(GroupImpl& g) {
                                nullptr),
           "clEnqueueWriteBuffer (particles)");
   }
+  if (trailSlots_ > 0) queueTrails(g, 0, g.size);
   std::vector<std::uint32_t> state(FL_STATE_HEADER + FL_KILL_CODES, 0u);
   state[FL_STATE_SIZE] = std::uint32_t(g.size);
   state[FL_STATE_NEXT_ID] = g.nextId;
@@ -686,6 +775,13 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     allocate(g);
     hostDirty_ = true;
   }
+  if (g.trail.length != trailSlots_) {
+    if (g.trail.length > 0 && g.hair.enabled)
+      throw Error("group '" + g.name + "': a trail in hair mode does not run on the device");
+    drain(g);
+    allocateTrails(g);
+    hostDirty_ = true;  // Group::setTrail started the trails on the host
+  }
   // The host's particles go up; the program's buffers stay the same (no rebuild).
   if (hostDirty_) upload(g);
   // Emitters may be edited at any time (Group::emitters()); the program follows their kinds.
@@ -788,7 +884,9 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   const bool acts = !g.actions.empty() && nBound > 0;
   const bool kills = acts;                      // the NaN guard can kill in any list
   const std::size_t deathRoom = g.deathRoom();  // Group::recordDeaths
-  if (!acts && births == 0) return;             // nothing on the device changes
+  const bool trails = trailSlots_ > 0;
+  // Nothing on the device changes (but a trail's new head, as on the CPU).
+  if (!acts && births == 0 && !trails) return;
   if (hits && acts) {
     // Room for every particle deflected by each Bounce in each sub-step, or the most a step
     // had, within one buffer the device allows; taken before anything of the step is queued.
@@ -880,10 +978,22 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   // A small group's step is one launch (fl_small) when its program has it.
   const std::size_t tiles = (nBound + FL_TILE - 1) / FL_TILE;
   const bool oneLaunch = acts && small_ && tiles <= kSmallTiles && !g.hair.enabled &&
-                         deathRoom == 0 && !hits && !g.birthsFeed;
+                         deathRoom == 0 && !hits && !g.birthsFeed && !trails;
   if (births > 0 && !oneLaunch) {
     birthArgs(birth_.get(), cl_uint(lanes_.size()) + 1, true);
     launch(birth_.get(), roundUp(births, kSmallLocal), kSmallLocal, "fl_birth");
+  }
+  if (births > 0 && trails) {
+    // A newborn's trail starts where it was born (startTrails), in the ring's head.
+    cl_kernel k = trailStart_.get();
+    for (int c = 0; c < 3; ++c) setArg(k, cl_uint(c), positionLane(c));
+    setArg(k, 3, trail_.get());
+    setArg(k, 4, trailCount_.get());
+    setArg(k, 5, state);
+    setArg(k, 6, cl_uint(births));
+    setArg(k, 7, cap);
+    setArg(k, 8, cl_uint(g.trailHead));
+    launch(k, roundUp(births, kSmallLocal), kSmallLocal, "fl_trail_start");
   }
   if (births > 0 && g.birthsFeed) {
     // Where they were born, before the act kernel moves them (a sub-emitter on birth).
@@ -1016,6 +1126,32 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
       cl_kernel k = tailKernel_.get();
       setArg(k, cl_uint(lanes_.size()) + 2, state);
       launch(k, std::min(roundUp(nBound, kSmallLocal), kMaxFillItems), kSmallLocal, "fl_tail");
+      if (trails) {  // the trails move with their particles
+        k = trailTail_.get();
+        setArg(k, 0, trail_.get());
+        setArg(k, 1, trailCount_.get());
+        setArg(k, 2, cl_uint(3 * trailSlots_));
+        setArg(k, 3, cap);
+        setArg(k, 4, holes_.get());
+        setArg(k, 5, tailList_.get());
+        setArg(k, 6, state);
+        launch(k, std::min(roundUp(nBound, kSmallLocal), kMaxFillItems), kSmallLocal,
+               "fl_trail_tail");
+      }
+    }
+    if (trails) {
+      // The ring turns; every live particle's position goes into the new head (recordTrails).
+      g.trailHead = (g.trailHead + 1) % trailSlots_;
+      cl_kernel k = trailRecord_.get();
+      for (int c = 0; c < 3; ++c) setArg(k, cl_uint(c), positionLane(c));
+      setArg(k, 3, trail_.get());
+      setArg(k, 4, trailCount_.get());
+      setArg(k, 5, state);
+      setArg(k, 6, cap);
+      setArg(k, 7, cl_uint(g.trailHead));
+      setArg(k, 8, cl_uint(trailSlots_));
+      launch(k, std::max(roundUp(nBound, kSmallLocal), kSmallLocal), kSmallLocal,
+             "fl_trail_record");
     }
     if (g.hair.enabled && births > 0) {
       queueHair(g, sp, births);
@@ -1035,6 +1171,7 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   check(clFlush(q), "clFlush");
   deviceNewer_ = true;
   fresh_ = AttributeSet();
+  trailFresh_ = false;
   if (g.hair.enabled && births > 0) {
     // Strands are host data: the step's come back now.
     drain(g);

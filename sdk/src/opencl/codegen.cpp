@@ -563,6 +563,15 @@ std::string cullingBody(const std::vector<Action>& acts, const std::string& body
 
 }  // namespace
 
+std::string trailProgramSource(bool fp64) {
+  std::ostringstream s;
+  s << "/* Flurry OpenCL program: trails. */\n";
+  if (fp64) s << "#pragma OPENCL EXTENSION cl_khr_fp64 : enable\n#define FL_FP64 1\n";
+  for (const char* f : {"compat_opencl.h", "math.h", "params.h", "compact.cl", "trail.cl"})
+    s << "/* ---- " << f << " */\n" << embeddedKernel(f) << "\n";
+  return s.str();
+}
+
 GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored, bool fp64,
                                  const std::string& emitSource, bool hair, bool cull,
                                  bool collisions) {
@@ -866,7 +875,7 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   }
   g.source = s.str();
   // Correctly rounded division and sqrt: the CPU's are, and Bounce divides.
-  g.options = "-cl-std=CL1.2 -cl-fp32-correctly-rounded-divide-sqrt";
+  g.options = kProgramOptions;
   return g;
 }
 

@@ -47,6 +47,14 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
                                  const std::string& emitSource, bool hair = false,
                                  bool cull = false, bool collisions = false);
 
+/// The build options of every Flurry program.
+inline constexpr const char* kProgramOptions =
+    "-cl-std=CL1.2 -cl-fp32-correctly-rounded-divide-sqrt";
+
+/// The trails' program (kernels/trail.cl: fl_trail_start, fl_trail_tail, fl_trail_record),
+/// the same for every group; its options are generateProgram's.
+std::string trailProgramSource(bool fp64);
+
 /// What the generator of one action writes into the fused act kernel.
 ///
 /// The act kernel holds each particle in registers named after its lanes (px py pz, vx vy vz,
