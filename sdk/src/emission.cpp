@@ -7,7 +7,6 @@
 // holes the pass leaves are filled from the tail afterwards.
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cmath>
 #include <limits>
 #include <span>
@@ -460,31 +459,37 @@ void emitNewborns(GroupImpl& g, const StepParams& sp) {
 namespace {
 
 // An event a DeathEmitter emits from: where, how fast, the particle and the action, and the
-// key of its count's random draws (a particle dies once; it may be deflected many times, each
-// at its own moment).
+// key of its count's random draws. A particle dies once: its id. It may be deflected many
+// times: its id, which of its deflections in the step this is (a step's events are in
+// particle, sub-step, action order on both backends) and the source's step, all integers, so
+// that a device without doubles (its times in float) draws the same counts.
 struct Trigger {
   Vec3 position, velocity;
   std::uint32_t id, action, key;
 };
-Trigger triggerOf(const DeathEvent& d) {
+Trigger triggerOf(const DeathEvent& d, std::uint32_t, std::uint64_t) {
   return {d.position, d.velocity, d.id, d.action, d.id};
 }
-Trigger triggerOf(const CollisionEvent& c) {
-  const auto t = std::bit_cast<std::uint64_t>(c.time);
-  return {c.position, c.velocity, c.id, c.action,
-          c.id ^ std::uint32_t(t) ^ std::uint32_t(t >> 32) * 0x9E3779B9u};
+Trigger triggerOf(const CollisionEvent& c, std::uint32_t ordinal, std::uint64_t step) {
+  std::uint64_t h = (std::uint64_t(c.id) << 32 | ordinal) ^ (step * 0x9E3779B97F4A7C15ull);
+  h = (h ^ (h >> 31)) * 0xBF58476D1CE4E5B9ull;  // splitmix64's finaliser
+  h = (h ^ (h >> 27)) * 0x94D049BB133111EBull;
+  return {c.position, c.velocity, c.id, c.action, std::uint32_t(h ^ (h >> 32))};
 }
 
 template <class Event>
-void emitFrom(GroupImpl& g, std::size_t k, std::span<const Event> events, std::uint64_t seed) {
+void emitFrom(GroupImpl& g, std::size_t k, std::span<const Event> events, std::uint64_t seed,
+              std::uint64_t sourceStep) {
   const DeathEmitter& de = g.deathEmitters[k];
   if (events.empty()) return;
   if (g.mirror) g.mirror->beginAppend(g);  // a device's group: its count, then only the newborns
   g.ensureStorage();
   const Lanes L = g.lanePointers();
   const std::size_t before = g.size;
-  for (const Event& event : events) {
-    const Trigger d = triggerOf(event);
+  std::uint32_t ordinal = 0;
+  for (std::size_t e = 0; e < events.size(); ++e) {
+    ordinal = e > 0 && events[e].id == events[e - 1].id ? ordinal + 1 : 0;
+    const Trigger d = triggerOf(events[e], ordinal, sourceStep);
     // A particle killed for a NaN or an infinity has no place to emit from.
     if (d.action == DeathEvent::kNonFinite) continue;
     if (de.cause >= 0 && d.action != std::uint32_t(de.cause)) continue;
@@ -549,12 +554,13 @@ void emitFrom(GroupImpl& g, std::size_t k, std::span<const Event> events, std::u
 }  // namespace
 
 void emitFromDeaths(GroupImpl& g, std::size_t k, const GroupImpl& source, std::uint64_t seed) {
+  // (ownSteps: the steps the source took, the same on both backends)
   if (g.deathEmitters[k].on == DeathEmitter::Trigger::Collision)
-    emitFrom<CollisionEvent>(g, k, source.collisionEvents, seed);
+    emitFrom<CollisionEvent>(g, k, source.collisionEvents, seed, source.ownSteps);
   else if (g.deathEmitters[k].on == DeathEmitter::Trigger::Birth)
-    emitFrom<DeathEvent>(g, k, source.birthEvents, seed);
+    emitFrom<DeathEvent>(g, k, source.birthEvents, seed, source.ownSteps);
   else
-    emitFrom<DeathEvent>(g, k, source.deathEvents, seed);
+    emitFrom<DeathEvent>(g, k, source.deathEvents, seed, source.ownSteps);
 }
 
 void compact(GroupImpl& g, const StepParams& sp) {
