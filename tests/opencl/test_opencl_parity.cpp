@@ -3,8 +3,11 @@
 // compacts in another order), the same counts, the same attributes.
 //
 #include <bit>
+#include <map>
+#include <optional>
 
 #include "builtin.hpp"
+#include "effect/descriptors.hpp"
 #include "parity.hpp"
 
 using namespace flurry;
@@ -236,4 +239,144 @@ TEST(OpenCLParity, EveryBuiltinSample) {
     std::printf("[ parity   ] NOT COMPARED (features not on the device yet):%s\n",
                 notOnDevice.c_str());
   EXPECT_GT(compared, 0);
+}
+
+namespace {
+
+// One action of each kind in a scene whose emission is bitwise on both backends (boxes and
+// uniform draws only: no libm there), with sensible parameters where the defaults do nothing.
+template <class A>
+A bitwiseCase() {
+  A a{};
+  const Domain box = Domain::box(Vec3(-1.0f, 0.5f, -1.0f), Vec3(1.0f, 2.0f, 1.0f));
+  // (Nothing falls in these scenes: the surfaces stand in the particles' way up.)
+  if constexpr (std::is_same_v<A, Bounce>)
+    a.surface = Domain::plane(Vec3(0, 2.5f, 0), Vec3(0, 1, 0));
+  if constexpr (std::is_same_v<A, ElectricField>) a.field = Vec3(0.0f, 2.0f, 1.0f);
+  if constexpr (std::is_same_v<A, TargetColor>) {
+    a.color = Vec3(1.0f, 0.2f, 0.0f);
+    a.rate = 2.0f;
+  }
+  if constexpr (std::is_same_v<A, SpeedClamp>) a.maxSpeed = 2.0f;
+  if constexpr (std::is_same_v<A, Sink>) a.region = Domain::sphere(Vec3(0.0f, 1.5f, 0.0f), 0.6f);
+  if constexpr (std::is_same_v<A, SinkVelocity>) a.velocity = Domain::sphere(Vec3(0.0f), 1.5f);
+  if constexpr (std::is_same_v<A, Block>) a.region = Domain::sphere(Vec3(0.0f, 2.0f, 0.0f), 0.5f);
+  if constexpr (std::is_same_v<A, Avoid>) a.obstacle = Domain::sphere(Vec3(0, 3, 0), 0.5f);
+  if constexpr (std::is_same_v<A, Jet>) {
+    a.center = Vec3(0.0f, 2.0f, 0.0f);
+    a.acceleration = box;
+  }
+  if constexpr (std::is_same_v<A, RandomAccel>) a.acceleration = box;
+  if constexpr (std::is_same_v<A, RandomDisplace>) a.displacement = box;
+  if constexpr (std::is_same_v<A, RandomVelocity>) a.velocity = box;
+  if constexpr (std::is_same_v<A, RandomRotVelocity>) a.rotVelocity = box;
+  if constexpr (std::is_same_v<A, SampledField>) {
+    auto f = std::make_shared<VectorField>();
+    f->dims = {2, 2, 2};
+    f->origin = Vec3(-3.0f);
+    f->voxelSize = 6.0f;
+    for (int k = 0; k < 8; ++k) f->data.push_back(Vec3(float(k % 2), float(k / 4), 0.5f));
+    a.field = f;
+  }
+  return a;
+}
+
+// Whether two runs hold the same particles to the bit, and the largest difference.
+std::pair<bool, float> bitwiseCompare(const RunResult& x, const RunResult& y) {
+  bool same = x.size == y.size;
+  float most = 0.0f;
+  auto cmp = [&](float a, float b) {
+    if (std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b)) return;
+    same = false;
+    most = std::max(most, std::abs(a - b));
+  };
+  for (const auto& [id, p] : x.byId) {
+    const auto it = y.byId.find(id);
+    if (it == y.byId.end()) return {false, kInfinity};
+    const Particle& q = it->second;
+    for (int c = 0; c < 3; ++c) {
+      cmp(p.position[c], q.position[c]);
+      cmp(p.velocity[c], q.velocity[c]);
+      cmp(p.up[c], q.up[c]);
+      cmp(p.rotVelocity[c], q.rotVelocity[c]);
+      cmp(p.positionB[c], q.positionB[c]);
+      cmp(p.velocityB[c], q.velocityB[c]);
+    }
+    for (int c = 0; c < 4; ++c) cmp(p.color[c], q.color[c]);
+    cmp(p.size, q.size);
+    cmp(p.age, q.age);
+    cmp(p.userData, q.userData);
+    if (p.visible != q.visible) same = false;
+  }
+  return {same, most};
+}
+
+}  // namespace
+
+// Which actions give the CPU's particles to the bit on the device, each alone before Move and
+// KillOld over 40 steps (docs/opencl.md, "Bitwise parity", keeps the table this prints). Both
+// sides run one source (kernels/*.h) in float with no contraction into FMAs and correctly
+// rounded division and square root: what is left to differ is where a libm function (exp, log,
+// sin, cos, pow, atan2) stands in the path, the device's builtin and the CPU's libm rounding
+// their last bit apart. The actions that may differ are listed with that function (on PoCL
+// only Explosion does); every other must be bitwise, and those listed must still be within
+// the parity tolerance.
+TEST(OpenCLParity, WhichActionsAreBitwise) {
+  FLURRY_REQUIRE_OPENCL();
+  // Each action not bitwise, and the libm function on its path.
+  const std::map<std::string, std::string> expectedNot = {
+      {"Explosion", "exp (float): the blast front's gaussian"},
+      {"Vortex", "pow (float), beyond the core"},
+      {"MagneticField", "cos, sin (double where the device has it)"}};
+  int bitwise = 0, differ = 0;
+  std::string table;
+  std::optional<RunResult> alone;  // the CPU's run without the action
+  auto check = [&](const std::string& name, const ActionList& list) {
+    auto build = [&](Context& ctx) -> Group& {
+      Group& g = ctx.createGroup("g", 3000);
+      Emitter e;
+      e.shape = Domain::box(Vec3(-0.5f, 0.5f, -0.5f), Vec3(0.5f, 1.5f, 0.5f));
+      e.rate = 900;
+      ParticleType t;
+      t.velocity = Domain::box(Vec3(-1.0f, 1.0f, -1.0f), Vec3(1.0f, 4.0f, 1.0f));
+      t.lifetime = Fuzzy(1.0f, 0.4f);
+      t.charge = Fuzzy(1.0f, 0.5f);
+      t.rotVelocity = Domain::box(Vec3(-1.0f), Vec3(1.0f));
+      e.types = {t};
+      g.addEmitter(e);
+      g.setActions(list);
+      return g;
+    };
+    const RunResult cpu = runEffect(Backend::Cpu, build, 40);
+    // A case that changes nothing would be bitwise for nothing: each action must act.
+    if (alone) {
+      EXPECT_FALSE(bitwiseCompare(*alone, cpu).first) << name << " changed nothing";
+    } else {
+      alone = cpu;
+    }
+    const auto [same, most] = bitwiseCompare(cpu, runEffect(Backend::OpenCL, build, 40));
+    const auto it = expectedNot.find(name);
+    char line[160];
+    std::snprintf(line, sizeof line, "| %s | %s | %.3g | %s |\n", name.c_str(),
+                  same ? "bitwise" : "differs", double(most),
+                  it == expectedNot.end() ? "" : it->second.c_str());
+    table += line;
+    (same ? bitwise : differ) += 1;
+    if (it == expectedNot.end()) {
+      EXPECT_TRUE(same) << name << " differs by up to " << most;
+    } else {
+      EXPECT_LE(most, 1e-3f) << name;
+    }
+  };
+  check("Move, KillOld", ActionList{Move{}, KillOld{}});
+  desc::forEachAction([&](auto tag) {
+    using A = typename decltype(tag)::type;
+    if constexpr (!std::is_same_v<A, Move> && !std::is_same_v<A, KillOld>)
+      check(desc::Describe<A>::name, ActionList{bitwiseCase<A>(), Move{}, KillOld{}});
+  });
+  std::printf(
+      "| action | CPU and device | largest difference | libm on its path |\n"
+      "| --- | --- | --- | --- |\n%s",
+      table.c_str());
+  std::printf("[ parity   ] %d bitwise, %d differ\n", bitwise, differ);
 }
