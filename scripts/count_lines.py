@@ -4,7 +4,10 @@ issue #13 (one source) asks to report before and after.
 
     python3 scripts/count_lines.py 3088d3e^ HEAD
 
-3088d3e is the first one-source commit, so 3088d3e^ is the engine before it.
+3088d3e is the first one-source commit, so 3088d3e^ is the engine before it. Its effect.cpp
+held the reader and Effect::build; since a0dbe80 effect.cpp is the reader alone (the build
+and EffectInstance are in effect_instance.cpp, the writer in effect_writer.cpp, all counted
+in the "effect files, all" row).
 """
 import re
 import subprocess
