@@ -2,6 +2,7 @@
 //   - the fused update pass and the whole fountain step at 1M and 4M particles,
 //   - the whole step of a heavy effect (curl-noise turbulence, an orbit, a bounce and a sink),
 //   - time per step of a small (1k particle) fountain: the launch overhead,
+//   - what death and collision events and trails of 8 positions cost,
 //   - kernel compile time, cold and cached (in memory, and on disk),
 //   - the machine's in-place read-modify-write bandwidth: the ceiling of an in-place update.
 //
@@ -242,6 +243,31 @@ void CollisionEvents(benchmark::State& state, Backend backend) {
   if (record) state.counters["events/step"] = events / (double(state.iterations()) * steps);
 }
 
+// Trails (Group::setTrail) on both backends: the fountain's ~300k particles keeping their
+// last 8 positions (range 0 = 8) or none (0). The difference over the live particles is a
+// trail's cost a particle and step: on the device three kernels of their own (start, move with
+// the compaction, record), on the CPU the fused pass's extra stores and compaction's rows.
+void Trails(benchmark::State& state, Backend backend) {
+  if (backend == Backend::OpenCL && !haveDevice()) return state.SkipWithError("no OpenCL device");
+  Context ctx(options(backend));
+  Group& g = samples::buildFountain(ctx, std::size_t(1) << 19, 1.0e5, 3.0f);
+  g.setActions(fountainActions());
+  g.setTrail({.length = std::uint32_t(state.range(0))});
+  ctx.run(90);
+  finish(g);
+  const int steps = 10;
+  double live = 0;
+  for (auto _ : state) {
+    for (int s = 0; s < steps; ++s) ctx.step();
+    finish(g);
+    live += double(g.size());
+  }
+  state.counters["us/step"] =
+      benchmark::Counter(double(state.iterations()) * steps * 1e-6,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["live"] = live / double(state.iterations());
+}
+
 // The ceiling, measured the same way in every benchmark (bench/common).
 void ReadModifyWrite(benchmark::State& state) {
   flurry::bench::readModifyWrite(state, kLanes, threads());
@@ -301,6 +327,7 @@ class SummaryReporter : public benchmark::ConsoleReporter {
       usPerStep_[name] = get("us/step");
       deathsPerStep_[name] = get("deaths/step");
       eventsPerStep_[name] = get("events/step");
+      live_[name] = get("live");
       if (name.rfind("Deflectors", 0) == 0) ms_[name] = r.GetAdjustedRealTime();
     }
   }
@@ -379,6 +406,16 @@ class SummaryReporter : public benchmark::ConsoleReporter {
             "an event\n",
             b, usPerStep_[on], e, usPerStep_[off], (usPerStep_[on] - usPerStep_[off]) * 1e3 / e);
     }
+    for (const char* b : {"cpu", "opencl"}) {
+      const std::string on = std::string("Trails/") + b + "/length:8",
+                        off = std::string("Trails/") + b + "/length:0";
+      const double n = live_[on];
+      if (usPerStep_[on] > 0 && usPerStep_[off] > 0 && n > 0)
+        std::printf(
+            "  %-6s trails of 8: %.0f us a step for %.0f particles, %.0f us without: %.2f ns a "
+            "particle\n",
+            b, usPerStep_[on], n, usPerStep_[off], (usPerStep_[on] - usPerStep_[off]) * 1e3 / n);
+    }
     if (gCompile.measured)
       std::printf(
           "  kernel program build, first step of a new Context: cold %.0f ms, cached in "
@@ -387,7 +424,8 @@ class SummaryReporter : public benchmark::ConsoleReporter {
   }
 
  private:
-  std::map<std::string, double> bytes_, items_, usPerStep_, ms_, deathsPerStep_, eventsPerStep_;
+  std::map<std::string, double> bytes_, items_, usPerStep_, ms_, deathsPerStep_, eventsPerStep_,
+      live_;
 };
 
 }  // namespace
@@ -473,6 +511,18 @@ BENCHMARK_CAPTURE(CollisionEvents, opencl, Backend::OpenCL)
     ->ArgName("record")
     ->Arg(0)
     ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(Trails, cpu, Backend::Cpu)
+    ->ArgName("length")
+    ->Arg(0)
+    ->Arg(8)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(Trails, opencl, Backend::OpenCL)
+    ->ArgName("length")
+    ->Arg(0)
+    ->Arg(8)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(SmallStep, cpu, Backend::Cpu)->Unit(benchmark::kMillisecond)->UseRealTime();
