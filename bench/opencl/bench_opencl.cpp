@@ -386,36 +386,23 @@ class SummaryReporter : public benchmark::ConsoleReporter {
             "aim <= 1.2)\n",
             b, i100 / i10, i100, i10);
     }
-    for (const char* b : {"cpu", "opencl"}) {
-      const std::string on = std::string("DeathEvents/") + b + "/record:1",
-                        off = std::string("DeathEvents/") + b + "/record:0";
-      const double d = deathsPerStep_[on];
-      if (usPerStep_[on] > 0 && usPerStep_[off] > 0 && d > 0)
-        std::printf(
-            "  %-6s death events: %.0f us a step recording %.0f deaths, %.0f us not: %.1f ns an "
-            "event\n",
-            b, usPerStep_[on], d, usPerStep_[off], (usPerStep_[on] - usPerStep_[off]) * 1e3 / d);
-    }
-    for (const char* b : {"cpu", "opencl"}) {
-      const std::string on = std::string("CollisionEvents/") + b + "/record:1",
-                        off = std::string("CollisionEvents/") + b + "/record:0";
-      const double e = eventsPerStep_[on];
-      if (usPerStep_[on] > 0 && usPerStep_[off] > 0 && e > 0)
-        std::printf(
-            "  %-6s collision events: %.0f us a step recording %.0f events, %.0f us not: %.1f ns "
-            "an event\n",
-            b, usPerStep_[on], e, usPerStep_[off], (usPerStep_[on] - usPerStep_[off]) * 1e3 / e);
-    }
-    for (const char* b : {"cpu", "opencl"}) {
-      const std::string on = std::string("Trails/") + b + "/length:8",
-                        off = std::string("Trails/") + b + "/length:0";
-      const double n = live_[on];
-      if (usPerStep_[on] > 0 && usPerStep_[off] > 0 && n > 0)
-        std::printf(
-            "  %-6s trails of 8: %.0f us a step for %.0f particles, %.0f us without: %.2f ns a "
-            "particle\n",
-            b, usPerStep_[on], n, usPerStep_[off], (usPerStep_[on] - usPerStep_[off]) * 1e3 / n);
-    }
+    // What a feature costs a unit: the step with it against without, over the units
+    // (`count`: the per-step counter of the run with it).
+    auto perUnit = [&](const char* what, const std::string& bench, const char* with,
+                       const char* without, const std::map<std::string, double>& count,
+                       const char* unit) {
+      for (const char* b : {"cpu", "opencl"}) {
+        const std::string on = bench + "/" + b + "/" + with, off = bench + "/" + b + "/" + without;
+        const auto n = count.find(on);
+        if (usPerStep_[on] > 0 && usPerStep_[off] > 0 && n != count.end() && n->second > 0)
+          std::printf("  %-6s %s: %.0f us a step with %.0f %ss, %.0f us without: %.2f ns per %s\n",
+                      b, what, usPerStep_[on], n->second, unit, usPerStep_[off],
+                      (usPerStep_[on] - usPerStep_[off]) * 1e3 / n->second, unit);
+      }
+    };
+    perUnit("death events", "DeathEvents", "record:1", "record:0", deathsPerStep_, "event");
+    perUnit("collision events", "CollisionEvents", "record:1", "record:0", eventsPerStep_, "event");
+    perUnit("trails of 8", "Trails", "length:8", "length:0", live_, "particle");
     if (gCompile.measured)
       std::printf(
           "  kernel program build, first step of a new Context: cold %.0f ms, cached in "
