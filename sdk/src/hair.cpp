@@ -26,9 +26,13 @@ void simulateHair(GroupImpl& g, const StepParams& sp) {
   h.size = g.size;
   g.size = 0;
 
-  const std::uint32_t firstId = h.lanes[std::size_t(Attribute::Id)][0].u()[0];
-  std::uint32_t lastId = firstId;
-  for (std::size_t i = 0; i < h.size; ++i) lastId = std::max(lastId, h.lanePointers().id[i]);
+  // The survivors were born last, up to g.nextId - 1: the first-born of them sets the first
+  // slot (not particle 0, whose place a later-born takes when the first-born died in its birth
+  // step: compaction fills from the tail). Counted back from nextId, as ids wrap at 2^32.
+  const std::uint32_t* ids = h.lanePointers().id;
+  std::uint32_t back = 0;  // how far before the last-born the first-born survivor is
+  for (std::size_t i = 0; i < h.size; ++i) back = std::max(back, g.nextId - 1u - ids[i]);
+  const std::uint32_t firstId = g.nextId - 1u - back, lastId = g.nextId - 1u;
   struct Strand {
     std::vector<Vec3> p;
     std::vector<Vec4> c;

@@ -231,6 +231,38 @@ TEST(Hair, StrandsHoldEachParticlesWholeLife) {
   EXPECT_EQ(g.stats().emitted, 20u);
 }
 
+// Newborns that die in their birth step leave holes that compaction fills from the tail
+// before the strands are made: particle 0's place then holds the last-born. Each survivor
+// still gets its own strand, in the order of birth (ids), and the dead none.
+TEST(Hair, NewbornsDeadInTheirBirthStepLeaveNoStrand) {
+  for (unsigned threads : {1u, 2u}) {
+    ContextOptions o;
+    o.dt = 0.05;
+    o.threads = threads;
+    Context ctx(o);
+    Group& g = ctx.createGroup("hair", 1000);
+    g.setHair({true, 1, 64});
+    auto burst = [&](float lifetime, float x) {
+      Emitter e;
+      e.bursts = {{0.0, 10, 0.0, 1}};
+      e.position = Vec3(x, 0.0f, 0.0f);
+      e.types[0].velocity = Domain::point(Vec3(0, 5, 0));
+      e.types[0].lifetime = lifetime;
+      g.addEmitter(e);
+    };
+    burst(0.001f, 0.0f);  // the first ten born: dead within their birth step
+    burst(1.0f, 1.0f);    // the next ten live a second
+    g.setActions({Gravity{}, Move{}, KillOld{}});
+    ctx.step();
+    const Strands& s = g.strands();
+    ASSERT_EQ(s.size(), 10u) << threads;
+    for (std::size_t k = 0; k < s.size(); ++k) {
+      EXPECT_GE(s.start[k + 1] - s.start[k], 19u);
+      EXPECT_EQ(s.position[s.start[k]].x, 1.0f);  // the second emitter's
+    }
+  }
+}
+
 TEST(UnionDomain, SamplesAllPartsByMeasure) {
   const Domain u =
       Domain::unite({Domain::box(Vec3(0), Vec3(1)), Domain::box(Vec3(10, 0, 0), Vec3(13, 1, 1))});
