@@ -394,11 +394,6 @@ void Context::Impl::feedDeathEmitters() {
       if (!source)
         throw Error("group '" + gi.name + "': deathEmitters[" + std::to_string(k) +
                     "].source: no group named '" + gi.deathEmitters[k].source + "' in the context");
-      // A device's hair group keeps strands of the step's own newborns only (fl_hair).
-      if (backendKind != Backend::Cpu && gi.hair.enabled)
-        throw Error("group '" + gi.name + "': deathEmitters[" + std::to_string(k) +
-                    "]: a group in hair mode takes no sub-emitter's newborns on the device yet "
-                    "(the CPU backend runs it)");
       if (gi.deathEmitters[k].on == DeathEmitter::Trigger::Collision) {
         source->impl_->collisionsFeed = true;  // records them all for it
       } else if (gi.deathEmitters[k].on == DeathEmitter::Trigger::Birth) {

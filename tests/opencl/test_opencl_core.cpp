@@ -225,6 +225,42 @@ TEST(OpenCLCore, HairStrandsMatchTheCpu) {
               cpu.strands.size(), cpu.strands.vertexCount(), worst);
 }
 
+// A hair group fed by a sub-emitter: the newborns the host appends after a step are made
+// strands in the next, with that step's own newborns, in id order, as on the CPU.
+TEST(OpenCLCore, HairFedByASubEmitterAsOnTheCpu) {
+  FLURRY_REQUIRE_OPENCL();
+  auto run = [](Backend backend) {
+    Context ctx(parityOptions(backend));
+    Group& sparks = ctx.createGroup("sparks", 4000);
+    sparks.addEmitter(spray(Vec3(0.0f, 1.0f, 0.0f), 600));
+    sparks.setActions({Gravity{kDown}, Move{}, KillOld{}});
+    Group& fur = ctx.createGroup("fur", 6000);
+    Emitter own = spray(Vec3(2.0f, 0.0f, 0.0f), 150);
+    own.types[0].lifetime = 0.6f;
+    fur.addEmitter(own);
+    DeathEmitter de;
+    de.source = "sparks";
+    de.count = 0.5f;
+    de.types[0].velocity = Domain::sphere(Vec3(0.0f, 1.0f, 0.0f), 0.5f);
+    de.types[0].lifetime = 0.5f;
+    fur.addDeathEmitter(de);
+    fur.setActions({Gravity{kDown}, Move{}, KillOld{}});
+    fur.setHair({true, 2, 16});
+    ctx.run(120);
+    return std::pair(fur.strands(), fur.stats());
+  };
+  const auto [cpu, cpuStats] = run(Backend::Cpu);
+  const auto [cl, clStats] = run(Backend::OpenCL);
+  EXPECT_EQ(cpuStats.emitted, clStats.emitted);
+  EXPECT_GT(cpuStats.emitted, 900u);  // its own 600 and the sub-emitter's
+  ASSERT_EQ(cpu.start, cl.start);
+  for (std::size_t v = 0; v < cpu.vertexCount(); ++v)
+    for (int c = 0; c < 3; ++c)
+      ASSERT_LE(std::abs(cpu.position[v][c] - cl.position[v][c]),
+                kAbs + kRel * std::abs(cpu.position[v][c]))
+          << "vertex " << v;
+}
+
 TEST(OpenCLCore, ACallbackMayNotReturn) {
   FLURRY_REQUIRE_OPENCL();
   ContextOptions o;

@@ -876,6 +876,9 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   const std::uint32_t births = std::uint32_t(std::min<std::uint64_t>(total, g.capacity));
   g.stats.droppedAtCapacity += total - births;  // the device sees at most `capacity`
   f.births = births;
+  // A hair group's strands: the particles it began the step with (a sub-emitter's newborns,
+  // appended by the host; otherwise it is empty) and its newborns, in id order.
+  const std::size_t hairStrands = g.hair.enabled ? std::min(size_ + births, g.capacity) : 0;
 
   // The step acts on the live particles and its newborns: an upper bound of both.
   std::size_t bound = size_;
@@ -886,7 +889,7 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   const std::size_t deathRoom = g.deathRoom();  // Group::recordDeaths
   const bool trails = trailSlots_ > 0;
   // Nothing on the device changes (but a trail's new head, as on the CPU).
-  if (!acts && births == 0 && !trails) return;
+  if (!acts && births == 0 && !trails && hairStrands == 0) return;
   if (hits && acts) {
     // Room for every particle deflected by each Bounce in each sub-step, or the most a step
     // had, within one buffer the device allows; taken before anything of the step is queued.
@@ -1153,8 +1156,8 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
       launch(k, std::max(roundUp(nBound, kSmallLocal), kSmallLocal), kSmallLocal,
              "fl_trail_record");
     }
-    if (g.hair.enabled && births > 0) {
-      queueHair(g, sp, births);
+    if (g.hair.enabled && hairStrands > 0) {
+      queueHair(g, sp, hairStrands);
       f.births = 0;  // the group is empty again after the step
     }
 
@@ -1172,10 +1175,10 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   deviceNewer_ = true;
   fresh_ = AttributeSet();
   trailFresh_ = false;
-  if (g.hair.enabled && births > 0) {
+  if (g.hair.enabled && hairStrands > 0) {
     // Strands are host data: the step's come back now.
     drain(g);
-    readStrands(g, births);
+    readStrands(g, hairStrands);
   }
   while (inFlight_.size() > kMaxInFlight) retire(g, true);
   while (!inFlight_.empty()) {  // take what is done without waiting

@@ -358,7 +358,10 @@ std::string hairKernel(const std::string& stepCode, const std::vector<LaneRef>& 
     s << "  " << (info(l.attribute).isUint ? "uint " : "float ") << l.name << " = l_" << l.name
       << "[i];\n";
   const bool color = stored.has(Attribute::Color), size = stored.has(Attribute::Size);
-  s << "  const uint strand = id - state[FL_STATE_FIRST_ID];\n"
+  // Strands in id order, from the first of the particles the step began with (a sub-emitter's
+  // newborns, appended by the host: ids just before the step's own) to its last newborn.
+  s << "  const uint strand = id - (state[FL_STATE_FIRST_ID] - (state[FL_STATE_OLD_SIZE] - "
+       "state[FL_STATE_BORN]));\n"
        "  uint count = 0u;\n"
        "#define FL_RECORD() do { if (count < maxVertices) { const uint o = strand * maxVertices + "
        "count;"
