@@ -32,18 +32,12 @@ FL_INLINE void fl_turn_up(float dt, float* ux, float* uy, float* uz, float wx, f
   *uz = z * ct + cz * st + kz * d;
 }
 
-/* A double that travels as two uints of FlActionParams::u (low word first). */
-FL_INLINE fl_real fl_real_from_words(uint lo, uint hi) {
-  return fl_real_from_bits(((ulong)hi << 32) | (ulong)lo);
-}
-
-/* Restore (forces.h fl_restore_step). u[0..1]: start, u[2..3]: start + duration, as doubles.
- * dt: the particle's sub-step. */
+/* Restore (forces.h fl_restore_step). dt: the particle's sub-step. */
 FL_INLINE void fl_restore(__global const FlActionParams* a, float dt, fl_real time, float* px,
                           float* py, float* pz, float* vx, float* vy, float* vz, float hx,
                           float hy, float hz) {
-  if (!fl_restore_started(fl_real_from_words(a->u[0], a->u[1]), time)) return;
-  const float left = fl_restore_left(fl_real_from_words(a->u[2], a->u[3]), time);
+  if (!fl_restore_started(fl_real_from_bits(a->own.restore.start), time)) return;
+  const float left = fl_restore_left(fl_real_from_bits(a->own.restore.end), time);
   fl_restore_step(left, dt, hx, hy, hz, px, py, pz, vx, vy, vz);
 }
 

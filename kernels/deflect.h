@@ -427,6 +427,24 @@ FL_INLINE int fl_on_segment(float wx, float wy, float wz, float dx, float dy, fl
   return (t >= 0.0f) & (t <= 1.0f);
 }
 
+/* Whether a point of the plane lies on Bounce's planar piece (FL_PIECE_*, params.h; a literal,
+ * so the tests of the other pieces fold away), from the record both backends make. */
+FL_INLINE int fl_on_piece(const FlBounceParams* b, int piece, float x, float y, float z) {
+  const float wx = x - b->point.x, wy = y - b->point.y, wz = z - b->point.z;
+  if (piece == FL_PIECE_RECTANGLE || piece == FL_PIECE_TRIANGLE) {
+    const FlXyz u = b->piece.dual.u, v = b->piece.dual.v;
+    return piece == FL_PIECE_RECTANGLE ? fl_on_rectangle(wx, wy, wz, u.x, u.y, u.z, v.x, v.y, v.z)
+                                       : fl_on_triangle(wx, wy, wz, u.x, u.y, u.z, v.x, v.y, v.z);
+  }
+  if (piece == FL_PIECE_DISC)
+    return fl_on_disc(wx, wy, wz, b->piece.disc.outer2, b->piece.disc.inner2);
+  if (piece == FL_PIECE_SEGMENT) {
+    const FlXyz d = b->piece.segment.direction;
+    return fl_on_segment(wx, wy, wz, d.x, d.y, d.z, b->piece.segment.length2);
+  }
+  return 1;
+}
+
 /* ---- Collision events (Group::recordCollisions): where a deflected particle met a solid ---- */
 
 /* When the straight path p + v·t meets a sphere (centre c, radius R) within [0, dt]: from

@@ -97,16 +97,192 @@ typedef struct FlBirthRun {
   fl_u32 kind;    /* FL_RUN_* */
 } FlBirthRun;
 
-/* One action's constants, computed on the host as the CPU backend computes them (so the
- * products with dt round the same way), by the packer of the action's family
- * (sdk/src/opencl/actions_*.cpp), which documents its f[] and u[] there. `domain` holds the
- * action's region, surface or sampled domain (fl_sample and fl_inside read it directly);
- * data longer than f[] (keys over life, a mesh's or union's data, grids) goes into the
- * list's `extra` floats, at offsets the packer puts in u[] or in the domain. */
+/* ---- Each action's constants, by name --------------------------------------------------
+ * Made on the host by the action's packer (sdk/src/opencl/actions_*.cpp) as the CPU backend
+ * makes them, so that the products with dt round the same way, and read by its function in
+ * its .cl file. A `decay` is exp(-rate * dt) made with std::exp for the step's `dt`, so the
+ * device agrees with the CPU to the bit; a sub-step of another length makes its own. */
+
+/* Three floats (OpenCL's float3 takes the room of four). */
+typedef struct FlXyz {
+  float x, y, z;
+} FlXyz;
+
+typedef struct FlGravityParams {
+  FlXyz acceleration;
+} FlGravityParams;
+
+/* Damping and RotDamping. */
+typedef struct FlDampingParams {
+  FlXyz decay, rate;
+  float dt;
+} FlDampingParams;
+
+typedef struct FlOrbitPointParams {
+  FlXyz center;
+  float magnitude, epsilon, maxRadius;
+} FlOrbitPointParams;
+
+typedef struct FlOrbitLineParams {
+  FlXyz point, axis; /* axis: unit, normalised as the CPU does */
+  float magnitude, epsilon, maxRadius;
+} FlOrbitLineParams;
+
+typedef struct FlVortexParams {
+  FlXyz center, axis; /* axis: unit */
+  float aroundSpeed, coreRadius, tightness, inSpeed, upSpeed, maxRadius;
+  float responsiveness, dt, decay;
+} FlVortexParams;
+
+/* Jet: the ball it acts in (its acceleration is the action's domain). */
+typedef struct FlJetParams {
+  FlXyz center;
+  float radius;
+} FlJetParams;
+
+typedef struct FlExplosionParams {
+  FlXyz center;
+  float speed, magnitude, epsilon, time;
+  float invTwoVariance; /* 1 / (2 stddev^2), apply()'s */
+  float twoVariance;    /* 2 stddev^2, accumulate()'s */
+} FlExplosionParams;
+
+typedef struct FlTurbulenceParams {
+  float amplitude, frequency;
+  FlXyz drift;
+  fl_u32 octaves;
+} FlTurbulenceParams;
+
+typedef struct FlElectricParams {
+  FlXyz field;
+} FlElectricParams;
+
+typedef struct FlMagneticParams {
+  FlXyz direction; /* field / |field|, 0 for no field */
+  float strength;  /* |field| */
+  FlXyz field;
+} FlMagneticParams;
+
+/* SampledField: the grid's samples (xyz each, x fastest) in the list's `extra` from `first`. */
+typedef struct FlSampledFieldParams {
+  FlXyz origin;
+  float voxelSize, strength, responsiveness, dt, decay;
+  fl_u32 first, nx, ny, nz;
+  fl_u32 carry; /* 1 for Mode::Velocity: carried towards the field */
+} FlSampledFieldParams;
+
+/* TargetVelocity, TargetRotVelocity, TargetColor, TargetSize: the target (a vector's three,
+ * or colour and alpha, or a size), approached at `rate`. */
+typedef struct FlTargetParams {
+  float target[4];
+  float rate, dt, decay;
+} FlTargetParams;
+
+typedef struct FlSpeedClampParams {
+  float minSpeed, maxSpeed;
+} FlSpeedClampParams;
+
+/* ColorOverLife, SizeOverLife: `keys` keys in the list's `extra` from `first`, each its t
+ * then its value (r g b a, or a size). */
+typedef struct FlCurveParams {
+  fl_u32 first, keys;
+} FlCurveParams;
+
+/* Restore: its start and start + duration, doubles as their bits. */
+typedef struct FlRestoreParams {
+  fl_u64 start, end;
+} FlRestoreParams;
+
+/* Bounce, as both backends prepare it (sdk/src/actions.cpp bounceParams): the plane of a
+ * planar piece (a segment's wall: its normal in the group's plane), or a sphere's center as
+ * `point`; on the device the surface itself is also the action's domain (boxes, and the
+ * integrators' guard). The planar pieces, as deflect.h fl_on_piece tells them: */
+#define FL_PIECE_PLANE 0
+#define FL_PIECE_RECTANGLE 1
+#define FL_PIECE_TRIANGLE 2
+#define FL_PIECE_DISC 3
+#define FL_PIECE_SEGMENT 4
+typedef struct FlBounceParams {
+  FlXyz point, normal;
+  float restitution, keep /* 1 - friction */, cutoff2;
+  union FlBouncePiece {
+    struct FlBounceDual {
+      FlXyz u, v; /* rectangle, triangle: the dual vectors of its edges */
+    } dual;
+    struct FlBounceDisc {
+      float outer2, inner2;
+    } disc;
+    struct FlBounceSegment {
+      FlXyz direction;
+      float length2;
+    } segment;
+    struct FlBounceSphere {
+      float radius, radius2, invRadius;
+      float reach; /* |center|_1 + radius */
+    } sphere;
+  } piece;
+} FlBounceParams;
+
+/* Sink: the chance that a particle it takes passes it. */
+typedef struct FlSinkParams {
+  float passThrough;
+} FlSinkParams;
+
+typedef struct FlAvoidParams {
+  float magnitude, epsilon, lookAhead;
+} FlAvoidParams;
+
+typedef struct FlConstrain2DParams {
+  FlXyz point, normal; /* normal: unit */
+} FlConstrain2DParams;
+
+/* Gravitate and Follow: a soft pull. */
+typedef struct FlPullParams {
+  float magnitude, epsilon, maxRadius2;
+} FlPullParams;
+
+/* MatchVelocity, MatchRotVelocity: `approach` is 1 - exp(-rate * dt). */
+typedef struct FlMatchParams {
+  float rate, dt, maxRadius2, approach;
+} FlMatchParams;
+
+/* A force's falloff (forces.h FlFalloff). */
+typedef struct FlFalloffParams {
+  float cx, cy, cz, radius, power;
+} FlFalloffParams;
+
+/* One action's constants. `domain` holds its region, surface or sampled domain (fl_sample
+ * and fl_inside read it directly); data longer than its own (keys over life, a mesh's or
+ * union's data, grids) goes into the list's `extra` floats, at offsets its own record or
+ * its domain holds. */
 typedef struct FlActionParams {
   FlDomain domain;
-  float f[32];
-  fl_u32 u[8];
+  union FlActionOwn {
+    float raw[24]; /* the size; first, so that value-initialising zeroes it all */
+    FlGravityParams gravity;
+    FlDampingParams damping;
+    FlOrbitPointParams orbitPoint;
+    FlOrbitLineParams orbitLine;
+    FlVortexParams vortex;
+    FlJetParams jet;
+    FlExplosionParams explosion;
+    FlTurbulenceParams turbulence;
+    FlElectricParams electric;
+    FlMagneticParams magnetic;
+    FlSampledFieldParams sampledField;
+    FlTargetParams target;
+    FlSpeedClampParams speedClamp;
+    FlCurveParams curve;
+    FlRestoreParams restore;
+    FlBounceParams bounce;
+    FlSinkParams sink;
+    FlAvoidParams avoid;
+    FlConstrain2DParams constrain2d;
+    FlPullParams pull;
+    FlMatchParams match;
+  } own;
+  FlFalloffParams falloff; /* a force's, where it has one */
+  fl_u32 pad;
 } FlActionParams;
 
 /* The group's device-side state: one small buffer of uints, read back asynchronously after

@@ -23,48 +23,32 @@ FL_INLINE float fl_surf_distance(__global const FlActionParams* a, uint kind, fl
 
 /* ---- Bounce ------------------------------------------------------------------------------ */
 
-/* How the deflector reflects (kernels/deflect.h): f[6] restitution, f[7] 1 - friction,
- * f[8] cutoff^2. */
+/* How the deflector reflects (kernels/deflect.h). */
 FL_INLINE FlReflect fl_reflect_of(__global const FlActionParams* a) {
+  __global const FlBounceParams* b = &a->own.bounce;
   FlReflect r;
-  r.restitution = a->f[6];
-  r.keep = a->f[7];
-  r.cutoff2 = a->f[8];
+  r.restitution = b->restitution;
+  r.keep = b->keep;
+  r.cutoff2 = b->cutoff2;
   return r;
 }
 
-#define FL_PIECE_PLANE 0
-#define FL_PIECE_RECTANGLE 1
-#define FL_PIECE_TRIANGLE 2
-#define FL_PIECE_DISC 3
-#define FL_PIECE_SEGMENT 4
-
-/* Whether a point of the plane lies on the piece (piece is a literal: folded away); the
- * tests are kernels/deflect.h's. f[0..2] the piece's point; rectangle f[10..15] its dual
- * vectors, triangle f[10..15] its edges' dual vectors, disc f[10] outer² f[11] inner²,
- * segment f[10..12] its direction f[13] its length². */
-FL_INLINE int fl_on_piece(__global const FlActionParams* a, int piece, float x, float y, float z) {
-  __global const float* f = a->f;
-  const float wx = x - f[0], wy = y - f[1], wz = z - f[2];
-  if (piece == FL_PIECE_RECTANGLE)
-    return fl_on_rectangle(wx, wy, wz, f[10], f[11], f[12], f[13], f[14], f[15]);
-  if (piece == FL_PIECE_TRIANGLE)
-    return fl_on_triangle(wx, wy, wz, f[10], f[11], f[12], f[13], f[14], f[15]);
-  if (piece == FL_PIECE_DISC) return fl_on_disc(wx, wy, wz, f[10], f[11]);
-  if (piece == FL_PIECE_SEGMENT) return fl_on_segment(wx, wy, wz, f[10], f[11], f[12], f[13]);
-  return 1;
+/* deflect.h fl_on_piece on the action's record. */
+FL_INLINE int fl_bounce_on_piece(__global const FlActionParams* a, int piece, float x, float y,
+                                 float z) {
+  const FlBounceParams b = a->own.bounce;
+  return fl_on_piece(&b, piece, x, y, z);
 }
 
-/* A two-sided planar deflector (kernels/deflect.h, as on the CPU). f[0..2] a point of the
- * plane, f[3..5] its unit normal. */
+/* A two-sided planar deflector (kernels/deflect.h, as on the CPU). */
 FL_INLINE void fl_bounce_planar(__global const FlActionParams* a, int piece, float dt, float* px,
                                 float* py, float* pz, float* vxs, float* vys, float* vzs) {
-  const float Px = a->f[0], Py = a->f[1], Pz = a->f[2];
-  const float Nx = a->f[3], Ny = a->f[4], Nz = a->f[5];
+  const FlXyz P = a->own.bounce.point, N = a->own.bounce.normal;
+  const float Px = P.x, Py = P.y, Pz = P.z, Nx = N.x, Ny = N.y, Nz = N.z;
   float side, tau, hx, hy, hz;
   const int reaches = fl_planar_hit(*px, *py, *pz, *vxs, *vys, *vzs, dt, Px, Py, Pz, Nx, Ny, Nz,
                                     &side, &tau, &hx, &hy, &hz);
-  if (!(reaches && fl_on_piece(a, piece, hx, hy, hz))) return;
+  if (!(reaches && fl_bounce_on_piece(a, piece, hx, hy, hz))) return;
   fl_planar_bounce(fl_reflect_of(a), 1, side, tau, hx, hy, hz, dt, Px, Py, Pz, Nx, Ny, Nz, px, py,
                    pz, vxs, vys, vzs);
 }
@@ -74,27 +58,28 @@ FL_INLINE void fl_bounce_planar(__global const FlActionParams* a, int piece, flo
 FL_INLINE void fl_bounce_planar_accel(__global const FlActionParams* a, int piece, float dt,
                                       float ax, float ay, float az, float* px, float* py, float* pz,
                                       float* vxs, float* vys, float* vzs) {
-  const float Px = a->f[0], Py = a->f[1], Pz = a->f[2];
-  const float Nx = a->f[3], Ny = a->f[4], Nz = a->f[5];
+  const FlXyz P = a->own.bounce.point, N = a->own.bounce.normal;
+  const float Px = P.x, Py = P.y, Pz = P.z, Nx = N.x, Ny = N.y, Nz = N.z;
   float side, tau, hx, hy, hz;
   const int hit = fl_planar_accel_hit(*px, *py, *pz, *vxs, *vys, *vzs, ax, ay, az, dt, Px, Py, Pz,
                                       Nx, Ny, Nz, &side, &tau, &hx, &hy, &hz) &
-                  fl_on_piece(a, piece, hx, hy, hz);
+                  fl_bounce_on_piece(a, piece, hx, hy, hz);
   if (!hit) return;
   fl_planar_accel_bounce(fl_reflect_of(a), side, tau, hx, hy, hz, dt, ax, ay, az, Px, Py, Pz, Nx,
                          Ny, Nz, px, py, pz, vxs, vys, vzs);
 }
 
 /* A sphere deflecting from outside (inside == 0) or keeping particles in: kernels/deflect.h,
- * as on the CPU. f[0..2] center, f[9] |C|_1 + R, f[10] R, f[11] R^2, f[12] 1/R. */
+ * as on the CPU. */
 FL_INLINE void fl_bounce_sphere(__global const FlActionParams* a, int inside, float dt, float* px,
                                 float* py, float* pz, float* vxs, float* vys, float* vzs) {
   const FlReflect rf = fl_reflect_of(a);
-  fl_bounce_sphere_once(rf, a->f[0], a->f[1], a->f[2], a->f[10], a->f[11], a->f[12], a->f[9],
-                        inside, dt, px, py, pz, vxs, vys, vzs);
+  const FlXyz C = a->own.bounce.point;
+  const struct FlBounceSphere s = a->own.bounce.piece.sphere;
+  fl_bounce_sphere_once(rf, C.x, C.y, C.z, s.radius, s.radius2, s.invRadius, s.reach, inside, dt,
+                        px, py, pz, vxs, vys, vzs);
   if (inside)
-    fl_bounce_sphere_again(rf, a->f[0], a->f[1], a->f[2], a->f[10], a->f[11], dt, px, py, pz, vxs,
-                           vys, vzs);
+    fl_bounce_sphere_again(rf, C.x, C.y, C.z, s.radius, s.radius2, dt, px, py, pz, vxs, vys, vzs);
 }
 
 /* A box keeping particles in (inside == 1) or deflecting them from outside: kernels/deflect.h.
@@ -122,16 +107,18 @@ FL_INLINE void fl_log_collision(__global const FlActionParams* a, int solid, int
   float hx, hy, hz, nx, ny, nz, tau;
   if (solid == 0) {
     float side;
-    const float Nx = a->f[3], Ny = a->f[4], Nz = a->f[5];
-    fl_planar_accel_hit(px, py, pz, vx, vy, vz, ax, ay, az, dt, a->f[0], a->f[1], a->f[2], Nx,
-                        Ny, Nz, &side, &tau, &hx, &hy, &hz);
+    const FlXyz P = a->own.bounce.point, N = a->own.bounce.normal;
+    const float Nx = N.x, Ny = N.y, Nz = N.z;
+    fl_planar_accel_hit(px, py, pz, vx, vy, vz, ax, ay, az, dt, P.x, P.y, P.z, Nx, Ny, Nz, &side,
+                        &tau, &hx, &hy, &hz);
     nx = Nx * side;
     ny = Ny * side;
     nz = Nz * side;
   } else {
     if (solid == 1) {
-      tau = fl_sphere_hit(px, py, pz, vx, vy, vz, a->f[0], a->f[1], a->f[2], a->f[10], inside, dt,
-                          &nx, &ny, &nz);
+      const FlXyz C = a->own.bounce.point;
+      tau = fl_sphere_hit(px, py, pz, vx, vy, vz, C.x, C.y, C.z, a->own.bounce.piece.sphere.radius,
+                          inside, dt, &nx, &ny, &nz);
     } else {
       __global const float* box = a->domain.v;
       const float p[3] = {px, py, pz}, v[3] = {vx, vy, vz};
@@ -184,7 +171,7 @@ FL_INLINE void fl_log_collision(__global const FlActionParams* a, int solid, int
 /* After a Move by an integrator other than semi-implicit Euler: a particle that its curved
  * step left on the wrong side of the deflector, compared with where it began the step
  * (sx, sy, sz), is put back on its side and reflected (fused_pass.cpp guard). The surface is
- * a->domain (packBounce); a segment's wall normal and point are f[3..5] and f[0..2]. */
+ * a->domain (packSurfaceAction); a segment's wall is its FlBounceParams plane. */
 FL_INLINE void fl_bounce_guard(__global const FlActionParams* a, uint kind, int inside, float sx,
                                float sy, float sz, float* px, float* py, float* pz, float* vx,
                                float* vy, float* vz, __global const float* shapes) {
@@ -193,30 +180,21 @@ FL_INLINE void fl_bounce_guard(__global const FlActionParams* a, uint kind, int 
   const int seg = kind == FL_DOMAIN_LINE;
   float3 nrm, back;
   if (fl_surf_planar(kind) || seg) {
-    nrm = seg ? fl_v3(a->f + 3) : fl_normal_leaf(d, kind, p0, shapes);
-    const float3 o = seg ? fl_v3(a->f) : fl_closest(d, kind, p0, shapes);
-    const float d0 = fl_dotv(p0 - o, nrm);
-    if (d0 < 0.0f) nrm = -nrm; /* towards the side it started on */
-    const float d1 = fl_dotv(p1 - o, nrm);
-    const float margin = 1e-6f * (1.0f + fl_lengthv(p1));
-    if (d1 >= margin) return;
-    /* Only if the step's chord passes through the piece (a plane: always). */
-    const float dd0 = fabs(d0);
-    const float3 hit = p0 + (p1 - p0) * (dd0 / (dd0 - d1));
-    if (!seg && !(fl_surf_distance(a, kind, hit, shapes) <= 1e-4f * (1.0f + fl_lengthv(hit))))
-      return;
-    back = p1 + nrm * (margin - d1);
+    const FlXyz wallN = a->own.bounce.normal, wallP = a->own.bounce.point;
+    nrm = seg ? (float3)(wallN.x, wallN.y, wallN.z) : fl_normal_leaf(d, kind, p0, shapes);
+    const float3 o = seg ? (float3)(wallP.x, wallP.y, wallP.z) : fl_closest(d, kind, p0, shapes);
+    float3 hit;
+    if (!fl_guard_planar(p0, p1, o, &nrm, &hit, &back)) return;
+    if (!seg && !fl_guard_on_piece(fl_surf_distance(a, kind, hit, shapes), hit)) return;
   } else {
-    const int in0 = fl_inside(d, kind, p0.x, p0.y, p0.z);
-    const int in1 = fl_inside(d, kind, p1.x, p1.y, p1.z);
-    if (in1 == in0 || in0 != inside) return;
+    if (!fl_guard_crossed(fl_inside(d, kind, p0.x, p0.y, p0.z), fl_inside(d, kind, p1.x, p1.y, p1.z),
+                          inside))
+      return;
     const float3 c = fl_closest(d, kind, p1, shapes);
-    nrm = fl_normal_leaf(d, kind, c, shapes) * (inside ? -1.0f : 1.0f);
-    back = c + nrm * (1e-5f * (1.0f + fl_lengthv(c)));
+    nrm = fl_normal_leaf(d, kind, c, shapes);
+    back = fl_guard_solid_back(c, inside, &nrm);
   }
-  float3 v = (float3)(*vx, *vy, *vz);
-  const float vn = fl_dotv(v, nrm);
-  if (vn < 0.0f) v -= nrm * (vn * (1.0f + a->f[6]));
+  const float3 v = fl_guard_reflect((float3)(*vx, *vy, *vz), nrm, a->own.bounce.restitution);
   *px = back.x;
   *py = back.y;
   *pz = back.z;
@@ -255,10 +233,10 @@ FL_INLINE void fl_sink_hit(__global const FlActionParams* a, uint kind, float dt
   *dead = fl_dead_sink_hit(fl_surf_distance(a, kind, h, shapes), h, code, *dead);
 }
 
-/* The particles this absorber just took survive if they pass it (absorb.h). f[0] passThrough. */
+/* The particles this absorber just took survive if they pass it (absorb.h). */
 FL_INLINE void fl_sink_pass(__global const FlActionParams* a, uint id, uint code, uint* dead,
                             uint seedLo, uint seedHi, uint key) {
-  *dead = fl_dead_after_pass(*dead, code, id, key, seedLo, seedHi, a->f[0]);
+  *dead = fl_dead_after_pass(*dead, code, id, key, seedLo, seedHi, a->own.sink.passThrough);
 }
 
 /* Hides the particles inside the region (absorb.h); the list's first blocker has set vis to 1
@@ -270,13 +248,14 @@ FL_INLINE void fl_block(__global const FlActionParams* a, uint kind, float x, fl
 
 /* ---- Avoid, Constrain2D ------------------------------------------------------------------ */
 
-/* actions_more.hpp apply(Avoid). f[0] magnitude, f[1] epsilon, f[2] lookAhead. */
+/* actions_more.hpp apply(Avoid). */
 FL_INLINE void fl_avoid(__global const FlActionParams* a, uint kind, float dt, float x, float y,
                         float z, float* vx, float* vy, float* vz, __global const float* shapes) {
   __global const float* d = a->domain.v;
   const int planar = fl_surf_planar(kind);
   const float3 p = (float3)(x, y, z), v = (float3)(*vx, *vy, *vz);
-  const float3 ahead = p + v * a->f[2];
+  __global const FlAvoidParams* av = &a->own.avoid;
+  const float3 ahead = p + v * av->lookAhead;
   int threat;
   if (planar) {
     float3 h;
@@ -291,22 +270,23 @@ FL_INLINE void fl_avoid(__global const FlActionParams* a, uint kind, float dt, f
   const float dist = fl_surf_distance(a, kind, p, shapes);
   float3 away = fl_normal_any(d, kind, p, shapes);
   if (planar && fl_dotv(p - fl_closest_any(d, kind, p, shapes), away) < 0.0f) away = -away;
-  fl_add_scaled(away.x, away.y, away.z, fl_avoid_push(a->f[0], a->f[1], dist) * dt, vx, vy, vz);
+  fl_add_scaled(away.x, away.y, away.z, fl_avoid_push(av->magnitude, av->epsilon, dist) * dt, vx, vy, vz);
 }
 
-/* forces.h fl_constrain_2d. f[0..2] point, f[3..5] unit normal. */
+/* forces.h fl_constrain_2d. */
 FL_INLINE void fl_constrain2d(__global const FlActionParams* a, float* px, float* py, float* pz,
                               float* vx, float* vy, float* vz) {
-  __global const float* f = a->f;
-  fl_constrain_2d(f[0], f[1], f[2], f[3], f[4], f[5], px, py, pz, vx, vy, vz);
+  const FlXyz P = a->own.constrain2d.point, N = a->own.constrain2d.normal;
+  fl_constrain_2d(P.x, P.y, P.z, N.x, N.y, N.z, px, py, pz, vx, vy, vz);
 }
 
 /* ---- Neighbours: the particles as they were at the start of the step (FL_SNAP) ----------- */
 
-/* forces.h fl_soft_pull towards d, added to acc. f[0] magnitude, f[1] epsilon, f[2] maxR^2. */
+/* forces.h fl_soft_pull towards d, added to acc. */
 FL_INLINE void fl_add_soft_pull(__global const FlActionParams* a, float3 d, float3* acc) {
+  __global const FlPullParams* q = &a->own.pull;
   float x, y, z;
-  fl_soft_pull(d.x, d.y, d.z, a->f[0], a->f[1], a->f[2], &x, &y, &z);
+  fl_soft_pull(d.x, d.y, d.z, q->magnitude, q->epsilon, q->maxRadius2, &x, &y, &z);
   *acc += (float3)(x, y, z);
 }
 
@@ -342,13 +322,14 @@ FL_INLINE void fl_add_accel(float3 acc, float dt, float* vx, float* vy, float* v
 }
 
 /* actions_more.hpp matchMean: towards the mean of the neighbours' field (snapshot attribute
- * `field`: 1 velocity, 2 angular velocity) within maxR. f[0] rate, f[1] the dt f[3] was
- * computed for, f[2] maxR^2, f[3] 1 - exp(-rate dt); another dt (sub-steps) computes it. */
+ * `field`: 1 velocity, 2 angular velocity) within maxR; a dt other than the packed one
+ * (sub-steps) computes its own approach. */
 FL_INLINE void fl_match_toward_mean(__global const FlActionParams* a, __global const float* snap,
                                     uint snapStride, uint snapN, uint self, uint field, float dt,
                                     float px, float py, float pz, float* ox, float* oy, float* oz) {
-  const float k = dt == a->f[1] ? a->f[3] : 1.0f - exp(-a->f[0] * dt);
+  __global const FlMatchParams* m = &a->own.match;
+  const float k = dt == m->dt ? m->approach : 1.0f - exp(-m->rate * dt);
   fl_match_mean(&FL_SNAP(0, 0, 0), &FL_SNAP(0, 1, 0), &FL_SNAP(0, 2, 0), &FL_SNAP(field, 0, 0),
-                &FL_SNAP(field, 1, 0), &FL_SNAP(field, 2, 0), snapN, self, a->f[2], px, py, pz, k,
+                &FL_SNAP(field, 1, 0), &FL_SNAP(field, 2, 0), snapN, self, m->maxRadius2, px, py, pz, k,
                 ox, oy, oz);
 }

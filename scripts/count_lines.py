@@ -18,7 +18,7 @@ PARTS = [
     ("effect loader (effect.cpp)", [r"^sdk/src/effect/effect\.cpp$"]),
     ("effect files, all (reader, writer, descriptors, docs)", [r"^sdk/src/effect/.*\.(cpp|hpp)$"]),
     ("action plumbing (actions.cpp, traits, OpenCL packers, codegen)",
-     [r"^sdk/src/actions\.cpp$", r"^sdk/src/action_traits\.hpp$",
+     [r"^sdk/src/actions\.cpp$", r"^sdk/src/action_(traits|params)\.hpp$",
       r"^sdk/src/opencl/actions_\w+\.cpp$", r"^sdk/src/opencl/codegen\.(cpp|hpp)$"]),
     ("CPU math (cpu/ kernels, domains, sampling, noise, shapes)",
      [r"^sdk/src/cpu/(kernels|actions_more|integrate|collisions)\.hpp$",

@@ -2,6 +2,7 @@
 #include <string>
 #include <type_traits>
 
+#include "action_params.hpp"
 #include "action_traits.hpp"
 #include "effect/check_fields.hpp"
 #include "effect/descriptors.hpp"
@@ -159,6 +160,56 @@ struct Access {
 }  // namespace
 
 namespace detail {
+
+int planarPiece(const Bounce& b) {
+  const auto& s = b.surface.shape();
+  if (std::holds_alternative<PlaneDomain>(s)) return FL_PIECE_PLANE;
+  if (std::holds_alternative<RectangleDomain>(s)) return FL_PIECE_RECTANGLE;
+  if (std::holds_alternative<TriangleDomain>(s)) return FL_PIECE_TRIANGLE;
+  if (std::holds_alternative<DiscDomain>(s)) return FL_PIECE_DISC;
+  if (std::holds_alternative<LineDomain>(s)) return FL_PIECE_SEGMENT;
+  return -1;
+}
+
+cl::FlBounceParams bounceParams(const Bounce& a) {
+  const auto xyz = [](Vec3 v) { return cl::FlXyz{v.x, v.y, v.z}; };
+  cl::FlBounceParams b{};
+  b.restitution = a.restitution;
+  b.keep = 1.0f - a.friction;
+  b.cutoff2 = a.cutoff * a.cutoff;
+  auto plane = [&](Vec3 P, Vec3 N) {
+    b.point = xyz(P);
+    b.normal = xyz(N);
+  };
+  const auto& shape = a.surface.shape();
+  if (const auto* pl = std::get_if<PlaneDomain>(&shape)) {
+    plane(pl->point, pl->normal);
+  } else if (const auto* r = std::get_if<RectangleDomain>(&shape)) {
+    // Dual vectors give the (s, t) coordinates of a point of the plane, also for a rhombus.
+    const Vec3 cu = glm::cross(r->v, r->normal), cv = glm::cross(r->normal, r->u);
+    plane(r->origin, r->normal);
+    b.piece.dual = {xyz(cu / glm::dot(r->u, cu)), xyz(cv / glm::dot(r->v, cv))};
+  } else if (const auto* t = std::get_if<TriangleDomain>(&shape)) {
+    const Vec3 e1 = t->p1 - t->p0, e2 = t->p2 - t->p0;
+    const Vec3 c1 = glm::cross(e2, t->normal), c2 = glm::cross(t->normal, e1);
+    plane(t->p0, t->normal);
+    b.piece.dual = {xyz(c1 / glm::dot(e1, c1)), xyz(c2 / glm::dot(e2, c2))};
+  } else if (const auto* d = std::get_if<DiscDomain>(&shape)) {
+    plane(d->center, d->normal);
+    b.piece.disc = {d->outerRadius * d->outerRadius, d->innerRadius * d->innerRadius};
+  } else if (const auto* ln = std::get_if<LineDomain>(&shape)) {
+    // 2-D: a wall standing on the group's plane, its normal in that plane.
+    const Vec3 dir = ln->p1 - ln->p0;
+    plane(ln->p0, glm::normalize(glm::cross(dir, a.planeNormal)));
+    b.piece.segment = {xyz(dir), glm::dot(dir, dir)};
+  } else if (const auto* s = std::get_if<SphereDomain>(&shape)) {
+    const Vec3 C = s->center;
+    const float R = s->outerRadius;
+    b.point = xyz(C);
+    b.piece.sphere = {R, R * R, 1.0f / R, std::abs(C.x) + std::abs(C.y) + std::abs(C.z) + R};
+  }
+  return b;
+}
 
 AttributeAccess attributeAccess(const Action& a) {
   return std::visit(Access{}, a);

@@ -75,13 +75,15 @@ void guard(const Bounce& b, const Lanes& L, const float* const* start, std::size
   const Domain& d = b.surface;
   const auto* seg = std::get_if<LineDomain>(&d.shape());
   const bool planar = d.isPlanar() || seg;
+  // A segment is a wall standing on the group's plane (bounceParams).
+  const cl::FlXyz wall = bounceParams(b).normal;
+  const Vec3 wallNormal(wall.x, wall.y, wall.z);
   thread_local std::vector<std::uint32_t> nearStore, flagStore;
   std::vector<std::uint32_t>& near = nearStore;
   std::size_t count = n;
   if (planar && n > 0) {
     const Vec3 p00(start[0][0], start[1][0], start[2][0]);
-    const Vec3 N =
-        seg ? glm::normalize(glm::cross(seg->p1 - seg->p0, b.planeNormal)) : d.normal(p00);
+    const Vec3 N = seg ? wallNormal : d.normal(p00);
     const Vec3 P = seg ? seg->p0 : d.closestPoint(p00);
     // How far the exact test's own point on the piece (its closest point) may lie from P.
     float extent = 0.0f;
@@ -121,29 +123,19 @@ void guard(const Bounce& b, const Lanes& L, const float* const* start, std::size
     Vec3 p1(L.p[0][i], L.p[1][i], L.p[2][i]);
     Vec3 nrm, back;
     if (planar) {
-      nrm = seg ? glm::normalize(glm::cross(seg->p1 - seg->p0, b.planeNormal)) : d.normal(p0);
+      nrm = seg ? wallNormal : d.normal(p0);
       const Vec3 o = seg ? seg->p0 : d.closestPoint(p0);
-      const float d0 = glm::dot(p0 - o, nrm);
-      if (d0 < 0.0f) nrm = -nrm;  // towards the side it started on
-      const float d1 = glm::dot(p1 - o, nrm);
-      const float margin = 1e-6f * (1.0f + glm::length(p1));
-      if (d1 >= margin) continue;
-      // Only if the step's chord passes through the piece (a plane: always).
-      const float dd0 = std::abs(d0);
-      const Vec3 hit = p0 + (p1 - p0) * (dd0 / (dd0 - d1));
-      const bool onPiece = seg ? true : d.distance(hit) <= 1e-4f * (1.0f + glm::length(hit));
-      if (!onPiece) continue;
-      back = p1 + nrm * (margin - d1);
+      Vec3 hit;
+      if (!kernel::fl_guard_planar(p0, p1, o, &nrm, &hit, &back)) continue;
+      if (!seg && !kernel::fl_guard_on_piece(d.distance(hit), hit)) continue;
     } else {
-      const bool in0 = d.contains(p0), in1 = d.contains(p1);
-      if (in1 == in0 || in0 != b.inside) continue;
+      if (!kernel::fl_guard_crossed(d.contains(p0), d.contains(p1), b.inside)) continue;
       const Vec3 c = d.closestPoint(p1);
-      nrm = d.normal(c) * (b.inside ? -1.0f : 1.0f);
-      back = c + nrm * (1e-5f * (1.0f + glm::length(c)));
+      nrm = d.normal(c);
+      back = kernel::fl_guard_solid_back(c, b.inside, &nrm);
     }
-    Vec3 v(L.v[0][i], L.v[1][i], L.v[2][i]);
-    const float vn = glm::dot(v, nrm);
-    if (vn < 0.0f) v -= nrm * (vn * (1.0f + b.restitution));
+    const Vec3 v =
+        kernel::fl_guard_reflect(Vec3(L.v[0][i], L.v[1][i], L.v[2][i]), nrm, b.restitution);
     for (int c = 0; c < 3; ++c) {
       L.p[c][i] = back[c];
       L.v[c][i] = v[c];

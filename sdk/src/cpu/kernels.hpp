@@ -11,6 +11,7 @@
 #include <cstring>
 #include <type_traits>
 
+#include "../action_params.hpp"
 #include "../group_impl.hpp"
 #include "../isa_namespace.hpp"
 #include "../kernel_compat.hpp"
@@ -22,6 +23,8 @@
 namespace flurry::detail {
 inline namespace FLURRY_ISA_NAMESPACE {
 namespace kernel {
+using cl::FlBounceParams;  // the records deflect.h reads (params.h)
+using cl::FlXyz;
 #include "../../kernels/absorb.h"
 #include "../../kernels/deflect.h"
 #include "../../kernels/forces.h"
@@ -428,11 +431,12 @@ inline void bouncePlanarAccelLoop(float* __restrict px, float* __restrict py, fl
 template <bool Inside, class Dt>
 inline void bounceSphereLoop(float* __restrict px, float* __restrict py, float* __restrict pz,
                              float* __restrict vxs, float* __restrict vys, float* __restrict vzs,
-                             std::size_t n, Dt dts, const SphereDomain& s, const Bounce& b) {
+                             std::size_t n, Dt dts, const Bounce& b) {
   const kernel::FlReflect rf{b.restitution, 1.0f - b.friction, b.cutoff * b.cutoff};
-  const Vec3 C = s.center;
-  const float R = s.outerRadius, R2 = R * R, invR = 1.0f / R;
-  const float scaleC = std::abs(C.x) + std::abs(C.y) + std::abs(C.z) + R;
+  const cl::FlBounceParams bp = bounceParams(b);
+  const Vec3 C(bp.point.x, bp.point.y, bp.point.z);
+  const float R = bp.piece.sphere.radius, R2 = bp.piece.sphere.radius2;
+  const float invR = bp.piece.sphere.invRadius, scaleC = bp.piece.sphere.reach;
   // Through locals: the kernel's pointers would hide the arrays' __restrict from the
   // vectoriser.
   for (std::size_t i = 0; i < n; ++i) {
@@ -464,45 +468,33 @@ inline void bounceBoxLoop(float* __restrict px, float* __restrict py, float* __r
 }
 
 // Calls f(P, N, onPiece) for a planar Bounce surface (plane, rectangle, triangle, disc, and
-// the 2-D segment, a wall standing on the group's plane); false for the others.
+// the 2-D segment, a wall standing on the group's plane); false for the others. The plane and
+// the piece are the record the device reads too (bounceParams).
 template <class F>
 inline bool withPlanarPiece(const Bounce& a, F&& f) {
-  const auto& shape = a.surface.shape();
-  if (const auto* pl = std::get_if<PlaneDomain>(&shape)) {
-    f(pl->point, pl->normal, [](float, float, float) { return true; });
-  } else if (const auto* r = std::get_if<RectangleDomain>(&shape)) {
-    // Dual vectors give the (s, t) coordinates of a point of the plane, also for a rhombus.
-    const Vec3 cu = glm::cross(r->v, r->normal), cv = glm::cross(r->normal, r->u);
-    const Vec3 du = cu / glm::dot(r->u, cu), dv = cv / glm::dot(r->v, cv);
-    const Vec3 o = r->origin;
-    f(o, r->normal, [=](float x, float y, float z) {
-      return kernel::fl_on_rectangle(x - o.x, y - o.y, z - o.z, du.x, du.y, du.z, dv.x, dv.y, dv.z);
-    });
-  } else if (const auto* t = std::get_if<TriangleDomain>(&shape)) {
-    const Vec3 e1 = t->p1 - t->p0, e2 = t->p2 - t->p0;
-    const Vec3 c1 = glm::cross(e2, t->normal), c2 = glm::cross(t->normal, e1);
-    const Vec3 d1 = c1 / glm::dot(e1, c1), d2 = c2 / glm::dot(e2, c2);
-    const Vec3 o = t->p0;
-    f(o, t->normal, [=](float x, float y, float z) {
-      return kernel::fl_on_triangle(x - o.x, y - o.y, z - o.z, d1.x, d1.y, d1.z, d2.x, d2.y, d2.z);
-    });
-  } else if (const auto* d = std::get_if<DiscDomain>(&shape)) {
-    const Vec3 o = d->center;
-    const float ro2 = d->outerRadius * d->outerRadius, ri2 = d->innerRadius * d->innerRadius;
-    f(o, d->normal, [=](float x, float y, float z) {
-      return kernel::fl_on_disc(x - o.x, y - o.y, z - o.z, ro2, ri2);
-    });
-  } else if (const auto* ln = std::get_if<LineDomain>(&shape)) {
-    // 2-D: the segment is a wall standing on the group's plane; its normal lies in the plane.
-    const Vec3 dir = ln->p1 - ln->p0;
-    const float len2 = glm::dot(dir, dir);
-    const Vec3 nrm = glm::normalize(glm::cross(dir, a.planeNormal));
-    const Vec3 o = ln->p0;
-    f(o, nrm, [=](float x, float y, float z) {
-      return kernel::fl_on_segment(x - o.x, y - o.y, z - o.z, dir.x, dir.y, dir.z, len2);
-    });
-  } else {
-    return false;
+  const int piece = planarPiece(a);
+  if (piece < 0) return false;
+  const cl::FlBounceParams b = bounceParams(a);
+  const Vec3 P(b.point.x, b.point.y, b.point.z), N(b.normal.x, b.normal.y, b.normal.z);
+  auto on = [&]<int Piece>() {
+    f(P, N, [b](float x, float y, float z) { return kernel::fl_on_piece(&b, Piece, x, y, z); });
+  };
+  switch (piece) {
+    case FL_PIECE_PLANE:
+      on.template operator()<FL_PIECE_PLANE>();
+      break;
+    case FL_PIECE_RECTANGLE:
+      on.template operator()<FL_PIECE_RECTANGLE>();
+      break;
+    case FL_PIECE_TRIANGLE:
+      on.template operator()<FL_PIECE_TRIANGLE>();
+      break;
+    case FL_PIECE_DISC:
+      on.template operator()<FL_PIECE_DISC>();
+      break;
+    default:
+      on.template operator()<FL_PIECE_SEGMENT>();
+      break;
   }
   return true;
 }
@@ -518,11 +510,11 @@ inline void apply(const Bounce& a, const Lanes& L, std::size_t n, const BlockCon
     });
     if (planar) return;
     const auto& shape = a.surface.shape();
-    if (const auto* s = std::get_if<SphereDomain>(&shape)) {
+    if (std::holds_alternative<SphereDomain>(shape)) {
       if (a.inside)
-        bounceSphereLoop<true>(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, dt, *s, a);
+        bounceSphereLoop<true>(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, dt, a);
       else
-        bounceSphereLoop<false>(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, dt, *s, a);
+        bounceSphereLoop<false>(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, dt, a);
     } else if (const auto* bx = std::get_if<BoxDomain>(&shape)) {
       if (a.inside)
         bounceBoxLoop<true>(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, dt, *bx, a);

@@ -1,6 +1,6 @@
 // The core actions on the device: Move, KillOld, CopyVertexB, Restore, Callback (its OpenCL
 // body). Their functions are in kernels/actions.cl.
-#include <cstring>
+#include <bit>
 #include <regex>
 #include <string>
 
@@ -70,9 +70,8 @@ bool generateCoreAction(const Action& act, ActionSource& s) {
 bool packCoreAction(const Action& act, ActionPack& p) {
   if (const auto* r = std::get_if<Restore>(&act)) {
     // kernels.hpp apply(Restore) works in double from these (as bit patterns: params.h).
-    const double start = r->start, end = double(r->start) + r->duration;
-    std::memcpy(&p.p.u[0], &start, 8);
-    std::memcpy(&p.p.u[2], &end, 8);
+    p.p.own.restore = {std::bit_cast<cl::fl_u64>(double(r->start)),
+                       std::bit_cast<cl::fl_u64>(double(r->start) + r->duration)};
     return true;
   }
   return std::holds_alternative<KillOld>(act) || std::holds_alternative<Move>(act) ||

@@ -1,6 +1,6 @@
 // Forces, random and target actions and curves over life on the device: the calls the fused
-// act kernel makes (kernels/forces.cl) and the constants they read. The f[] and u[] of each
-// action are listed with its function in forces.cl.
+// act kernel makes (kernels/forces.cl) and the constants they read (their records are in
+// kernels/params.h).
 //
 // Products with dt are made on the device (dt there is the sub-step's): a host-made product
 // would be wrong under sub-steps. Exponentials of -rate·dt are the exception: the host packs
@@ -17,14 +17,6 @@ namespace flurry::detail::ocl {
 namespace {
 
 using A = Attribute;
-
-constexpr int kFalloff = 27;  // forces.cl FL_FALLOFF
-
-void putFalloff(float* f, const Falloff& fo) {
-  putVec(f, kFalloff, fo.center);
-  f[kFalloff + 3] = fo.radius;
-  f[kFalloff + 4] = fo.power;
-}
 
 // A domain the device samples: its kind as a literal (fl_sample_any folds its switch on
 // it); a mesh's or union's data is in the list's `extra` (packSampled), which the calls pass.
@@ -191,175 +183,107 @@ bool generateForceAction(const Action& act, ActionSource& s) {
 
 bool packForceAction(const Action& act, ActionPack& p) {
   const float dt = p.dt;
-  float* f = p.p.f;
-  cl::fl_u32* u = p.p.u;
-  // f[at] = the step's dt, f[at + 1] = exp(-rate·dt) as the CPU makes it (fl_decay).
-  auto decay = [&](int at, float rate) {
-    f[at] = dt;
-    f[at + 1] = std::exp(-rate * dt);
+  auto& own = p.p.own;
+  // exp(-rate·dt) as the CPU makes it, for the step's dt (fl_force_decay).
+  auto decay = [&](float rate) { return std::exp(-rate * dt); };
+  auto falloff = [&](const Falloff& f) {
+    p.p.falloff = {f.center.x, f.center.y, f.center.z, f.radius, f.power};
   };
-  // Targets: f[0..3] the target, [4] rate, [5..6] its decay.
   auto target = [&](float x, float y, float z, float w, float rate) {
-    f[0] = x;
-    f[1] = y;
-    f[2] = z;
-    f[3] = w;
-    f[4] = rate;
-    decay(5, rate);
+    own.target = {{x, y, z, w}, rate, dt, decay(rate)};
+  };
+  auto damping = [&](Vec3 rate) {
+    own.damping = {xyz(Vec3(decay(rate.x), decay(rate.y), decay(rate.z))), xyz(rate), dt};
   };
   if (const auto* g = std::get_if<Gravity>(&act)) {
-    putVec(f, 0, g->acceleration);
-    putFalloff(f, g->falloff);
-    return true;
-  }
-  // Damping and RotDamping: f[0..2] exp(-rate·dt), f[3..5] rate (Exact reads these), f[6] dt.
-  auto damping = [&](Vec3 rate) {
-    putVec(f, 0, Vec3(std::exp(-rate.x * dt), std::exp(-rate.y * dt), std::exp(-rate.z * dt)));
-    putVec(f, 3, rate);
-    f[6] = dt;
-  };
-  if (const auto* d = std::get_if<Damping>(&act)) {
+    own.gravity = {xyz(g->acceleration)};
+    falloff(g->falloff);
+  } else if (const auto* d = std::get_if<Damping>(&act)) {
     damping(d->rate);
-    putFalloff(f, d->falloff);
-    return true;
-  }
-  if (const auto* d = std::get_if<RotDamping>(&act)) {
-    damping(d->rate);
-    return true;
-  }
-  if (const auto* o = std::get_if<OrbitPoint>(&act)) {
-    putVec(f, 0, o->center);
-    f[3] = o->magnitude;
-    f[4] = o->epsilon;
-    f[5] = o->maxRadius;
-    return true;
-  }
-  if (const auto* o = std::get_if<OrbitLine>(&act)) {
-    putVec(f, 0, o->point);
-    putVec(f, 3, glm::normalize(o->axis));  // as the CPU normalises it, per block
-    f[6] = o->magnitude;
-    f[7] = o->epsilon;
-    f[8] = o->maxRadius;
-    return true;
-  }
-  if (const auto* v = std::get_if<Vortex>(&act)) {
-    putVec(f, 0, v->center);
-    putVec(f, 3, glm::normalize(v->axis));
-    f[6] = v->aroundSpeed;
-    f[7] = v->coreRadius;
-    f[8] = v->tightness;
-    f[9] = v->inSpeed;
-    f[10] = v->upSpeed;
-    f[11] = v->responsiveness;
-    f[12] = v->maxRadius;
-    decay(13, v->responsiveness);
-    return true;
-  }
-  if (const auto* j = std::get_if<Jet>(&act)) {
-    putVec(f, 0, j->center);
-    f[3] = j->radius;
+    falloff(d->falloff);
+  } else if (const auto* rd = std::get_if<RotDamping>(&act)) {
+    damping(rd->rate);
+  } else if (const auto* o = std::get_if<OrbitPoint>(&act)) {
+    own.orbitPoint = {xyz(o->center), o->magnitude, o->epsilon, o->maxRadius};
+  } else if (const auto* ol = std::get_if<OrbitLine>(&act)) {
+    // The axis normalised as the CPU normalises it, per block.
+    own.orbitLine = {xyz(ol->point), xyz(glm::normalize(ol->axis)), ol->magnitude, ol->epsilon,
+                     ol->maxRadius};
+  } else if (const auto* v = std::get_if<Vortex>(&act)) {
+    own.vortex = {xyz(v->center),
+                  xyz(glm::normalize(v->axis)),
+                  v->aroundSpeed,
+                  v->coreRadius,
+                  v->tightness,
+                  v->inSpeed,
+                  v->upSpeed,
+                  v->maxRadius,
+                  v->responsiveness,
+                  dt,
+                  decay(v->responsiveness)};
+  } else if (const auto* j = std::get_if<Jet>(&act)) {
+    own.jet = {xyz(j->center), j->radius};
     p.p.domain = packSampled(j->acceleration, p);
-    return true;
-  }
-  if (const auto* e = std::get_if<Explosion>(&act)) {
-    putVec(f, 0, e->center);
-    f[3] = e->speed;
-    f[4] = e->magnitude;
-    f[5] = 1.0f / (2.0f * e->stddev * e->stddev);  // apply()
-    f[6] = e->epsilon;
-    f[7] = e->time;
-    f[8] = 2 * e->stddev * e->stddev;  // accumulate()
-    return true;
-  }
-  if (const auto* r = std::get_if<RandomAccel>(&act)) {
-    p.p.domain = packSampled(r->acceleration, p);
-    putFalloff(f, r->falloff);
-    return true;
-  }
-  if (const auto* r = std::get_if<RandomDisplace>(&act)) {
-    p.p.domain = packSampled(r->displacement, p);
-    return true;
-  }
-  if (const auto* r = std::get_if<RandomVelocity>(&act)) {
-    p.p.domain = packSampled(r->velocity, p);
-    return true;
-  }
-  if (const auto* r = std::get_if<RandomRotVelocity>(&act)) {
-    p.p.domain = packSampled(r->rotVelocity, p);
-    return true;
-  }
-  if (const auto* t = std::get_if<Turbulence>(&act)) {
-    f[0] = t->amplitude;
-    f[1] = t->frequency;
-    putVec(f, 2, t->drift);
-    u[0] = cl::fl_u32(t->octaves);
-    putFalloff(f, t->falloff);
-    return true;
-  }
-  if (const auto* e = std::get_if<ElectricField>(&act)) {
-    putVec(f, 0, e->field);
-    putFalloff(f, e->falloff);
-    return true;
-  }
-  if (const auto* m = std::get_if<MagneticField>(&act)) {
+  } else if (const auto* e = std::get_if<Explosion>(&act)) {
+    const float twoVariance = 2 * e->stddev * e->stddev;
+    own.explosion = {xyz(e->center), e->speed, e->magnitude,
+                     e->epsilon,     e->time,  1.0f / (2.0f * e->stddev * e->stddev),
+                     twoVariance};
+  } else if (const auto* ra = std::get_if<RandomAccel>(&act)) {
+    p.p.domain = packSampled(ra->acceleration, p);
+    falloff(ra->falloff);
+  } else if (const auto* rp = std::get_if<RandomDisplace>(&act)) {
+    p.p.domain = packSampled(rp->displacement, p);
+  } else if (const auto* rv = std::get_if<RandomVelocity>(&act)) {
+    p.p.domain = packSampled(rv->velocity, p);
+  } else if (const auto* rr = std::get_if<RandomRotVelocity>(&act)) {
+    p.p.domain = packSampled(rr->rotVelocity, p);
+  } else if (const auto* t = std::get_if<Turbulence>(&act)) {
+    own.turbulence = {t->amplitude, t->frequency, xyz(t->drift), cl::fl_u32(t->octaves)};
+    falloff(t->falloff);
+  } else if (const auto* ef = std::get_if<ElectricField>(&act)) {
+    own.electric = {xyz(ef->field)};
+    falloff(ef->falloff);
+  } else if (const auto* m = std::get_if<MagneticField>(&act)) {
     const float B = glm::length(m->field);
-    putVec(f, 0, B > 0.0f ? m->field / B : Vec3(0.0f));
-    f[3] = B;
-    putVec(f, 4, m->field);
-    putFalloff(f, m->falloff);
-    return true;
-  }
-  if (const auto* sf = std::get_if<SampledField>(&act)) {
+    own.magnetic = {xyz(B > 0.0f ? m->field / B : Vec3(0.0f)), B, xyz(m->field)};
+    falloff(m->falloff);
+  } else if (const auto* sf = std::get_if<SampledField>(&act)) {
     const VectorField& field = *sf->field;
-    putVec(f, 0, field.origin);
-    f[3] = field.voxelSize;
-    f[4] = sf->strength;
-    f[5] = sf->responsiveness;
-    decay(6, sf->responsiveness);
-    u[0] = cl::fl_u32(p.extra.size());
-    u[1] = cl::fl_u32(field.dims.x);
-    u[2] = cl::fl_u32(field.dims.y);
-    u[3] = cl::fl_u32(field.dims.z);
-    u[4] = sf->mode == SampledField::Mode::Velocity ? 1u : 0u;
+    own.sampledField = {xyz(field.origin),
+                        field.voxelSize,
+                        sf->strength,
+                        sf->responsiveness,
+                        dt,
+                        decay(sf->responsiveness),
+                        cl::fl_u32(p.extra.size()),
+                        cl::fl_u32(field.dims.x),
+                        cl::fl_u32(field.dims.y),
+                        cl::fl_u32(field.dims.z),
+                        sf->mode == SampledField::Mode::Velocity ? 1u : 0u};
     for (const Vec3& v : field.data) p.extra.insert(p.extra.end(), {v.x, v.y, v.z});
-    putFalloff(f, sf->falloff);
-    return true;
-  }
-  if (const auto* t = std::get_if<TargetVelocity>(&act)) {
-    target(t->velocity.x, t->velocity.y, t->velocity.z, 0.0f, t->rate);
-    return true;
-  }
-  if (const auto* t = std::get_if<TargetRotVelocity>(&act)) {
-    target(t->rotVelocity.x, t->rotVelocity.y, t->rotVelocity.z, 0.0f, t->rate);
-    return true;
-  }
-  if (const auto* t = std::get_if<TargetColor>(&act)) {
-    target(t->color.x, t->color.y, t->color.z, t->alpha, t->rate);
-    return true;
-  }
-  if (const auto* t = std::get_if<TargetSize>(&act)) {
-    target(t->size, 0.0f, 0.0f, 0.0f, t->rate);
-    return true;
-  }
-  if (const auto* c = std::get_if<SpeedClamp>(&act)) {
-    f[0] = c->minSpeed;
-    f[1] = c->maxSpeed;
-    return true;
-  }
-  if (const auto* c = std::get_if<ColorOverLife>(&act)) {
-    u[0] = cl::fl_u32(p.extra.size());
-    u[1] = cl::fl_u32(c->keys.size());
-    for (const auto& k : c->keys)
+    falloff(sf->falloff);
+  } else if (const auto* tv = std::get_if<TargetVelocity>(&act)) {
+    target(tv->velocity.x, tv->velocity.y, tv->velocity.z, 0.0f, tv->rate);
+  } else if (const auto* tr = std::get_if<TargetRotVelocity>(&act)) {
+    target(tr->rotVelocity.x, tr->rotVelocity.y, tr->rotVelocity.z, 0.0f, tr->rate);
+  } else if (const auto* tc = std::get_if<TargetColor>(&act)) {
+    target(tc->color.x, tc->color.y, tc->color.z, tc->alpha, tc->rate);
+  } else if (const auto* ts = std::get_if<TargetSize>(&act)) {
+    target(ts->size, 0.0f, 0.0f, 0.0f, ts->rate);
+  } else if (const auto* c = std::get_if<SpeedClamp>(&act)) {
+    own.speedClamp = {c->minSpeed, c->maxSpeed};
+  } else if (const auto* co = std::get_if<ColorOverLife>(&act)) {
+    own.curve = {cl::fl_u32(p.extra.size()), cl::fl_u32(co->keys.size())};
+    for (const auto& k : co->keys)
       p.extra.insert(p.extra.end(), {k.t, k.color.r, k.color.g, k.color.b, k.color.a});
-    return true;
+  } else if (const auto* so = std::get_if<SizeOverLife>(&act)) {
+    own.curve = {cl::fl_u32(p.extra.size()), cl::fl_u32(so->keys.size())};
+    for (const auto& k : so->keys) p.extra.insert(p.extra.end(), {k.t, k.size});
+  } else {
+    return false;
   }
-  if (const auto* c = std::get_if<SizeOverLife>(&act)) {
-    u[0] = cl::fl_u32(p.extra.size());
-    u[1] = cl::fl_u32(c->keys.size());
-    for (const auto& k : c->keys) p.extra.insert(p.extra.end(), {k.t, k.size});
-    return true;
-  }
-  return false;
+  return true;
 }
 
 }  // namespace flurry::detail::ocl

@@ -4,75 +4,13 @@
 #include <cmath>
 #include <string>
 
+#include "../action_params.hpp"
 #include "codegen.hpp"
 #include "emission.hpp"
 
 namespace flurry::detail::ocl {
 
 namespace {
-
-// Which planar piece a Bounce surface is (FL_PIECE_*), or -1 for a solid.
-int pieceOf(const Domain& d) {
-  const auto& s = d.shape();
-  if (std::holds_alternative<PlaneDomain>(s)) return 0;
-  if (std::holds_alternative<RectangleDomain>(s)) return 1;
-  if (std::holds_alternative<TriangleDomain>(s)) return 2;
-  if (std::holds_alternative<DiscDomain>(s)) return 3;
-  if (std::holds_alternative<LineDomain>(s)) return 4;
-  return -1;
-}
-
-// As kernels.hpp apply(Bounce) prepares them. f[]: [0..2] plane point, [3..5] unit normal,
-// [6] restitution, [7] 1 - friction, [8] cutoff^2, then by surface: rectangle/triangle
-// [10..12] dual u, [13..15] dual v | disc [10] outer^2, [11] inner^2 | segment [10..12] its
-// direction, [13] its length^2 | sphere [0..2] center, [9] |C|_1 + R, [10] R, [11] R^2,
-// [12] 1/R; the surface itself in `domain` (boxes, and the integrators' guard).
-void packBounce(const Bounce& a, cl::FlActionParams& p) {
-  p.domain = packDomain(a.surface);
-  float* f = p.f;
-  f[6] = a.restitution;
-  f[7] = 1.0f - a.friction;
-  f[8] = a.cutoff * a.cutoff;
-  const auto& shape = a.surface.shape();
-  auto plane = [&](Vec3 P, Vec3 N) {
-    putVec(f, 0, P);
-    putVec(f, 3, N);
-  };
-  if (const auto* pl = std::get_if<PlaneDomain>(&shape)) {
-    plane(pl->point, pl->normal);
-  } else if (const auto* r = std::get_if<RectangleDomain>(&shape)) {
-    const Vec3 cu = glm::cross(r->v, r->normal), cv = glm::cross(r->normal, r->u);
-    const Vec3 du = cu / glm::dot(r->u, cu), dv = cv / glm::dot(r->v, cv);
-    plane(r->origin, r->normal);
-    putVec(f, 10, du);
-    putVec(f, 13, dv);
-  } else if (const auto* t = std::get_if<TriangleDomain>(&shape)) {
-    const Vec3 e1 = t->p1 - t->p0, e2 = t->p2 - t->p0;
-    const Vec3 c1 = glm::cross(e2, t->normal), c2 = glm::cross(t->normal, e1);
-    const Vec3 d1 = c1 / glm::dot(e1, c1), d2 = c2 / glm::dot(e2, c2);
-    plane(t->p0, t->normal);
-    putVec(f, 10, d1);
-    putVec(f, 13, d2);
-  } else if (const auto* d = std::get_if<DiscDomain>(&shape)) {
-    plane(d->center, d->normal);
-    f[10] = d->outerRadius * d->outerRadius;
-    f[11] = d->innerRadius * d->innerRadius;
-  } else if (const auto* ln = std::get_if<LineDomain>(&shape)) {
-    // 2-D: a wall standing on the group's plane, its normal in that plane.
-    const Vec3 dir = ln->p1 - ln->p0;
-    plane(ln->p0, glm::normalize(glm::cross(dir, a.planeNormal)));
-    putVec(f, 10, dir);
-    f[13] = glm::dot(dir, dir);
-  } else if (const auto* s = std::get_if<SphereDomain>(&shape)) {
-    const Vec3 C = s->center;
-    const float R = s->outerRadius;
-    putVec(f, 0, C);
-    f[9] = std::abs(C.x) + std::abs(C.y) + std::abs(C.z) + R;
-    f[10] = R;
-    f[11] = R * R;
-    f[12] = 1.0f / R;
-  }
-}
 
 // The kind literal of a region the device tests. The calls pass the list's `extra` as the
 // table where a mesh's or union's data is (packRegion), read for those kinds only.
@@ -85,19 +23,12 @@ cl::FlDomain packRegion(const Domain& d, ActionPack& p) {
   return ShapePacker{p.extra, {}, {}}.pack(d);
 }
 
-// Gravitate, Follow, Match*: f[0] magnitude (rate), f[1] epsilon, f[2] maxRadius^2.
-void packPull(float magnitude, float epsilon, float maxRadius, float* f) {
-  f[0] = magnitude;
-  f[1] = epsilon;
-  f[2] = maxRadius * maxRadius;
-}
-
 const char* kSnapArgs = "snap, snapStride, snapN, i";
 
 }  // namespace
 
 std::string bounceOnCurve(const Bounce& b, const std::string& params, const std::string& acc) {
-  const int piece = pieceOf(b.surface);
+  const int piece = planarPiece(b);
   if (piece < 0) return "";
   return "fl_bounce_planar_accel(" + params + ", " + std::to_string(piece) + ", dt, " + acc +
          "x, " + acc + "y, " + acc + "z, &px, &py, &pz, &vx, &vy, &vz);\n";
@@ -113,9 +44,8 @@ bool generateSurfaceAction(const Action& act, ActionSource& s) {
       s.apply = "fl_bounce_sphere(" + ap + ", " + in + ", dt, " + pv;
     else if (std::holds_alternative<BoxDomain>(shape))
       s.apply = "fl_bounce_box(" + ap + ", " + in + ", dt, " + pv;
-    else if (pieceOf(b->surface) >= 0)
-      s.apply =
-          "fl_bounce_planar(" + ap + ", " + std::to_string(pieceOf(b->surface)) + ", dt, " + pv;
+    else if (planarPiece(*b) >= 0)
+      s.apply = "fl_bounce_planar(" + ap + ", " + std::to_string(planarPiece(*b)) + ", dt, " + pv;
     else  // validation allows no other surface
       notOnDevice(std::string("Bounce on a ") + b->surface.name());
     return true;
@@ -188,54 +118,37 @@ bool generateSurfaceAction(const Action& act, ActionSource& s) {
 }
 
 bool packSurfaceAction(const Action& act, ActionPack& p) {
-  float* f = p.p.f;
+  auto& own = p.p.own;
   if (const auto* b = std::get_if<Bounce>(&act)) {
-    packBounce(*b, p.p);
-    return true;
-  }
-  if (const auto* k = std::get_if<Sink>(&act)) {
+    p.p.domain = packDomain(b->surface);  // boxes, and the integrators' guard
+    own.bounce = bounceParams(*b);
+  } else if (const auto* k = std::get_if<Sink>(&act)) {
     p.p.domain = packRegion(k->region, p);
-    f[0] = k->passThrough;
-    return true;
-  }
-  if (const auto* k = std::get_if<SinkVelocity>(&act)) {
-    p.p.domain = packRegion(k->velocity, p);
-    return true;
-  }
-  if (const auto* b = std::get_if<Block>(&act)) {
-    p.p.domain = packRegion(b->region, p);
-    return true;
-  }
-  if (const auto* k = std::get_if<Avoid>(&act)) {
-    p.p.domain = packRegion(k->obstacle, p);
-    f[0] = k->magnitude;
-    f[1] = k->epsilon;
-    f[2] = k->lookAhead;
-    return true;
-  }
-  if (const auto* k = std::get_if<Constrain2D>(&act)) {
-    putVec(f, 0, k->point);
-    putVec(f, 3, glm::normalize(k->normal));
-    return true;
-  }
-  if (const auto* k = std::get_if<Gravitate>(&act)) {
-    packPull(k->magnitude, k->epsilon, k->maxRadius, f);
-    return true;
-  }
-  if (const auto* k = std::get_if<Follow>(&act)) {
-    packPull(k->magnitude, k->epsilon, k->maxRadius, f);
-    return true;
-  }
-  const MatchVelocity* mv = std::get_if<MatchVelocity>(&act);
-  const auto* mr = std::get_if<MatchRotVelocity>(&act);
-  if (mv || mr) {
+    own.sink = {k->passThrough};
+  } else if (const auto* sv = std::get_if<SinkVelocity>(&act)) {
+    p.p.domain = packRegion(sv->velocity, p);
+  } else if (const auto* bl = std::get_if<Block>(&act)) {
+    p.p.domain = packRegion(bl->region, p);
+  } else if (const auto* av = std::get_if<Avoid>(&act)) {
+    p.p.domain = packRegion(av->obstacle, p);
+    own.avoid = {av->magnitude, av->epsilon, av->lookAhead};
+  } else if (const auto* c = std::get_if<Constrain2D>(&act)) {
+    own.constrain2d = {xyz(c->point), xyz(glm::normalize(c->normal))};
+  } else if (const auto* g = std::get_if<Gravitate>(&act)) {
+    own.pull = {g->magnitude, g->epsilon, g->maxRadius * g->maxRadius};
+  } else if (const auto* f = std::get_if<Follow>(&act)) {
+    own.pull = {f->magnitude, f->epsilon, f->maxRadius * f->maxRadius};
+  } else if (const auto* mv = std::get_if<MatchVelocity>(&act)) {
     // actions_more.hpp approach(rate, dt) for the step's dt; sub-steps compute their own.
-    const float rate = mv ? mv->magnitude : mr->magnitude;
-    packPull(rate, p.dt, mv ? mv->maxRadius : mr->maxRadius, f);
-    f[3] = 1.0f - std::exp(-rate * p.dt);
-    return true;
+    own.match = {mv->magnitude, p.dt, mv->maxRadius * mv->maxRadius,
+                 1.0f - std::exp(-mv->magnitude * p.dt)};
+  } else if (const auto* mr = std::get_if<MatchRotVelocity>(&act)) {
+    own.match = {mr->magnitude, p.dt, mr->maxRadius * mr->maxRadius,
+                 1.0f - std::exp(-mr->magnitude * p.dt)};
+  } else {
+    return false;
   }
-  return false;
+  return true;
 }
 
 }  // namespace flurry::detail::ocl

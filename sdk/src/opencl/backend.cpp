@@ -40,8 +40,9 @@ static_assert(sizeof(cl::FlEmitter) == 72 + 16 + 32 + 16 + 32 &&
               offsetof(cl::FlEmitter, start) == 72);
 static_assert(sizeof(cl::FlKeyframe) == 24 && offsetof(cl::FlKeyframe, position) == 8);
 static_assert(sizeof(cl::FlBirthRun) == 64 && offsetof(cl::FlBirthRun, emitter) == 56);
-static_assert(sizeof(cl::FlActionParams) == 72 + 32 * 4 + 8 * 4 &&
-              offsetof(cl::FlActionParams, f) == 72 && offsetof(cl::FlActionParams, u) == 200);
+static_assert(sizeof(cl::FlActionParams) == 72 + 24 * 4 + 6 * 4 &&
+              offsetof(cl::FlActionParams, own) == 72 &&
+              offsetof(cl::FlActionParams, falloff) == 168 && alignof(cl::FlActionParams) == 8);
 static_assert(FL_TILE % 16 == 0);
 
 namespace {

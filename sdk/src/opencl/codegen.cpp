@@ -256,7 +256,8 @@ std::string integrateMove(Integrator integrator, const std::vector<std::string>&
       for (std::size_t j = 0; j < accels.size(); ++j)
         if (!dampingParams[j].empty()) {
           const std::string& d = dampingParams[j];
-          c << "kx += " << d << "->f[3]; ky += " << d << "->f[4]; kz += " << d << "->f[5];\n";
+          const std::string k = d + "->own.damping.rate.";
+          c << "kx += " << k << "x; ky += " << k << "y; kz += " << k << "z;\n";
         }
       for (const char* d : {"x", "y", "z"})
         c << "fl_exact_step(a0a" << d << ", k" << d << ", dt, &p" << d << ", &v" << d << ");\n";
@@ -434,9 +435,9 @@ bool culledCode(const Action& a, std::size_t k, std::string& code) {
   if (const auto* g = std::get_if<Gravity>(&a)) {
     if (!(g->falloff.radius < kInfinity)) return false;
     // fl_gravity_falloff with its weight +0: v + a·(dt·0) turns -0 into +0.
-    const std::string ap = "(ap + " + std::to_string(k) + ")";
-    code = "vx = vx + " + ap + "->f[0] * (dt * 0.0f);\nvy = vy + " + ap +
-           "->f[1] * (dt * 0.0f);\nvz = vz + " + ap + "->f[2] * (dt * 0.0f);\n";
+    const std::string acc = "(ap + " + std::to_string(k) + ")->own.gravity.acceleration.";
+    code = "vx = vx + " + acc + "x * (dt * 0.0f);\nvy = vy + " + acc +
+           "y * (dt * 0.0f);\nvz = vz + " + acc + "z * (dt * 0.0f);\n";
     return true;
   }
   if (const auto* d = std::get_if<Damping>(&a)) return d->falloff.radius < kInfinity;
