@@ -162,6 +162,66 @@ TEST(Group, CompactionKeepsEverySurvivorOnceWithItsLanes) {
   }
 }
 
+// One thread walking a group's blocks fills the holes as it goes, from blocks it takes from
+// the back (fused_pass.cpp fillingWalk), and leaves compaction the rest where the front meets
+// the back: the particles end where compaction alone puts them (two threads share the pass
+// out and leave every hole to it), every lane and trail point bit for bit, however the dead
+// fall.
+TEST(Group, AWalkThatFillsHolesLeavesWhatCompactionWould) {
+  const std::pair<const char*, bool (*)(std::size_t)> patterns[] = {
+      {"every third, and the tail", [](std::size_t i) { return i % 3 == 0 || i >= 70000; }},
+      {"nine in ten", [](std::size_t i) { return (i * 2654435761u) % 10 != 0; }},
+      {"the first half", [](std::size_t i) { return i < 40000; }},
+      {"the last block", [](std::size_t i) { return i >= 79000; }},
+      {"one in a hundred", [](std::size_t i) { return i % 100 == 7; }}};
+  for (const auto& [name, dies] : patterns) {
+    SCOPED_TRACE(name);
+    auto run = [&, dies = dies](unsigned threads, std::uint64_t* filled) {
+      Context ctx({.seed = 3, .dt = 0.1, .threads = threads});
+      Group& g = ctx.createGroup("g", 81000);  // room for the newborns
+      g.require({Attribute::Color});
+      g.setTrail({.length = 3});
+      for (std::size_t i = 0; i < 80000; ++i) {
+        Particle p;
+        p.position = Vec3(float(i), dies(i) ? -1.0f : 1.0f, 0.0f);
+        p.velocity = Vec3(0.5f, float(i % 7), 0.0f);
+        p.color = Vec4(float(i), 0.0f, 1.0f, 1.0f);
+        EXPECT_TRUE(g.add(p));
+        if (i == 40000) ctx.step();  // (no actions yet) the first half's trails one point longer
+      }
+      // Born in the step too (newborns at the tail, which the walk takes from first).
+      Emitter e;
+      e.shape = Domain::point(Vec3(5.0f, 3.0f, 0.0f));
+      e.rate = 2000.0;
+      g.addEmitter(e);
+      g.setActions(
+          {Sink{Domain::box(Vec3(-1.0f, -2.0f, -1.0f), Vec3(90000.0f, 0.0f, 1.0f))}, Move{}});
+      ctx.step();
+      *filled = detail::implOf(g).filledByPass;
+      std::vector<float> all(g.ids().begin(), g.ids().end());
+      for (Attribute a : {Attribute::Position, Attribute::Velocity, Attribute::Color})
+        for (int c = 0; c < componentCount(a); ++c) {
+          const auto l = g.lane(a, c);
+          all.insert(all.end(), l.begin(), l.end());
+        }
+      Vec3 points[TrailOptions::kMaxLength];
+      for (std::size_t i = 0; i < g.size(); ++i) {
+        const std::size_t k = g.trail(i, points);
+        for (std::size_t j = 0; j < k; ++j)
+          all.insert(all.end(), {points[j].x, points[j].y, points[j].z});
+        all.push_back(float(k));
+      }
+      return all;
+    };
+    std::uint64_t walked = 0, shared = 0;
+    const auto one = run(1, &walked), two = run(2, &shared);
+    EXPECT_GT(walked, 0u) << "the walk filled no hole";
+    EXPECT_EQ(shared, 0u);
+    ASSERT_EQ(one.size(), two.size());
+    EXPECT_EQ(std::memcmp(one.data(), two.data(), one.size() * sizeof(float)), 0);
+  }
+}
+
 TEST(Group, CountsAddUpAndIdsStayUnique) {
   Context ctx;
   Group& g = samples::buildFountain(ctx, 50000, 30000.0, 0.4f);

@@ -1,6 +1,7 @@
 // The backend interface: how one step of one group is carried out.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 
@@ -65,5 +66,12 @@ void stopEmitting(GroupImpl& group, double at, bool showers);
 /// Fills the act pass's holes with the live particles at the tail, so [0, size) is dense
 /// again.
 void compact(GroupImpl& group, const StepParams& params);
+
+/// Every lane a particle has (its attributes' and its trail's), as words: what compaction
+/// moves.
+using StoredLanes = std::array<std::uint32_t*, std::size_t(Attribute::Count) * 4 +
+                                                   3 * TrailOptions::kMaxLength + 1>;
+/// Fills `stored` with the group's lanes; returns how many.
+std::size_t storedLanes(GroupImpl& group, StoredLanes& stored);
 
 }  // namespace flurry::detail

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 #include <span>
+#include <utility>
 
 #include "backend.hpp"
 #include "emission_plan.hpp"
@@ -563,6 +564,16 @@ void emitFromDeaths(GroupImpl& g, std::size_t k, const GroupImpl& source, std::u
     emitFrom<DeathEvent>(g, k, source.deathEvents, seed, source.ownSteps);
 }
 
+std::size_t storedLanes(GroupImpl& g, StoredLanes& stored) {
+  std::size_t lanes = 0;
+  for (auto& attr : g.lanes)
+    for (auto& lane : attr)
+      if (lane) stored[lanes++] = lane.u();
+  for (auto& lane : g.trailLanes) stored[lanes++] = lane.u();
+  if (g.trailCount) stored[lanes++] = g.trailCount.u();
+  return lanes;
+}
+
 void compact(GroupImpl& g, const StepParams& sp) {
   g.bornCount = 0;  // the step's newborns are ordinary particles from now on
   // Close the holes with the live particles at the tail: the lowest hole takes the last.
@@ -570,15 +581,19 @@ void compact(GroupImpl& g, const StepParams& sp) {
   const std::uint32_t* left = g.holes.data();  // ascending
   const std::size_t leftCount = g.holes.size();
   const std::size_t newSize = g.size - leftCount;
+  // Where the act pass stopped filling holes (none filled: from the top).
+  const std::size_t filled = std::exchange(g.holesFilled, 0);
+  const std::size_t from = filled > 0 ? g.filledFrom : g.size;
   thread_local std::vector<std::pair<std::uint32_t, std::uint32_t>> movesStore;
   auto& moves = movesStore;  // (from, to)
   moves.clear();
   // As many as the holes may ever be (their capacity only grows): a step that leaves more
   // holes than any before does not allocate.
   if (moves.capacity() < leftCount) moves.reserve(std::max(leftCount, g.holes.capacity()));
-  std::size_t src = g.size;      // candidates below this
-  std::size_t back = leftCount;  // holes at or above src are left[back..]
-  for (std::size_t h = 0; h < leftCount && left[h] < newSize; ++h) {
+  std::size_t src = from;  // candidates below this
+  // Holes at or above src are left[back..].
+  std::size_t back = std::size_t(std::lower_bound(left, left + leftCount, from) - left);
+  for (std::size_t h = filled; h < leftCount && left[h] < newSize; ++h) {
     do {
       --src;
     } while (back > 0 && left[back - 1] == src && (--back, true));
@@ -586,15 +601,8 @@ void compact(GroupImpl& g, const StepParams& sp) {
   }
   g.size = newSize;
   if (moves.empty()) return;
-  // Every stored lane and the trails' (no allocation).
-  std::array<std::uint32_t*, std::size_t(Attribute::Count) * 4 + 3 * TrailOptions::kMaxLength + 1>
-      stored;
-  std::size_t lanes = 0;
-  for (auto& attr : g.lanes)
-    for (auto& lane : attr)
-      if (lane) stored[lanes++] = lane.u();
-  for (auto& lane : g.trailLanes) stored[lanes++] = lane.u();
-  if (g.trailCount) stored[lanes++] = g.trailCount.u();
+  StoredLanes stored;
+  const std::size_t lanes = storedLanes(g, stored);
   auto moveLane = [&](std::uint32_t* lane, std::size_t a, std::size_t b) {
     for (std::size_t k = a; k < b; ++k) lane[moves[k].second] = lane[moves[k].first];
   };

@@ -200,7 +200,10 @@ struct PassScratch {
   std::vector<float> blockBounds;       ///< per block: min xyz, max xyz of its live particles
   std::vector<std::size_t> deathStart;  ///< each block's first death event
   std::vector<float> stepStart;         ///< positions at the step's start, for the guard
-  bool busy = false;                    ///< a step on this thread is using it
+  /// A pass that fills holes as it goes: the live particles of the blocks it took from the
+  /// back, highest first, the fillers still to give.
+  std::vector<std::uint32_t> spare;
+  bool busy = false;  ///< a step on this thread is using it
 };
 
 struct GroupImpl;
@@ -357,6 +360,11 @@ struct GroupImpl {
   bool boundsValid = false;          ///< stepBounds is the live particles' box now
   Bounds stepBounds;                 ///< of the last step's pass, when boundsValid
   std::vector<std::uint32_t> holes;  ///< sorted dead indices of this step
+  /// The first `holesFilled` of them the act pass has already filled, each with the live
+  /// particle compact() would have moved there, the last from index `filledFrom`: compact()
+  /// goes on from there (the same moves, in the same order, as if it made them all).
+  std::uint32_t holesFilled = 0, filledFrom = 0;
+  std::uint64_t filledByPass = 0;  ///< holes the act pass ever filled (for the tests)
   /// This step's newborns, written before the act pass: [bornFirst, bornFirst + bornCount),
   /// each with the part of the step it still has to live (seconds, bornRemaining[r]), which
   /// the pass runs it through the action list for.

@@ -461,10 +461,76 @@ std::uint32_t collectDead(PassScratch& pass, std::size_t base, std::size_t n,
   return count;
 }
 
+// The dead flags of a thread's blocks.
+struct DeadFlags {
+  std::vector<std::uint32_t> flags;
+  bool clean = true;
+};
+
+// The blocks [0, blocks) run by one thread (runOne(b)), in an order that lets it close the
+// step's holes while each block is still in cache: after a block from the front, each of its
+// holes takes the highest live particle, from blocks run from the back as needed. Those are
+// compact()'s moves, in its order (the lowest hole takes the last live particle), made here
+// instead of in a pass of their own that would read and write every lane again; the walk
+// stops filling where the front meets the back (a hole whose filler would be below it, or in
+// its own block) and leaves compact() the rest (GroupImpl::holesFilled).
+template <class RunOne>
+void fillingWalk(GroupImpl& g, PassScratch& pass, std::size_t B, std::size_t blocks,
+                 RunOne&& runOne) {
+  const std::size_t n = g.size;
+  StoredLanes stored;
+  const std::size_t laneCount = storedLanes(g, stored);
+  std::vector<std::uint32_t>& spare = pass.spare;
+  spare.clear();  // (room for n: actFusedImpl)
+  std::size_t next = 0, lo = 0, hi = blocks;
+  std::uint32_t filled = 0, from = 0;
+  // Runs the last block not run yet and keeps its live particles, highest first.
+  auto takeBack = [&] {
+    runOne(--hi);
+    const std::size_t first = hi * B;
+    const std::uint32_t* dead = pass.deadIndex.data() + first;  // ascending
+    std::uint32_t k = pass.deadCount[hi];
+    for (std::size_t i = std::min(n, first + B); i-- > first;) {
+      if (k > 0 && dead[k - 1] == i) {
+        --k;
+        continue;
+      }
+      spare.push_back(std::uint32_t(i));
+    }
+  };
+  bool filling = true;
+  for (; lo < hi; ++lo) {
+    runOne(lo);
+    const std::uint32_t* holes = pass.deadIndex.data() + lo * B;
+    // The block's fillers first, then lane by lane: one stream at a time (the lanes the
+    // actions did not touch are not in cache).
+    std::uint32_t k = 0;
+    for (const std::uint32_t dead = filling ? pass.deadCount[lo] : 0; k < dead; ++k) {
+      while (next + k == spare.size() && hi > lo + 1) takeBack();
+      if (next + k == spare.size()) {
+        filling = false;
+        break;
+      }
+    }
+    const std::uint32_t* fillers = spare.data() + next;
+    for (std::size_t l = 0; l < laneCount; ++l) {
+      std::uint32_t* __restrict lane = stored[l];
+      for (std::uint32_t j = 0; j < k; ++j) lane[holes[j]] = lane[fillers[j]];
+    }
+    if (k > 0) from = fillers[k - 1];
+    next += k;
+    filled += k;
+  }
+  g.holesFilled = filled;
+  g.filledFrom = from;
+  g.filledByPass += filled;
+}
+
 }  // namespace
 
 void actFusedImpl(GroupImpl& g, const StepParams& sp) {
   g.holes.clear();
+  g.holesFilled = 0;
   g.trailRecorded = false;  // until the pass below records them
   const std::size_t n = g.size;
   // At most n die: room for all of them, grown geometrically, so that a step that kills
@@ -480,6 +546,10 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
   const PassScratchUse scratch(g);
   PassScratch& pass = *scratch;
   pass.deadIndex.resize(n);
+  // The filling walk's fillers, at most n: grown with the dead list, so that a step that
+  // walks alone for the first time does not allocate either.
+  if (pass.spare.capacity() < pass.deadIndex.capacity())
+    pass.spare.reserve(pass.deadIndex.capacity());
   pass.deadCode.resize(n);
   assignFill(pass.deadCount, blocks, 0);
   assignFill(pass.culledCount, blocks, 0);
@@ -556,48 +626,60 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
   std::uint32_t* const trailCount = sp.fused ? g.nextTrailSlot(trailSlot) : nullptr;
   const std::uint32_t trailMost = g.trail.length;
   if (sp.fused) {
-    sp.pool->parallelFor(tasks, [&](std::size_t t) {
-      // The dead flags, all zero between blocks (collectDead clears what it takes); filled
-      // again only after a block that did not finish (an action threw).
-      struct DeadFlags {
-        std::vector<std::uint32_t> flags;
-        bool clean = true;
-      };
-      thread_local DeadFlags deadStore;
-      DeadFlags& store = deadStore;  // one TLS lookup, not one per use
+    // A block through the whole list, then what is taken while it is in cache: its guard
+    // against non-finite values, its trail slot, its bounds, its dead. The dead flags are all
+    // zero between blocks (collectDead clears what it takes); filled again only after a
+    // block that did not finish (an action threw).
+    auto runOne = [&](std::size_t b, DeadFlags& store) {
       std::vector<std::uint32_t>& dead = store.flags;
       if (dead.size() < B) dead.resize(B);
-      const std::size_t end = std::min(blocks, (t + 1) * blocksPerTask);
-      for (std::size_t b = t * blocksPerTask; b < end; ++b) {
-        const std::size_t first = b * B, m = std::min(B, n - first);
-        cpu::BlockContext ctx = base;
-        ctx.base = first;
-        if (!store.clean) std::fill(dead.begin(), dead.end(), 0u);
-        store.clean = false;
-        ctx.dead = dead.data();
-        const Lanes blockLanes = lanes.offset(first);
-        const std::size_t old = oldIn(first, m);
-        cpu::CollisionLog log{&g, b, t1, plan.substeps, 0};
-        ctx.collisions = logHits ? &log : nullptr;
-        for (std::uint32_t s = 0; s < plan.substeps; ++s) {
-          log.sub = s;
-          Culler culler;  // the sub-step's own bounds
-          runBlock(acts, plan, 0, acts.size(), blockLanes, m, old, atSubstep(ctx, s),
-                   remainingAt(first, old), s, t1, cull ? &culler : nullptr);
-          pass.culledCount[b] += culler.culled;
-        }
-        guardFinite(blockLanes, m, dead.data(), plan.list.guardVelocity);
-        if (trailCount) {
-          for (int c = 0; c < 3; ++c) std::copy_n(blockLanes.p[c], m, trailSlot[c] + first);
-          std::uint32_t* __restrict count = trailCount + first;
-          for (std::size_t i = 0; i < m; ++i) count[i] = std::min(count[i] + 1u, trailMost);
-        }
-        if (bounds) liveBounds(blockLanes, m, dead.data(), pass.blockBounds.data() + 6 * b);
-        pass.deadCount[b] = collectDead(pass, first, m, dead.data());
-        tally(b, pass.deadCount[b]);
-        store.clean = true;
+      const std::size_t first = b * B, m = std::min(B, n - first);
+      cpu::BlockContext ctx = base;
+      ctx.base = first;
+      if (!store.clean) std::fill(dead.begin(), dead.end(), 0u);
+      store.clean = false;
+      ctx.dead = dead.data();
+      const Lanes blockLanes = lanes.offset(first);
+      const std::size_t old = oldIn(first, m);
+      cpu::CollisionLog log{&g, b, t1, plan.substeps, 0};
+      ctx.collisions = logHits ? &log : nullptr;
+      for (std::uint32_t s = 0; s < plan.substeps; ++s) {
+        log.sub = s;
+        Culler culler;  // the sub-step's own bounds
+        runBlock(acts, plan, 0, acts.size(), blockLanes, m, old, atSubstep(ctx, s),
+                 remainingAt(first, old), s, t1, cull ? &culler : nullptr);
+        pass.culledCount[b] += culler.culled;
       }
-    });
+      guardFinite(blockLanes, m, dead.data(), plan.list.guardVelocity);
+      if (trailCount) {
+        for (int c = 0; c < 3; ++c) std::copy_n(blockLanes.p[c], m, trailSlot[c] + first);
+        std::uint32_t* __restrict count = trailCount + first;
+        for (std::size_t i = 0; i < m; ++i) count[i] = std::min(count[i] + 1u, trailMost);
+      }
+      if (bounds) liveBounds(blockLanes, m, dead.data(), pass.blockBounds.data() + 6 * b);
+      pass.deadCount[b] = collectDead(pass, first, m, dead.data());
+      tally(b, pass.deadCount[b]);
+      store.clean = true;
+    };
+    // One thread walking every block fills the holes as it goes (fillingWalk), unless the
+    // dead must stay in place for their death events, or a user's action could throw midway
+    // (the group would keep a particle twice).
+    const bool alone = sp.pool->size() == 1 || tasks == 1;
+    const bool fill = alone && blocks > 1 && g.deathRoom() == 0 &&
+                      std::none_of(acts.begin(), acts.end(), [](const Action& a) {
+                        return std::holds_alternative<Callback>(a);
+                      });
+    if (fill) {
+      thread_local DeadFlags deadStore;
+      fillingWalk(g, pass, B, blocks, [&](std::size_t b) { runOne(b, deadStore); });
+    } else {
+      sp.pool->parallelFor(tasks, [&](std::size_t t) {
+        thread_local DeadFlags deadStore;
+        DeadFlags& store = deadStore;  // one TLS lookup, not one per use
+        const std::size_t end = std::min(blocks, (t + 1) * blocksPerTask);
+        for (std::size_t b = t * blocksPerTask; b < end; ++b) runOne(b, store);
+      });
+    }
   } else {
     // The unfused baseline: one parallel pass over the whole group per action.
     assignFill(g.deadFlags, n, 0u);
