@@ -17,6 +17,9 @@ struct AttributeAccess {
   AttributeSet reads, writes;
 };
 AttributeAccess attributeAccess(const Action& a);
+/// Whether the action may change positions or velocities (it writes either; a Callback
+/// always may): the pass's bounds of a block are taken again after it, on both backends.
+bool movesParticles(const Action& a);
 
 /// The kill code that marks particles whose position or velocity became NaN or infinite.
 inline constexpr std::uint32_t kNonFiniteCode = 255;

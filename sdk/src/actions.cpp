@@ -215,6 +215,12 @@ AttributeAccess attributeAccess(const Action& a) {
   return std::visit(Access{}, a);
 }
 
+bool movesParticles(const Action& a) {
+  if (std::holds_alternative<Callback>(a)) return true;  // it may write what it did not declare
+  const AttributeSet w = attributeAccess(a).writes;
+  return w.has(Attribute::Position) || w.has(Attribute::Velocity);
+}
+
 bool isForce(const Action& a) {
   return std::holds_alternative<Gravity>(a) || std::holds_alternative<Damping>(a) ||
          std::holds_alternative<OrbitPoint>(a) || std::holds_alternative<OrbitLine>(a) ||

@@ -111,14 +111,6 @@ ActionPlan::Reach actionReach(const Action& a, const ActionPlan& plan, std::size
   return r;
 }
 
-// Whether action `a` may change positions or velocities.
-bool movesParticles(const Action& a) {
-  return !(std::holds_alternative<KillOld>(a) || std::holds_alternative<Sink>(a) ||
-           std::holds_alternative<SinkVelocity>(a) || std::holds_alternative<Block>(a) ||
-           std::holds_alternative<ColorOverLife>(a) || std::holds_alternative<SizeOverLife>(a) ||
-           std::holds_alternative<TargetColor>(a) || std::holds_alternative<TargetSize>(a) ||
-           std::holds_alternative<CopyVertexB>(a));
-}
 }  // namespace
 
 // Here, in a baseline translation unit, and not in the fused pass: the pass is compiled once

@@ -401,17 +401,6 @@ std::string hairKernel(const std::string& stepCode, const std::vector<LaneRef>& 
 
 namespace {
 
-// Whether action `a` may change positions or velocities: the work-group's bounds are taken
-// again after it (cpu_backend.cpp movesParticles; an action missing from this list only
-// costs a gather).
-bool mayMove(const Action& a) {
-  return !(std::holds_alternative<KillOld>(a) || std::holds_alternative<Sink>(a) ||
-           std::holds_alternative<SinkVelocity>(a) || std::holds_alternative<Block>(a) ||
-           std::holds_alternative<ColorOverLife>(a) || std::holds_alternative<SizeOverLife>(a) ||
-           std::holds_alternative<TargetColor>(a) || std::holds_alternative<TargetSize>(a) ||
-           std::holds_alternative<CopyVertexB>(a));
-}
-
 // What a culled action still does to stay bitwise exact (fused_pass.cpp applyCulled), or
 // false when it is never culled (no finite reach: cpu_backend.cpp actionReach, by the
 // action's kind; the host's reach in extra, scale >= 0, says whether it is this step).
@@ -492,7 +481,7 @@ std::string cullingBody(const std::vector<Action>& acts, const std::string& body
     if (std::holds_alternative<Callback>(acts[k]))
       piece[k] = "    if (fl_live) {\n" + piece[k] + "    }\n";
     const std::string r = "(extra + reachOff + " + std::to_string(k * FL_REACH_FLOATS) + "u)";
-    moves[k] = placed[k] != 0 && mayMove(acts[k]);
+    moves[k] = placed[k] != 0 && movesParticles(acts[k]);
     follow[k] = placed[k] == 1 && moves[k] ? followCode(acts[k], r) : "";
     cull[k] = placed[k] == 1 && culledCode(acts[k], k, culled[k]);
   }
