@@ -110,7 +110,8 @@ struct GroupStats {
   std::uint64_t emittersDropped = 0;
   /// Cumulative wall-clock seconds the CPU backend spent in each part of its steps: the
   /// action pass, the newborns (births planned and written), the compaction (holes closed
-  /// from the tail). For profiling; other backends leave them 0.
+  /// from the tail; a pass that one thread walks closes most of them as it goes, in `act`).
+  /// For profiling; other backends leave them 0.
   struct StepSeconds {
     double emit = 0.0;
     double act = 0.0;
