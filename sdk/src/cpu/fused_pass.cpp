@@ -76,7 +76,7 @@ void guard(const Bounce& b, const Lanes& L, const float* const* start, std::size
   const auto* seg = std::get_if<LineDomain>(&d.shape());
   const bool planar = d.isPlanar() || seg;
   // A segment is a wall standing on the group's plane (bounceParams).
-  const cl::FlXyz wall = bounceParams(b).normal;
+  const cl::FlXyz wall = seg ? bounceParams(b).normal : cl::FlXyz{};
   const Vec3 wallNormal(wall.x, wall.y, wall.z);
   thread_local std::vector<std::uint32_t> nearStore, flagStore;
   std::vector<std::uint32_t>& near = nearStore;

@@ -225,10 +225,9 @@ bool packForceAction(const Action& act, ActionPack& p) {
     own.jet = {xyz(j->center), j->radius};
     p.p.domain = packSampled(j->acceleration, p);
   } else if (const auto* e = std::get_if<Explosion>(&act)) {
-    const float twoVariance = 2 * e->stddev * e->stddev;
-    own.explosion = {xyz(e->center), e->speed, e->magnitude,
-                     e->epsilon,     e->time,  1.0f / (2.0f * e->stddev * e->stddev),
-                     twoVariance};
+    const float twoVariance = 2 * e->stddev * e->stddev;  // accumulate()'s; apply() its inverse
+    own.explosion = {xyz(e->center), e->speed,           e->magnitude, e->epsilon,
+                     e->time,        1.0f / twoVariance, twoVariance};
   } else if (const auto* ra = std::get_if<RandomAccel>(&act)) {
     p.p.domain = packSampled(ra->acceleration, p);
     falloff(ra->falloff);
