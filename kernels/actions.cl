@@ -32,15 +32,6 @@ FL_INLINE void fl_turn_up(float dt, float* ux, float* uy, float* uz, float wx, f
   *uz = z * ct + cz * st + kz * d;
 }
 
-/* Restore (forces.h fl_restore_step). dt: the particle's sub-step. */
-FL_INLINE void fl_restore(__global const FlActionParams* a, float dt, fl_real time, float* px,
-                          float* py, float* pz, float* vx, float* vy, float* vz, float hx,
-                          float hy, float hz) {
-  if (!fl_restore_started(fl_real_from_bits(a->own.restore.start), time)) return;
-  const float left = fl_restore_left(fl_real_from_bits(a->own.restore.end), time);
-  fl_restore_step(left, dt, hx, hy, hz, px, py, pz, vx, vy, vz);
-}
-
 /* ---- Spatial culling per work-group (fused_pass.cpp Culler) ------------------------------ */
 
 /* The work-group's swept bounds: the box its straight paths p .. p + v*dt lie in and the

@@ -1,10 +1,11 @@
 /* Forces, targets and speed limits, per particle: written once for both backends in the
  * kernels' shared C subset (compat_opencl.h on the device, sdk/src/kernel_compat.hpp on the
  * CPU, whose loops call these on locals and still vectorise). Scalars in, what changes through
- * pointers; each side passes an action's constants as arguments from its own storage
- * (forces.cl unpacks FlActionParams, actions_more.hpp the action's struct).
+ * pointers. Each force's own function (the last part of this file) takes its record
+ * (params.h), which one maker fills for both backends (sdk/src/action_params.hpp): the device
+ * passes the act kernel's copy, the CPU its own.
  *
- * The fl_*_accel functions are a force as an acceleration at a state (integrate.hpp
+ * The *_accel and *_acc functions are a force as an acceleration at a state (integrate.hpp
  * accumulate(), and the device's integrators): they ADD to *ax, *ay, *az. The others change
  * the velocity over a step dt. Where a step is taken (a pull is zero, the particle is out of
  * reach) the result is a select rather than an early return, so the CPU's loops vectorise and
@@ -12,13 +13,9 @@
 #ifndef FLURRY_KERNELS_FORCES_H
 #define FLURRY_KERNELS_FORCES_H
 
-/* A force's falloff: (1 - r/radius)^power inside the radius around (cx, cy, cz), 0 outside,
- * 1 everywhere for an infinite radius. */
-typedef struct FlFalloff {
-  float cx, cy, cz, radius, power;
-} FlFalloff;
-
-FL_INLINE float fl_falloff_weight(FlFalloff f, float px, float py, float pz) {
+/* A force's falloff (its record's FlFalloffParams): (1 - r/radius)^power inside the radius
+ * around (cx, cy, cz), 0 outside, 1 everywhere for an infinite radius. */
+FL_INLINE float fl_falloff_weight(FlFalloffParams f, float px, float py, float pz) {
   if (!(f.radius < INFINITY)) return 1.0f;
   const float dx = px - f.cx, dy = py - f.cy, dz = pz - f.cz;
   const float t = fl_maxf(0.0f, 1.0f - sqrt(dx * dx + dy * dy + dz * dz) / f.radius);
@@ -219,9 +216,8 @@ FL_INLINE void fl_magnetic_accel(float Bx, float By, float Bz, float q, float w,
   *az += (vx * By - Bx * vy) * q * w;
 }
 
-/* ---- SampledField: a trilinear lookup in a grid of vectors (field.hpp VectorField::sample),
- * positions outside taking the border's value. Each side reads the eight corners from its
- * own storage (the CPU's vector, the device's buffer) and blends them here. */
+/* ---- SampledField: a trilinear lookup in a grid of vectors (VectorField::sample),
+ * positions outside taking the border's value (fl_grid_sample below). */
 
 /* Along an axis of n samples, at g voxels from the grid's origin: the cell's lower sample
  * *i0 and upper *i1 (the same at the last sample), and the weight of *i1. The clamp is
@@ -246,6 +242,27 @@ FL_INLINE float fl_field_blend(float c000, float c100, float c010, float c110, f
   const float c00 = c000 * sx + c100 * tx, c10 = c010 * sx + c110 * tx;
   const float c01 = c001 * sx + c101 * tx, c11 = c011 * sx + c111 * tx;
   return (c00 * sy + c10 * ty) * (1.0f - tz) + (c01 * sy + c11 * ty) * tz;
+}
+
+/* The field's value at p: a grid of nx x ny x nz vectors of three floats each, x fastest, at
+ * `g`, from (ox, oy, oz) in steps of vs. Both backends read the same floats: the CPU its
+ * VectorField's, the device its copy in the act kernel's `extra`. */
+FL_INLINE float3 fl_grid_sample(const FL_GLOBAL float* g, int nx, int ny, int nz, float ox,
+                                float oy, float oz, float vs, float px, float py, float pz) {
+  int x0, x1, y0, y1, z0, z1;
+  const float tx = fl_field_axis((px - ox) / vs, nx, &x0, &x1);
+  const float ty = fl_field_axis((py - oy) / vs, ny, &y0, &y1);
+  const float tz = fl_field_axis((pz - oz) / vs, nz, &z0, &z1);
+  /* The corner (x, y, z)'s component k (64-bit: a grid may pass 2^32 floats). */
+#define FL_CORNER(x, y, z, k) \
+  g[((ulong)(x) + (ulong)nx * ((ulong)(y) + (ulong)ny * (ulong)(z))) * 3u + (k)]
+#define FL_BLEND(k)                                                                         \
+  fl_field_blend(FL_CORNER(x0, y0, z0, k), FL_CORNER(x1, y0, z0, k), FL_CORNER(x0, y1, z0, k), \
+                 FL_CORNER(x1, y1, z0, k), FL_CORNER(x0, y0, z1, k), FL_CORNER(x1, y0, z1, k), \
+                 FL_CORNER(x0, y1, z1, k), FL_CORNER(x1, y1, z1, k), tx, ty, tz)
+  return make_float3(FL_BLEND(0), FL_BLEND(1), FL_BLEND(2));
+#undef FL_BLEND
+#undef FL_CORNER
 }
 
 /* ---- Targets, speed limits ---------------------------------------------------------------- */
@@ -364,6 +381,296 @@ FL_INLINE void fl_curve_lookup(const FL_GLOBAL float* keys, uint count, uint str
   const FL_GLOBAL float* v0 = keys + (hi - 1) * stride + 1;
   const FL_GLOBAL float* v1 = keys + hi * stride + 1;
   for (uint c = 0; c + 1 < stride; ++c) out[c] = v0[c] + (v1[c] - v0[c]) * w;
+}
+
+/* ---- Each force from its record (params.h), as both backends call it ---------------------- */
+
+/* exp(-rate dt): the maker's value (std::exp) for the step length it made the record for, so
+ * that both backends use the same bits; computed for any other length (a newborn's rest of its
+ * step, a sub-step on the device). */
+FL_INLINE float fl_force_decay(float rate, float dt, float madeDt, float made) {
+  return dt == madeDt ? made : exp(-rate * dt);
+}
+
+/* fl_approach, with the maker's exp for the step length it made the record for. */
+FL_INLINE float fl_force_approach(float rate, float dt, float madeDt, float made) {
+  return dt == madeDt ? 1.0f - made : fl_approach(rate, dt);
+}
+
+/* Gravity: v + a dt; with a falloff v + a (dt w). */
+FL_INLINE void fl_gravity(FlGravityParams g, float dt, float* vx, float* vy, float* vz) {
+  *vx += g.acceleration.x * dt;
+  *vy += g.acceleration.y * dt;
+  *vz += g.acceleration.z * dt;
+}
+
+FL_INLINE void fl_gravity_falloff(FlGravityParams g, FlFalloffParams f, float dt, float px,
+                                  float py, float pz, float* vx, float* vy, float* vz) {
+  fl_add_scaled(g.acceleration.x, g.acceleration.y, g.acceleration.z,
+                dt * fl_falloff_weight(f, px, py, pz), vx, vy, vz);
+}
+
+FL_INLINE void fl_gravity_acc(FlGravityParams g, FlFalloffParams f, float px, float py, float pz,
+                              float* ax, float* ay, float* az) {
+  const float w = fl_falloff_weight(f, px, py, pz);
+  *ax += g.acceleration.x * w;
+  *ay += g.acceleration.y * w;
+  *az += g.acceleration.z * w;
+}
+
+/* Damping and RotDamping: each component decays at its rate over dt (exactly); with a falloff
+ * at its rate times the weight. */
+FL_INLINE void fl_damping_factors(FlDampingParams d, float dt, float* fx, float* fy, float* fz) {
+  *fx = fl_force_decay(d.rate.x, dt, d.dt, d.decay.x);
+  *fy = fl_force_decay(d.rate.y, dt, d.dt, d.decay.y);
+  *fz = fl_force_decay(d.rate.z, dt, d.dt, d.decay.z);
+}
+
+FL_INLINE void fl_damping(FlDampingParams d, float dt, float* vx, float* vy, float* vz) {
+  float fx, fy, fz;
+  fl_damping_factors(d, dt, &fx, &fy, &fz);
+  *vx *= fx;
+  *vy *= fy;
+  *vz *= fz;
+}
+
+FL_INLINE void fl_damping_falloff(FlDampingParams d, FlFalloffParams f, float dt, float px,
+                                  float py, float pz, float* vx, float* vy, float* vz) {
+  fl_damping_step(d.rate.x, d.rate.y, d.rate.z, dt, fl_falloff_weight(f, px, py, pz), vx, vy, vz);
+}
+
+FL_INLINE void fl_damping_acc(FlDampingParams d, FlFalloffParams f, float px, float py, float pz,
+                              float vx, float vy, float vz, float* ax, float* ay, float* az) {
+  fl_damping_accel(d.rate.x, d.rate.y, d.rate.z, fl_falloff_weight(f, px, py, pz), vx, vy, vz, ax,
+                   ay, az);
+}
+
+/* OrbitPoint: the softened pull towards its centre. */
+FL_INLINE void fl_orbit_point_acc(FlOrbitPointParams o, float px, float py, float pz, float* ax,
+                                  float* ay, float* az) {
+  float x, y, z;
+  fl_soft_pull(o.center.x - px, o.center.y - py, o.center.z - pz, o.magnitude, o.epsilon,
+               o.maxRadius * o.maxRadius, &x, &y, &z);
+  fl_add_scaled(x, y, z, 1.0f, ax, ay, az);
+}
+
+FL_INLINE void fl_orbit_point(FlOrbitPointParams o, float dt, float px, float py, float pz,
+                              float* vx, float* vy, float* vz) {
+  float x, y, z;
+  fl_soft_pull(o.center.x - px, o.center.y - py, o.center.z - pz, o.magnitude, o.epsilon,
+               o.maxRadius * o.maxRadius, &x, &y, &z);
+  fl_add_scaled(x, y, z, dt, vx, vy, vz);
+}
+
+/* OrbitLine: the softened pull towards the nearest point of its line. */
+FL_INLINE void fl_orbit_line_acc(FlOrbitLineParams o, float px, float py, float pz, float* ax,
+                                 float* ay, float* az) {
+  float x, y, z;
+  fl_orbit_line_pull(o.point.x, o.point.y, o.point.z, o.axis.x, o.axis.y, o.axis.z, o.magnitude,
+                     o.epsilon, o.maxRadius * o.maxRadius, px, py, pz, &x, &y, &z);
+  fl_add_scaled(x, y, z, 1.0f, ax, ay, az);
+}
+
+FL_INLINE void fl_orbit_line(FlOrbitLineParams o, float dt, float px, float py, float pz,
+                             float* vx, float* vy, float* vz) {
+  float x, y, z;
+  fl_orbit_line_pull(o.point.x, o.point.y, o.point.z, o.axis.x, o.axis.y, o.axis.z, o.magnitude,
+                     o.epsilon, o.maxRadius * o.maxRadius, px, py, pz, &x, &y, &z);
+  fl_add_scaled(x, y, z, dt, vx, vy, vz);
+}
+
+/* Vortex: the velocity carried towards its field. */
+FL_INLINE FlVortex fl_vortex_of(FlVortexParams p) {
+  const FlVortex v = {p.center.x,  p.center.y, p.center.z,    p.axis.x,     p.axis.y,
+                      p.axis.z,    p.aroundSpeed, p.coreRadius, p.tightness, p.inSpeed,
+                      p.upSpeed,   p.maxRadius};
+  return v;
+}
+
+FL_INLINE void fl_vortex(FlVortexParams p, float dt, float px, float py, float pz, float* vx,
+                         float* vy, float* vz) {
+  fl_vortex_step(fl_vortex_of(p), fl_force_approach(p.responsiveness, dt, p.dt, p.decay), px, py,
+                 pz, vx, vy, vz);
+}
+
+FL_INLINE void fl_vortex_acc(FlVortexParams p, float px, float py, float pz, float vx, float vy,
+                             float vz, float* ax, float* ay, float* az) {
+  fl_vortex_accel(fl_vortex_of(p), p.responsiveness, px, py, pz, vx, vy, vz, ax, ay, az);
+}
+
+/* Jet: whether p is where it acts (its acceleration each side draws from its domain). */
+FL_INLINE int fl_jet_reaches(FlJetParams j, float px, float py, float pz) {
+  return fl_in_ball(j.center.x, j.center.y, j.center.z, j.radius, px, py, pz);
+}
+
+/* Explosion: the pulse whose front is at its radius at mid-step (from the time, in double). */
+FL_INLINE void fl_explosion(FlExplosionParams e, float dt, fl_real time, float px, float py,
+                            float pz, float* vx, float* vy, float* vz) {
+  const fl_real t = time + (fl_real)0.5 * (fl_real)dt;
+  if (t < (fl_real)e.time) return;
+  const float front = e.speed * (float)(t - (fl_real)e.time);
+  fl_explosion_step(e.center.x, e.center.y, e.center.z, e.magnitude, e.invTwoVariance, e.epsilon,
+                    front, dt, px, py, pz, vx, vy, vz);
+}
+
+FL_INLINE void fl_explosion_acc(FlExplosionParams e, fl_real t, float px, float py, float pz,
+                                float* ax, float* ay, float* az) {
+  if (!(t >= (fl_real)e.time)) return;
+  const float front = e.speed * (float)(t - (fl_real)e.time);
+  fl_explosion_accel(e.center.x, e.center.y, e.center.z, e.magnitude, e.twoVariance, e.epsilon,
+                     front, px, py, pz, ax, ay, az);
+}
+
+/* Turbulence: curl noise (noise.h) at the time, weighed by the falloff. */
+FL_INLINE FlTurbulence fl_turbulence_of(FlTurbulenceParams p) {
+  const FlTurbulence t = {p.amplitude, p.frequency, p.drift.x, p.drift.y, p.drift.z, p.octaves};
+  return t;
+}
+
+FL_INLINE void fl_turbulence(FlTurbulenceParams p, FlFalloffParams f, float dt, fl_real time,
+                             float px, float py, float pz, float* vx, float* vy, float* vz) {
+  const float3 acc = fl_turbulence_field(fl_turbulence_of(p), (float)time, px, py, pz);
+  fl_add_scaled(acc.x, acc.y, acc.z, dt * fl_falloff_weight(f, px, py, pz), vx, vy, vz);
+}
+
+FL_INLINE void fl_turbulence_acc(FlTurbulenceParams p, FlFalloffParams f, fl_real t, float px,
+                                 float py, float pz, float* ax, float* ay, float* az) {
+  fl_turbulence_accel(fl_turbulence_of(p), (float)t, fl_falloff_weight(f, px, py, pz), px, py, pz,
+                      ax, ay, az);
+}
+
+/* ElectricField: q E dt w, q the charge over mass. */
+FL_INLINE void fl_electric(FlElectricParams e, FlFalloffParams f, float dt, float px, float py,
+                           float pz, float* vx, float* vy, float* vz, float charge, float mass) {
+  const float w = fl_falloff_weight(f, px, py, pz);
+  fl_add_scaled(e.field.x, e.field.y, e.field.z, fl_charge_per_mass(charge, mass) * dt * w, vx,
+                vy, vz);
+}
+
+FL_INLINE void fl_electric_acc(FlElectricParams e, FlFalloffParams f, float px, float py, float pz,
+                               float charge, float mass, float* ax, float* ay, float* az) {
+  const float q = fl_charge_per_mass(charge, mass);
+  const float w = fl_falloff_weight(f, px, py, pz);
+  *ax += e.field.x * q * w;
+  *ay += e.field.y * q * w;
+  *az += e.field.z * q * w;
+}
+
+/* MagneticField: v turns about B by -(q/m)|B| dt w, exactly (fl_magnetic_turn). */
+FL_INLINE void fl_magnetic(FlMagneticParams m, FlFalloffParams f, float dt, float px, float py,
+                           float pz, float* vx, float* vy, float* vz, float charge, float mass) {
+  if (!(m.strength > 0.0f)) return;
+  const fl_real theta = -(fl_real)fl_charge_per_mass(charge, mass) * (fl_real)m.strength *
+                        (fl_real)dt * (fl_real)fl_falloff_weight(f, px, py, pz);
+  fl_magnetic_turn(m.direction.x, m.direction.y, m.direction.z, theta, vx, vy, vz);
+}
+
+FL_INLINE void fl_magnetic_acc(FlMagneticParams m, FlFalloffParams f, float px, float py, float pz,
+                               float vx, float vy, float vz, float charge, float mass, float* ax,
+                               float* ay, float* az) {
+  fl_magnetic_accel(m.field.x, m.field.y, m.field.z, fl_charge_per_mass(charge, mass),
+                    fl_falloff_weight(f, px, py, pz), vx, vy, vz, ax, ay, az);
+}
+
+/* SampledField, from the field's value (ux, uy, uz) at p (each side samples its own copy of
+ * the grid with fl_field_axis and fl_field_blend) and the falloff's weight w: an acceleration
+ * (v + u s dt w), or carried towards it (Mode::Velocity). */
+FL_INLINE void fl_sampled_field(FlSampledFieldParams s, float dt, float w, float ux, float uy,
+                                float uz, float* vx, float* vy, float* vz) {
+  ux = ux * s.strength;
+  uy = uy * s.strength;
+  uz = uz * s.strength;
+  if (s.carry) {
+    const float kw = fl_force_approach(s.responsiveness, dt, s.dt, s.decay) * w;
+    *vx = *vx + (ux - *vx) * kw;
+    *vy = *vy + (uy - *vy) * kw;
+    *vz = *vz + (uz - *vz) * kw;
+  } else {
+    const float k = dt * w;
+    *vx = *vx + ux * k;
+    *vy = *vy + uy * k;
+    *vz = *vz + uz * k;
+  }
+}
+
+FL_INLINE void fl_sampled_field_acc(FlSampledFieldParams s, float w, float ux, float uy, float uz,
+                                    float vx, float vy, float vz, float* ax, float* ay,
+                                    float* az) {
+  ux = ux * s.strength;
+  uy = uy * s.strength;
+  uz = uz * s.strength;
+  if (s.carry) {
+    ux = (ux - vx) * s.responsiveness;
+    uy = (uy - vy) * s.responsiveness;
+    uz = (uz - vz) * s.responsiveness;
+  }
+  *ax += ux * w;
+  *ay += uy * w;
+  *az += uz * w;
+}
+
+/* Targets: each value carried towards the target by fl_approach of the rate. */
+FL_INLINE float fl_target_k(FlTargetParams t, float dt) {
+  return fl_force_approach(t.rate, dt, t.dt, t.decay);
+}
+
+FL_INLINE void fl_target3(FlTargetParams t, float dt, float* x, float* y, float* z) {
+  const float k = fl_target_k(t, dt);
+  *x = fl_toward(*x, t.target[0], k);
+  *y = fl_toward(*y, t.target[1], k);
+  *z = fl_toward(*z, t.target[2], k);
+}
+
+FL_INLINE void fl_target_color(FlTargetParams t, float dt, float* r, float* g, float* b,
+                               float* al) {
+  const float k = fl_target_k(t, dt);
+  *r = fl_toward(*r, t.target[0], k);
+  *g = fl_toward(*g, t.target[1], k);
+  *b = fl_toward(*b, t.target[2], k);
+  *al = fl_toward(*al, t.target[3], k);
+}
+
+FL_INLINE void fl_target_size(FlTargetParams t, float dt, float* size) {
+  *size = fl_toward(*size, t.target[0], fl_target_k(t, dt));
+}
+
+/* SpeedClamp. */
+FL_INLINE void fl_speed_clamp(FlSpeedClampParams c, float* vx, float* vy, float* vz) {
+  fl_clamp_speed(c.minSpeed, c.maxSpeed, vx, vy, vz);
+}
+
+/* Gravitate and Follow: the softened pull towards a neighbour (dx, dy, dz) away, into o. */
+FL_INLINE void fl_pull(FlPullParams q, float dx, float dy, float dz, float* ox, float* oy,
+                       float* oz) {
+  fl_soft_pull(dx, dy, dz, q.magnitude, q.epsilon, q.maxRadius2, ox, oy, oz);
+}
+
+/* MatchVelocity and MatchRotVelocity: how far towards the neighbours' mean over dt (the
+ * maker's approach for the step length it made the record for). */
+FL_INLINE float fl_match_k(FlMatchParams m, float dt) {
+  return dt == m.dt ? m.approach : 1.0f - exp(-m.rate * dt);
+}
+
+/* Avoid: the change of speed away from an obstacle at distance dist over dt. */
+FL_INLINE float fl_avoid_step(FlAvoidParams a, float dist, float dt) {
+  return fl_avoid_push(a.magnitude, a.epsilon, dist) * dt;
+}
+
+/* Constrain2D onto its plane (fl_constrain_2d; the normal is unit). */
+FL_INLINE void fl_constrain2d(FlConstrain2DParams c, float* px, float* py, float* pz, float* vx,
+                              float* vy, float* vz) {
+  fl_constrain_2d(c.point.x, c.point.y, c.point.z, c.normal.x, c.normal.y, c.normal.z, px, py, pz,
+                  vx, vy, vz);
+}
+
+/* Restore towards home (hx, hy, hz) from its start (fl_restore_step); dt is the particle's
+ * (sub-)step, `time` when it begins. */
+FL_INLINE void fl_restore(FlRestoreParams r, float dt, fl_real time, float* px, float* py,
+                          float* pz, float* vx, float* vy, float* vz, float hx, float hy,
+                          float hz) {
+  if (!fl_restore_started(fl_real_from_bits(r.start), time)) return;
+  const float left = fl_restore_left(fl_real_from_bits(r.end), time);
+  fl_restore_step(left, dt, hx, hy, hz, px, py, pz, vx, vy, vz);
 }
 
 #endif /* FLURRY_KERNELS_FORCES_H */

@@ -98,10 +98,11 @@ typedef struct FlBirthRun {
 } FlBirthRun;
 
 /* ---- Each action's constants, by name --------------------------------------------------
- * Made on the host by the action's packer (sdk/src/opencl/actions_*.cpp) as the CPU backend
- * makes them, so that the products with dt round the same way, and read by its function in
- * its .cl file. A `decay` is exp(-rate * dt) made with std::exp for the step's `dt`, so the
- * device agrees with the CPU to the bit; a sub-step of another length makes its own. */
+ * Made on the host by one maker for both backends (actionParams, sdk/src/action_params.hpp)
+ * and read by the action's kernel function (forces.h, deflect.h, ...), which the CPU's pass
+ * and the device's act kernel both call. A `decay` is exp(-rate * dt) made with std::exp for
+ * the record's `dt`, so both backends multiply by the same bits; a step of another length (a
+ * newborn's rest of its step, a sub-step on the device) makes its own. */
 
 /* Three floats (OpenCL's float3 takes the room of four). */
 typedef struct FlXyz {
@@ -246,7 +247,7 @@ typedef struct FlMatchParams {
   float rate, dt, maxRadius2, approach;
 } FlMatchParams;
 
-/* A force's falloff (forces.h FlFalloff). */
+/* A force's falloff (forces.h fl_falloff_weight). */
 typedef struct FlFalloffParams {
   float cx, cy, cz, radius, power;
 } FlFalloffParams;

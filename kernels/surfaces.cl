@@ -246,7 +246,7 @@ FL_INLINE void fl_block(__global const FlActionParams* a, uint kind, float x, fl
   *vis = fl_visible_after_block(fl_inside_any(a->domain.v, kind, x, y, z, shapes), *vis);
 }
 
-/* ---- Avoid, Constrain2D ------------------------------------------------------------------ */
+/* ---- Avoid (Constrain2D is forces.h's) ------------------------------------------------------------------ */
 
 /* actions_more.hpp apply(Avoid). */
 FL_INLINE void fl_avoid(__global const FlActionParams* a, uint kind, float dt, float x, float y,
@@ -254,8 +254,7 @@ FL_INLINE void fl_avoid(__global const FlActionParams* a, uint kind, float dt, f
   __global const float* d = a->domain.v;
   const int planar = fl_surf_planar(kind);
   const float3 p = (float3)(x, y, z), v = (float3)(*vx, *vy, *vz);
-  __global const FlAvoidParams* av = &a->own.avoid;
-  const float3 ahead = p + v * av->lookAhead;
+  const float3 ahead = p + v * a->own.avoid.lookAhead;
   int threat;
   if (planar) {
     float3 h;
@@ -270,23 +269,15 @@ FL_INLINE void fl_avoid(__global const FlActionParams* a, uint kind, float dt, f
   const float dist = fl_surf_distance(a, kind, p, shapes);
   float3 away = fl_normal_any(d, kind, p, shapes);
   if (planar && fl_dotv(p - fl_closest_any(d, kind, p, shapes), away) < 0.0f) away = -away;
-  fl_add_scaled(away.x, away.y, away.z, fl_avoid_push(av->magnitude, av->epsilon, dist) * dt, vx, vy, vz);
-}
-
-/* forces.h fl_constrain_2d. */
-FL_INLINE void fl_constrain2d(__global const FlActionParams* a, float* px, float* py, float* pz,
-                              float* vx, float* vy, float* vz) {
-  const FlXyz P = a->own.constrain2d.point, N = a->own.constrain2d.normal;
-  fl_constrain_2d(P.x, P.y, P.z, N.x, N.y, N.z, px, py, pz, vx, vy, vz);
+  fl_add_scaled(away.x, away.y, away.z, fl_avoid_step(a->own.avoid, dist, dt), vx, vy, vz);
 }
 
 /* ---- Neighbours: the particles as they were at the start of the step (FL_SNAP) ----------- */
 
 /* forces.h fl_soft_pull towards d, added to acc. */
 FL_INLINE void fl_add_soft_pull(__global const FlActionParams* a, float3 d, float3* acc) {
-  __global const FlPullParams* q = &a->own.pull;
   float x, y, z;
-  fl_soft_pull(d.x, d.y, d.z, q->magnitude, q->epsilon, q->maxRadius2, &x, &y, &z);
+  fl_pull(a->own.pull, d.x, d.y, d.z, &x, &y, &z);
   *acc += (float3)(x, y, z);
 }
 
@@ -327,9 +318,8 @@ FL_INLINE void fl_add_accel(float3 acc, float dt, float* vx, float* vy, float* v
 FL_INLINE void fl_match_toward_mean(__global const FlActionParams* a, __global const float* snap,
                                     uint snapStride, uint snapN, uint self, uint field, float dt,
                                     float px, float py, float pz, float* ox, float* oy, float* oz) {
-  __global const FlMatchParams* m = &a->own.match;
-  const float k = dt == m->dt ? m->approach : 1.0f - exp(-m->rate * dt);
+  const float k = fl_match_k(a->own.match, dt);
   fl_match_mean(&FL_SNAP(0, 0, 0), &FL_SNAP(0, 1, 0), &FL_SNAP(0, 2, 0), &FL_SNAP(field, 0, 0),
-                &FL_SNAP(field, 1, 0), &FL_SNAP(field, 2, 0), snapN, self, m->maxRadius2, px, py, pz, k,
+                &FL_SNAP(field, 1, 0), &FL_SNAP(field, 2, 0), snapN, self, a->own.match.maxRadius2, px, py, pz, k,
                 ox, oy, oz);
 }

@@ -23,7 +23,7 @@ PARTS = [
     ("CPU math (cpu/ kernels, domains, sampling, noise, shapes)",
      [r"^sdk/src/cpu/(kernels|actions_more|integrate|collisions)\.hpp$",
       r"^sdk/src/(domain|sampling|newborns)\.cpp$",
-      r"^sdk/src/(noise|shape_math|field_math|sampling)\.hpp$"]),
+      r"^sdk/src/(noise|shape_math|field_math|sampling|forces_kernel)\.hpp$"]),
     ("OpenCL C only (kernels/*.cl)", [r"^kernels/.*\.cl$"]),
     ("shared by both (kernels/*.h)", [r"^kernels/.*\.h$"]),
 ]

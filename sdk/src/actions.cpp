@@ -1,3 +1,4 @@
+#include <bit>
 #include <cmath>
 #include <string>
 #include <type_traits>
@@ -8,6 +9,7 @@
 #include "effect/descriptors.hpp"
 #include "flurry/actions.hpp"
 #include "flurry/error.hpp"
+#include "flurry/field.hpp"
 
 namespace flurry {
 
@@ -209,6 +211,117 @@ cl::FlBounceParams bounceParams(const Bounce& a) {
     b.piece.sphere = {R, R * R, 1.0f / R, std::abs(C.x) + std::abs(C.y) + std::abs(C.z) + R};
   }
   return b;
+}
+
+cl::FlActionParams actionParams(const Action& act, float dt) {
+  const auto xyz = [](Vec3 v) { return cl::FlXyz{v.x, v.y, v.z}; };
+  cl::FlActionParams p{};
+  auto& own = p.own;
+  // exp(-rate·dt) for the step length the record is made for (fl_force_decay).
+  auto decay = [&](float rate) { return std::exp(-rate * dt); };
+  auto falloff = [&](const Falloff& f) {
+    p.falloff = {f.center.x, f.center.y, f.center.z, f.radius, f.power};
+  };
+  auto target = [&](float x, float y, float z, float w, float rate) {
+    own.target = {{x, y, z, w}, rate, dt, decay(rate)};
+  };
+  auto damping = [&](Vec3 rate) {
+    own.damping = {xyz(Vec3(decay(rate.x), decay(rate.y), decay(rate.z))), xyz(rate), dt};
+  };
+  auto match = [&](float rate, float maxRadius) {
+    own.match = {rate, dt, maxRadius * maxRadius, 1.0f - decay(rate)};
+  };
+  if (const auto* g = std::get_if<Gravity>(&act)) {
+    own.gravity = {xyz(g->acceleration)};
+    falloff(g->falloff);
+  } else if (const auto* d = std::get_if<Damping>(&act)) {
+    damping(d->rate);
+    falloff(d->falloff);
+  } else if (const auto* rd = std::get_if<RotDamping>(&act)) {
+    damping(rd->rate);
+  } else if (const auto* o = std::get_if<OrbitPoint>(&act)) {
+    own.orbitPoint = {xyz(o->center), o->magnitude, o->epsilon, o->maxRadius};
+  } else if (const auto* ol = std::get_if<OrbitLine>(&act)) {
+    own.orbitLine = {xyz(ol->point), xyz(glm::normalize(ol->axis)), ol->magnitude, ol->epsilon,
+                     ol->maxRadius};
+  } else if (const auto* v = std::get_if<Vortex>(&act)) {
+    own.vortex = {xyz(v->center),
+                  xyz(glm::normalize(v->axis)),
+                  v->aroundSpeed,
+                  v->coreRadius,
+                  v->tightness,
+                  v->inSpeed,
+                  v->upSpeed,
+                  v->maxRadius,
+                  v->responsiveness,
+                  dt,
+                  decay(v->responsiveness)};
+  } else if (const auto* j = std::get_if<Jet>(&act)) {
+    own.jet = {xyz(j->center), j->radius};
+  } else if (const auto* e = std::get_if<Explosion>(&act)) {
+    const float twoVariance =
+        2 * e->stddev * e->stddev;  // the acceleration's; the step its inverse
+    own.explosion = {xyz(e->center), e->speed,           e->magnitude, e->epsilon,
+                     e->time,        1.0f / twoVariance, twoVariance};
+  } else if (const auto* ra = std::get_if<RandomAccel>(&act)) {
+    falloff(ra->falloff);
+  } else if (const auto* t = std::get_if<Turbulence>(&act)) {
+    own.turbulence = {t->amplitude, t->frequency, xyz(t->drift), cl::fl_u32(t->octaves)};
+    falloff(t->falloff);
+  } else if (const auto* ef = std::get_if<ElectricField>(&act)) {
+    own.electric = {xyz(ef->field)};
+    falloff(ef->falloff);
+  } else if (const auto* m = std::get_if<MagneticField>(&act)) {
+    const float B = glm::length(m->field);
+    own.magnetic = {xyz(B > 0.0f ? m->field / B : Vec3(0.0f)), B, xyz(m->field)};
+    falloff(m->falloff);
+  } else if (const auto* sf = std::get_if<SampledField>(&act)) {
+    // (where the grid is, `first`, is the device's: its packer places the grid)
+    const VectorField& field = *sf->field;
+    own.sampledField = {xyz(field.origin),
+                        field.voxelSize,
+                        sf->strength,
+                        sf->responsiveness,
+                        dt,
+                        decay(sf->responsiveness),
+                        0u,
+                        cl::fl_u32(field.dims.x),
+                        cl::fl_u32(field.dims.y),
+                        cl::fl_u32(field.dims.z),
+                        sf->mode == SampledField::Mode::Velocity ? 1u : 0u};
+    falloff(sf->falloff);
+  } else if (const auto* tv = std::get_if<TargetVelocity>(&act)) {
+    target(tv->velocity.x, tv->velocity.y, tv->velocity.z, 0.0f, tv->rate);
+  } else if (const auto* tr = std::get_if<TargetRotVelocity>(&act)) {
+    target(tr->rotVelocity.x, tr->rotVelocity.y, tr->rotVelocity.z, 0.0f, tr->rate);
+  } else if (const auto* tc = std::get_if<TargetColor>(&act)) {
+    target(tc->color.x, tc->color.y, tc->color.z, tc->alpha, tc->rate);
+  } else if (const auto* ts = std::get_if<TargetSize>(&act)) {
+    target(ts->size, 0.0f, 0.0f, 0.0f, ts->rate);
+  } else if (const auto* c = std::get_if<SpeedClamp>(&act)) {
+    own.speedClamp = {c->minSpeed, c->maxSpeed};
+  } else if (const auto* r = std::get_if<Restore>(&act)) {
+    // In double, as bit patterns (params.h).
+    own.restore = {std::bit_cast<cl::fl_u64>(double(r->start)),
+                   std::bit_cast<cl::fl_u64>(double(r->start) + r->duration)};
+  } else if (const auto* b = std::get_if<Bounce>(&act)) {
+    own.bounce = bounceParams(*b);
+  } else if (const auto* k = std::get_if<Sink>(&act)) {
+    own.sink = {k->passThrough};
+  } else if (const auto* av = std::get_if<Avoid>(&act)) {
+    own.avoid = {av->magnitude, av->epsilon, av->lookAhead};
+  } else if (const auto* c2 = std::get_if<Constrain2D>(&act)) {
+    own.constrain2d = {xyz(c2->point), xyz(glm::normalize(c2->normal))};
+  } else if (const auto* gr = std::get_if<Gravitate>(&act)) {
+    own.pull = {gr->magnitude, gr->epsilon, gr->maxRadius * gr->maxRadius};
+  } else if (const auto* f = std::get_if<Follow>(&act)) {
+    own.pull = {f->magnitude, f->epsilon, f->maxRadius * f->maxRadius};
+  } else if (const auto* mv = std::get_if<MatchVelocity>(&act)) {
+    match(mv->magnitude, mv->maxRadius);
+  } else if (const auto* mr = std::get_if<MatchRotVelocity>(&act)) {
+    match(mr->magnitude, mr->maxRadius);
+  }
+  return p;
 }
 
 AttributeAccess attributeAccess(const Action& a) {

@@ -537,6 +537,7 @@ void detail::GroupImpl::prefetchData() const {
   prefetchVector(plan.timeFree);
   prefetchVector(plan.moves);
   prefetchVector(plan.gathered);
+  prefetchVector(plan.records);
   if (frame) prefetchBytes(frame.get(), sizeof(Frame));
 }
 

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "../../kernels/params.h"
 #include "flurry/group.hpp"
 #include "flurry/strands.hpp"
 #include "flurry/transform.hpp"
@@ -148,6 +149,11 @@ struct ActionPlan {
   /// Per action: it may change positions or velocities (the bounds must be taken again).
   std::vector<std::uint8_t> moves;
   bool cullable = false;  ///< some action has a finite reach
+  /// Per action: its record (actionParams), as the device gets it, made for steps of
+  /// `recordsDt` (actionRecords): made again only for a new list or a new step length.
+  std::vector<cl::FlActionParams> records;
+  std::uint64_t recordsVersion = ~std::uint64_t(0);
+  float recordsDt = 0.0f;
 };
 
 /// A group placed in the world (Group::setTransform): its emitters and action list as the
@@ -227,6 +233,8 @@ class PassScratchUse {
 /// Brings group.plan up to date with its action list (when actionsVersion changed) and
 /// returns it (cpu/cpu_backend.cpp).
 const ActionPlan& planActions(GroupImpl& group);
+/// The records of the group's actions for steps of dt (ActionPlan::records).
+const cl::FlActionParams* actionRecords(GroupImpl& group, float dt);
 
 struct GroupImpl {
   /// From the arena's huge pages, as its lanes (page_arena.hpp): a small group's step then

@@ -27,27 +27,11 @@ inline void put(float* const* a, std::size_t i, Vec3 v) {
 }
 // The per-particle math of the forces and absorbers is kernels/forces.h and absorb.h, shared
 // with the device (kernels.hpp includes them in namespace kernel); these adapt its arguments.
-inline kernel::FlFalloff flFalloff(const Falloff& f) {
-  return {f.center.x, f.center.y, f.center.z, f.radius, f.power};
-}
-inline float falloffWeight(const Falloff& f, Vec3 p) {
-  return kernel::fl_falloff_weight(flFalloff(f), p.x, p.y, p.z);
-}
-inline float approach(float rate, float dt) {
-  return kernel::fl_approach(rate, dt);
-}
-inline Vec3 softPull(Vec3 d, float magnitude, float eps, float maxR) {
+// Gravitate's and Follow's pull towards a neighbour d away (kernels/forces.h fl_pull).
+inline Vec3 softPull(Vec3 d, const cl::FlPullParams& q) {
   Vec3 o;
-  kernel::fl_soft_pull(d.x, d.y, d.z, magnitude, eps, maxR * maxR, &o.x, &o.y, &o.z);
+  kernel::fl_pull(q, d.x, d.y, d.z, &o.x, &o.y, &o.z);
   return o;
-}
-inline kernel::FlVortex flVortex(const Vortex& a) {
-  const Vec3 k = glm::normalize(a.axis);
-  return {a.center.x,    a.center.y,   a.center.z,  k.x,       k.y,       k.z,
-          a.aroundSpeed, a.coreRadius, a.tightness, a.inSpeed, a.upSpeed, a.maxRadius};
-}
-inline kernel::FlTurbulence flTurbulence(const Turbulence& a) {
-  return {a.amplitude, a.frequency, a.drift.x, a.drift.y, a.drift.z, kernel::uint(a.octaves)};
 }
 // Calls f(&x, &y, &z) on locals holding lane particle i's vector and stores them back: the
 // shared kernels' pointers into the arrays would hide their __restrict from the vectoriser.
@@ -118,11 +102,6 @@ inline void addVaryingLoop(float* __restrict vx, float* __restrict vy, float* __
     vz[i] = vz[i] + az[i] * dt[i];
   }
 }
-// x += (target - x)·(1 - exp(-rate·dt[i])): an exponential approach over each particle's step.
-inline void approachOwnLoop(float* __restrict x, std::size_t n, float target, float rate,
-                            const float* __restrict h) {
-  for (std::size_t i = 0; i < n; ++i) x[i] = kernel::fl_toward(x[i], target, approach(rate, h[i]));
-}
 }  // namespace
 
 // ---- Absorbers, blockers -----------------------------------------------------------------
@@ -169,7 +148,7 @@ inline void apply(const Sink& a, const Lanes& L, std::size_t n, const BlockConte
       c.dead[i] = kernel::fl_dead_sink_hit(a.region.distance(h), h, c.action + 1, c.dead[i]);
     }
   }
-  passThrough(c, L, n, a.passThrough);
+  passThrough(c, L, n, c.record().own.sink.passThrough);
 }
 
 inline void apply(const SinkVelocity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
@@ -198,64 +177,26 @@ inline void apply(const Block& a, const Lanes& L, std::size_t n, const BlockCont
 
 // ---- Forces ------------------------------------------------------------------------------
 
-// Gravity and Damping with a falloff radius (without one they are the vectorised loops).
-inline void applyWeighted(const Gravity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const Vec3 g = a.acceleration;
-  for (std::size_t i = 0; i < n; ++i)
-    onLocals(L.v, i, [&](float* x, float* y, float* z) {
-      kernel::fl_add_scaled(g.x, g.y, g.z, c.dtAt(i) * falloffWeight(a.falloff, at(L.p, i)), x, y,
-                            z);
-    });
+inline void apply(const RotDamping&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  dampLanes(c.record().own.damping, L.rot, n, c);
 }
 
-inline void applyWeighted(const Damping& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  for (std::size_t i = 0; i < n; ++i)
-    onLocals(L.v, i, [&](float* x, float* y, float* z) {
-      kernel::fl_damping_step(a.rate.x, a.rate.y, a.rate.z, c.dtAt(i),
-                              falloffWeight(a.falloff, at(L.p, i)), x, y, z);
-    });
-}
-
-inline void apply(const RotDamping& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  withDt(c, [&](auto dt) { dampLoop(L.rot[0], L.rot[1], L.rot[2], n, a.rate, dt); });
-}
-
-// fl_soft_pull (branch-free) over __restrict lanes, through locals so that it vectorises.
-template <class Dt>
-inline void orbitPointLoop(const float* __restrict px, const float* __restrict py,
-                           const float* __restrict pz, float* __restrict vx, float* __restrict vy,
-                           float* __restrict vz, std::size_t n, Vec3 center, float magnitude,
-                           float eps, float maxR2, Dt dt) {
-  for (std::size_t i = 0; i < n; ++i) {
-    float x, y, z, ux = vx[i], uy = vy[i], uz = vz[i];
-    kernel::fl_soft_pull(center.x - px[i], center.y - py[i], center.z - pz[i], magnitude, eps,
-                         maxR2, &x, &y, &z);
-    kernel::fl_add_scaled(x, y, z, dt[i], &ux, &uy, &uz);
-    vx[i] = ux, vy[i] = uy, vz[i] = uz;
-  }
-}
-
-inline void apply(const OrbitPoint& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  withDt(c, [&](auto dt) {
-    orbitPointLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, a.center, a.magnitude,
-                   a.epsilon, a.maxRadius * a.maxRadius, dt);
+inline void apply(const OrbitPoint&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const cl::FlOrbitPointParams o = c.record().own.orbitPoint;
+  velocityLoop(L, n, c, [o](float px, float py, float pz, float dt, float* x, float* y, float* z) {
+    kernel::fl_orbit_point(o, dt, px, py, pz, x, y, z);
   });
 }
 
-inline void apply(const OrbitLine& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const Vec3 u = glm::normalize(a.axis), o = a.point;
-  const float maxR2 = a.maxRadius * a.maxRadius;
-  for (std::size_t i = 0; i < n; ++i) {
-    float gx, gy, gz;
-    kernel::fl_orbit_line_pull(o.x, o.y, o.z, u.x, u.y, u.z, a.magnitude, a.epsilon, maxR2,
-                               L.p[0][i], L.p[1][i], L.p[2][i], &gx, &gy, &gz);
-    onLocals(L.v, i, [&](float* x, float* y, float* z) {
-      kernel::fl_add_scaled(gx, gy, gz, c.dtAt(i), x, y, z);
-    });
-  }
+inline void apply(const OrbitLine&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const cl::FlOrbitLineParams o = c.record().own.orbitLine;
+  velocityLoop(L, n, c, [o](float px, float py, float pz, float dt, float* x, float* y, float* z) {
+    kernel::fl_orbit_line(o, dt, px, py, pz, x, y, z);
+  });
 }
 
-inline void apply(const Gravitate& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+inline void apply(const Gravitate&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const cl::FlPullParams q = c.record().own.pull;
   const Snapshot& s = *c.snapshot;
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3 p = at(L.p, i);
@@ -263,30 +204,26 @@ inline void apply(const Gravitate& a, const Lanes& L, std::size_t n, const Block
     Vec3 acc(0.0f);
     for (std::size_t j = 0; j < s.size; ++j) {
       if (j == self) continue;
-      acc +=
-          softPull(Vec3(s.p[0][j], s.p[1][j], s.p[2][j]) - p, a.magnitude, a.epsilon, a.maxRadius);
+      acc += softPull(Vec3(s.p[0][j], s.p[1][j], s.p[2][j]) - p, q);
     }
     put(L.v, i, at(L.v, i) + acc * c.dtAt(i));
   }
 }
 
-inline void apply(const Vortex& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const kernel::FlVortex vortex = flVortex(a);
-  const float kStep = approach(a.responsiveness, c.dt);
-  for (std::size_t i = 0; i < n; ++i) {
-    const float k = c.ownDt ? approach(a.responsiveness, c.ownDt[i]) : kStep;
+inline void apply(const Vortex&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const cl::FlVortexParams v = c.record().own.vortex;
+  for (std::size_t i = 0; i < n; ++i)
     onLocals(L.v, i, [&](float* x, float* y, float* z) {
-      kernel::fl_vortex_step(vortex, k, L.p[0][i], L.p[1][i], L.p[2][i], x, y, z);
+      kernel::fl_vortex(v, c.dtAt(i), L.p[0][i], L.p[1][i], L.p[2][i], x, y, z);
     });
-  }
 }
 
 inline void apply(const Jet& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const cl::FlJetParams jet = c.record().own.jet;
   const bool constant = std::holds_alternative<PointDomain>(a.acceleration.shape());
   const Vec3 fixed = constant ? std::get<PointDomain>(a.acceleration.shape()).p : Vec3(0.0f);
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 C = a.center;
-    if (!kernel::fl_in_ball(C.x, C.y, C.z, a.radius, L.p[0][i], L.p[1][i], L.p[2][i])) continue;
+    if (!kernel::fl_jet_reaches(jet, L.p[0][i], L.p[1][i], L.p[2][i])) continue;
     Vec3 acc = fixed;
     if (!constant) {
       Random rng = actionRandom(c, L, i);
@@ -296,29 +233,28 @@ inline void apply(const Jet& a, const Lanes& L, std::size_t n, const BlockContex
   }
 }
 
-inline void apply(const Explosion& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const double t = c.time + 0.5 * c.dt;  // the front's radius at mid-step
-  if (t < a.time) return;
-  const float front = a.speed * float(t - a.time);
-  const float inv2s2 = 1.0f / (2.0f * a.stddev * a.stddev);
-  const Vec3 C = a.center;
+inline void apply(const Explosion&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const cl::FlExplosionParams e = c.record().own.explosion;
+  if (c.time + 0.5 * c.dt < e.time) return;  // (fl_explosion's test, once for the block)
   for (std::size_t i = 0; i < n; ++i)
     onLocals(L.v, i, [&](float* x, float* y, float* z) {
-      kernel::fl_explosion_step(C.x, C.y, C.z, a.magnitude, inv2s2, a.epsilon, front, c.dt,
-                                L.p[0][i], L.p[1][i], L.p[2][i], x, y, z);
+      kernel::fl_explosion(e, c.dt, c.time, L.p[0][i], L.p[1][i], L.p[2][i], x, y, z);
     });
 }
 
 // The accelerations are drawn for a batch of particles at once (Philox vectorised, the
 // domain sampled by sampleBatch), the same numbers as one Random per particle.
 inline void apply(const RandomAccel& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const bool weighted = a.falloff.radius < kInfinity;
+  const cl::FlFalloffParams falloff = c.record().falloff;
+  const bool weighted = falloff.radius < kInfinity;
   sampleFromActionStreams(a.acceleration, L, n, c,
                           [&](std::size_t first, std::size_t m, float* ax, float* ay, float* az) {
                             if (weighted) {  // v + a·(dt·w), as without a falloff (w = 1)
                               for (std::size_t k = 0; k < m; ++k) {
-                                const float s = c.dtAt(first + k) *
-                                                falloffWeight(a.falloff, at(L.p, first + k));
+                                const std::size_t i = first + k;
+                                const float s =
+                                    c.dtAt(i) * kernel::fl_falloff_weight(falloff, L.p[0][i],
+                                                                          L.p[1][i], L.p[2][i]);
                                 ax[k] *= s;
                                 ay[k] *= s;
                                 az[k] *= s;
@@ -358,68 +294,61 @@ inline void apply(const RandomRotVelocity& a, const Lanes& L, std::size_t n,
   storeSamples(a.rotVelocity, L.rot, L, n, c);
 }
 
-inline void apply(const Turbulence& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const kernel::FlTurbulence turbulence = flTurbulence(a);
-  const float t = float(c.time);
-  for (std::size_t i = 0; i < n; ++i) {
-    const float px = L.p[0][i], py = L.p[1][i], pz = L.p[2][i];
-    const Vec3 acc = kernel::fl_turbulence_field(turbulence, t, px, py, pz);
-    const float k = c.dtAt(i) * falloffWeight(a.falloff, Vec3(px, py, pz));
+inline void apply(const Turbulence&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const cl::FlActionParams& r = c.record();
+  const cl::FlTurbulenceParams t = r.own.turbulence;
+  const cl::FlFalloffParams f = r.falloff;
+  for (std::size_t i = 0; i < n; ++i)
     onLocals(L.v, i, [&](float* x, float* y, float* z) {
-      kernel::fl_add_scaled(acc.x, acc.y, acc.z, k, x, y, z);
+      kernel::fl_turbulence(t, f, c.dtAt(i), c.time, L.p[0][i], L.p[1][i], L.p[2][i], x, y, z);
     });
-  }
 }
 
-// Charge over mass; a particle of zero (or negative) mass does not respond to fields.
-inline float chargePerMass(const Lanes& L, std::size_t i) {
-  return kernel::fl_charge_per_mass(L.charge[i], L.mass[i]);
-}
-
-inline void apply(const ElectricField& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const Vec3 E = a.field;
-  for (std::size_t i = 0; i < n; ++i) {
-    const float w = falloffWeight(a.falloff, at(L.p, i));
+inline void apply(const ElectricField&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const cl::FlActionParams& r = c.record();
+  const cl::FlElectricParams e = r.own.electric;
+  const cl::FlFalloffParams f = r.falloff;
+  for (std::size_t i = 0; i < n; ++i)
     onLocals(L.v, i, [&](float* x, float* y, float* z) {
-      kernel::fl_add_scaled(E.x, E.y, E.z, chargePerMass(L, i) * c.dtAt(i) * w, x, y, z);
+      kernel::fl_electric(e, f, c.dtAt(i), L.p[0][i], L.p[1][i], L.p[2][i], x, y, z, L.charge[i],
+                          L.mass[i]);
     });
-  }
 }
 
-inline void apply(const MagneticField& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const float B = glm::length(a.field);
-  if (!(B > 0.0f)) return;
-  const Vec3 k = a.field / B;
-  for (std::size_t i = 0; i < n; ++i) {
-    // dv/dt = (q/m) v × B is a rotation about B at -(q/m)|B|: done exactly (Rodrigues), in
-    // double so that the speed does not drift by float rounding over many steps.
-    const double theta =
-        -double(chargePerMass(L, i)) * B * c.dtAt(i) * falloffWeight(a.falloff, at(L.p, i));
+inline void apply(const MagneticField&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const cl::FlActionParams& r = c.record();
+  const cl::FlMagneticParams m = r.own.magnetic;
+  const cl::FlFalloffParams f = r.falloff;
+  if (!(m.strength > 0.0f)) return;
+  for (std::size_t i = 0; i < n; ++i)
     onLocals(L.v, i, [&](float* x, float* y, float* z) {
-      kernel::fl_magnetic_turn(k.x, k.y, k.z, theta, x, y, z);
+      kernel::fl_magnetic(m, f, c.dtAt(i), L.p[0][i], L.p[1][i], L.p[2][i], x, y, z, L.charge[i],
+                          L.mass[i]);
     });
-  }
 }
 
+// The grid is the CPU's own copy (VectorField), sampled as the device samples its buffer.
 inline void apply(const SampledField& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const VectorField& f = *a.field;
-  const float kStep = approach(a.responsiveness, c.dt);
+  const cl::FlActionParams& r = c.record();
+  const cl::FlSampledFieldParams s = r.own.sampledField;
+  const cl::FlFalloffParams f = r.falloff;
+  const VectorField& field = *a.field;
   for (std::size_t i = 0; i < n; ++i) {
-    const float k = c.ownDt ? approach(a.responsiveness, c.ownDt[i]) : kStep, dt = c.dtAt(i);
     const Vec3 p = at(L.p, i);
-    const float w = falloffWeight(a.falloff, p);
-    const Vec3 u = sampleTrilinear(f, p) * a.strength;
-    const Vec3 v = at(L.v, i);
-    put(L.v, i,
-        a.mode == SampledField::Mode::Acceleration ? v + u * (dt * w) : v + (u - v) * (k * w));
+    const Vec3 u = sampleTrilinear(field, p);
+    onLocals(L.v, i, [&](float* x, float* y, float* z) {
+      kernel::fl_sampled_field(s, c.dtAt(i), kernel::fl_falloff_weight(f, p.x, p.y, p.z), u.x, u.y,
+                               u.z, x, y, z);
+    });
   }
 }
 
 inline void apply(const Avoid& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const cl::FlAvoidParams avoid = c.record().own.avoid;
   const bool planar = a.obstacle.isPlanar();
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3 p = at(L.p, i), v = at(L.v, i);
-    const Vec3 ahead = p + v * a.lookAhead;
+    const Vec3 ahead = p + v * avoid.lookAhead;
     bool threat;
     if (planar) {
       Vec3 h;
@@ -434,42 +363,42 @@ inline void apply(const Avoid& a, const Lanes& L, std::size_t n, const BlockCont
     Vec3 away = a.obstacle.normal(p);
     if (planar && glm::dot(p - a.obstacle.closestPoint(p), away) < 0.0f) away = -away;
     onLocals(L.v, i, [&](float* x, float* y, float* z) {
-      kernel::fl_add_scaled(away.x, away.y, away.z,
-                            kernel::fl_avoid_push(a.magnitude, a.epsilon, dist) * c.dtAt(i), x, y,
-                            z);
+      kernel::fl_add_scaled(away.x, away.y, away.z, kernel::fl_avoid_step(avoid, dist, c.dtAt(i)),
+                            x, y, z);
     });
   }
 }
 
-inline void apply(const Follow& a, const Lanes& L, std::size_t n, const BlockContext& c) {
+inline void apply(const Follow&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const cl::FlPullParams q = c.record().own.pull;
   const Snapshot& s = *c.snapshot;
   for (std::size_t i = 0; i < n; ++i) {
     const std::size_t next = c.base + i + 1;
     if (next >= s.size) continue;  // the last particle leads
     const Vec3 d = Vec3(s.p[0][next], s.p[1][next], s.p[2][next]) - at(L.p, i);
-    put(L.v, i, at(L.v, i) + softPull(d, a.magnitude, a.epsilon, a.maxRadius) * c.dtAt(i));
+    put(L.v, i, at(L.v, i) + softPull(d, q) * c.dtAt(i));
   }
 }
 
 // Towards the mean of the neighbours' values within maxRadius, at `magnitude` per second
 // (kernels/forces.h, shared with the device).
 inline void matchMean(const Snapshot& s, const float* const* self, const float* const* field,
-                      float* const* out, std::size_t n, const BlockContext& c, float rate,
-                      float maxR) {
-  const float kStep = approach(rate, c.dt);
-  const float r2max = maxR * maxR;
+                      float* const* out, std::size_t n, const BlockContext& c) {
+  const cl::FlMatchParams m = c.record().own.match;
+  const float kStep = kernel::fl_match_k(m, c.dt);
   for (std::size_t i = 0; i < n; ++i) {
-    const float k = c.ownDt ? approach(rate, c.ownDt[i]) : kStep;
+    const float k = c.ownDt ? kernel::fl_match_k(m, c.ownDt[i]) : kStep;
     kernel::fl_match_mean(s.p[0], s.p[1], s.p[2], field[0], field[1], field[2],
-                          std::uint32_t(s.size), std::uint32_t(c.base + i), r2max, self[0][i],
-                          self[1][i], self[2][i], k, &out[0][i], &out[1][i], &out[2][i]);
+                          std::uint32_t(s.size), std::uint32_t(c.base + i), m.maxRadius2,
+                          self[0][i], self[1][i], self[2][i], k, &out[0][i], &out[1][i],
+                          &out[2][i]);
   }
 }
-inline void apply(const MatchVelocity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  matchMean(*c.snapshot, L.p, c.snapshot->v, L.v, n, c, a.magnitude, a.maxRadius);
+inline void apply(const MatchVelocity&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  matchMean(*c.snapshot, L.p, c.snapshot->v, L.v, n, c);
 }
-inline void apply(const MatchRotVelocity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  matchMean(*c.snapshot, L.p, c.snapshot->rot, L.rot, n, c, a.magnitude, a.maxRadius);
+inline void apply(const MatchRotVelocity&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  matchMean(*c.snapshot, L.p, c.snapshot->rot, L.rot, n, c);
 }
 
 // ---- Targets, clamps, curves -------------------------------------------------------------
@@ -477,41 +406,42 @@ inline void apply(const MatchRotVelocity& a, const Lanes& L, std::size_t n, cons
 inline void approachLoop(float* __restrict x, std::size_t n, float target, float k) {
   for (std::size_t i = 0; i < n; ++i) x[i] = kernel::fl_toward(x[i], target, k);
 }
-// Each lane towards its target at `rate`: one factor for the block's step, or one per
-// newborn for its own.
-inline void approachLanes(float* const* lane, const float* target, int count, float rate,
-                          std::size_t n, const BlockContext& c) {
-  const float k = approach(rate, c.dt);
-  for (int d = 0; d < count; ++d)
-    if (c.ownDt)
-      approachOwnLoop(lane[d], n, target[d], rate, c.ownDt);
-    else
-      approachLoop(lane[d], n, target[d], k);
+// Each lane towards the record's target: one factor for the block's step (fl_target_k), or
+// one per newborn for its own.
+inline void approachLanes(float* const* lane, int count, std::size_t n, const BlockContext& c) {
+  const cl::FlTargetParams t = c.record().own.target;
+  const float k = kernel::fl_target_k(t, c.dt);
+  for (int d = 0; d < count; ++d) {
+    if (c.ownDt) {
+      float* __restrict x = lane[d];
+      for (std::size_t i = 0; i < n; ++i)
+        x[i] = kernel::fl_toward(x[i], t.target[d], kernel::fl_target_k(t, c.ownDt[i]));
+    } else {
+      approachLoop(lane[d], n, t.target[d], k);
+    }
+  }
 }
-inline void apply(const TargetVelocity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const float t[3] = {a.velocity.x, a.velocity.y, a.velocity.z};
-  approachLanes(L.v, t, 3, a.rate, n, c);
+inline void apply(const TargetVelocity&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  approachLanes(L.v, 3, n, c);
 }
-inline void apply(const TargetRotVelocity& a, const Lanes& L, std::size_t n,
-                  const BlockContext& c) {
-  const float t[3] = {a.rotVelocity.x, a.rotVelocity.y, a.rotVelocity.z};
-  approachLanes(L.rot, t, 3, a.rate, n, c);
+inline void apply(const TargetRotVelocity&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  approachLanes(L.rot, 3, n, c);
 }
-inline void apply(const TargetColor& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const float t[4] = {a.color.x, a.color.y, a.color.z, a.alpha};
-  approachLanes(L.color, t, 4, a.rate, n, c);
+inline void apply(const TargetColor&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  approachLanes(L.color, 4, n, c);
 }
-inline void apply(const TargetSize& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  approachLanes(&L.size, &a.size, 1, a.rate, n, c);
+inline void apply(const TargetSize&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  approachLanes(&L.size, 1, n, c);
 }
 
-inline void apply(const SpeedClamp& a, const Lanes& L, std::size_t n, const BlockContext&) {
+inline void apply(const SpeedClamp&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const cl::FlSpeedClampParams clamp = c.record().own.speedClamp;
   float* __restrict vx = L.v[0];
   float* __restrict vy = L.v[1];
   float* __restrict vz = L.v[2];
   for (std::size_t i = 0; i < n; ++i) {
     float x = vx[i], y = vy[i], z = vz[i];
-    kernel::fl_clamp_speed(a.minSpeed, a.maxSpeed, &x, &y, &z);
+    kernel::fl_speed_clamp(clamp, &x, &y, &z);
     vx[i] = x, vy[i] = y, vz[i] = z;
   }
 }
@@ -550,8 +480,8 @@ inline void apply(const SizeOverLife& a, const Lanes& L, std::size_t n, const Bl
 
 // ---- Bookkeeping -------------------------------------------------------------------------
 
-inline void apply(const Constrain2D& a, const Lanes& L, std::size_t n, const BlockContext&) {
-  const Vec3 nrm = glm::normalize(a.normal), o = a.point;
+inline void apply(const Constrain2D&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const cl::FlConstrain2DParams plane = c.record().own.constrain2d;
   float* __restrict px = L.p[0];
   float* __restrict py = L.p[1];
   float* __restrict pz = L.p[2];
@@ -560,7 +490,7 @@ inline void apply(const Constrain2D& a, const Lanes& L, std::size_t n, const Blo
   float* __restrict vz = L.v[2];
   for (std::size_t i = 0; i < n; ++i) {
     float x = px[i], y = py[i], z = pz[i], u = vx[i], v = vy[i], w = vz[i];
-    kernel::fl_constrain_2d(o.x, o.y, o.z, nrm.x, nrm.y, nrm.z, &x, &y, &z, &u, &v, &w);
+    kernel::fl_constrain2d(plane, &x, &y, &z, &u, &v, &w);
     px[i] = x, py[i] = y, pz[i] = z, vx[i] = u, vy[i] = v, vz[i] = w;
   }
 }
@@ -570,13 +500,13 @@ inline void apply(const CopyVertexB& a, const Lanes& L, std::size_t n, const Blo
   if (a.copyVelocity) copyLoop(L.velB[0], L.velB[1], L.velB[2], L.v[0], L.v[1], L.v[2], n);
 }
 
-inline void apply(const Restore& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  if (!kernel::fl_restore_started(a.start, c.time)) return;
-  const float left = kernel::fl_restore_left(double(a.start) + a.duration, c.time);
+inline void apply(const Restore&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const cl::FlRestoreParams r = c.record().own.restore;
+  if (!kernel::fl_restore_started(kernel::fl_real_from_bits(r.start), c.time)) return;
   for (std::size_t i = 0; i < n; ++i) {
     float x = L.p[0][i], y = L.p[1][i], z = L.p[2][i], u = L.v[0][i], v = L.v[1][i], w = L.v[2][i];
-    kernel::fl_restore_step(left, c.dt, L.posB[0][i], L.posB[1][i], L.posB[2][i], &x, &y, &z, &u,
-                            &v, &w);
+    kernel::fl_restore(r, c.dt, c.time, &x, &y, &z, &u, &v, &w, L.posB[0][i], L.posB[1][i],
+                       L.posB[2][i]);
     L.p[0][i] = x, L.p[1][i] = y, L.p[2][i] = z, L.v[0][i] = u, L.v[1][i] = v, L.v[2][i] = w;
   }
 }

@@ -1,9 +1,11 @@
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <utility>
 #include <vector>
 
+#include "../action_params.hpp"
 #include "../action_traits.hpp"
 #include "../backend.hpp"
 #include "actions_more.hpp"  // (defines what kernels.hpp declares)
@@ -187,6 +189,19 @@ const ActionPlan& planActions(GroupImpl& g) {
   }
   plan.version = g.actionsVersion;
   return plan;
+}
+
+const cl::FlActionParams* actionRecords(GroupImpl& g, float dt) {
+  ActionPlan& plan = g.plan;
+  const auto& acts = g.actions.actions();
+  if (plan.recordsVersion != g.actionsVersion || plan.records.size() != acts.size() ||
+      std::bit_cast<std::uint32_t>(plan.recordsDt) != std::bit_cast<std::uint32_t>(dt)) {
+    plan.records.resize(acts.size());  // resized, not replaced: a moved instance's each step
+    for (std::size_t k = 0; k < acts.size(); ++k) plan.records[k] = actionParams(acts[k], dt);
+    plan.recordsVersion = g.actionsVersion;
+    plan.recordsDt = dt;
+  }
+  return plan.records.data();
 }
 
 namespace {

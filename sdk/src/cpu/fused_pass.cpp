@@ -202,11 +202,11 @@ struct Culler {
 
 // What a culled action still does to particles out of its reach (to stay bitwise exact).
 void applyCulled(const Action& a, const Lanes& L, std::size_t n, const cpu::BlockContext& c) {
-  if (const auto* g = std::get_if<Gravity>(&a)) {
+  if (std::holds_alternative<Gravity>(a)) {
     // The kernel's v + a·(dt·w) with w = +0: turns -0 into +0 where a's component is >= +0.
     const float z = c.dt * 0.0f;
-    cpu::addLoop(L.v[0], L.v[1], L.v[2], n, g->acceleration.x * z, g->acceleration.y * z,
-                 g->acceleration.z * z);
+    const cl::FlXyz g = c.record().own.gravity.acceleration;
+    cpu::addLoop(L.v[0], L.v[1], L.v[2], n, g.x * z, g.y * z, g.z * z);
   } else if (std::holds_alternative<Block>(a) && c.action == c.firstBlocker) {
     std::fill_n(L.visible, n, 1u);  // the first blocker starts from "visible"
   }
@@ -606,6 +606,7 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
   cpu::BlockContext base{subDt, sp.seed, std::uint32_t(sp.step), g.streamKey() << 16, 0, nullptr};
   base.time = sp.time;
   base.firstBlocker = plan.list.firstBlocker;
+  base.records = actionRecords(g, subDt);
   // Actions that read other particles read them as they were at the start of the step, so
   // the result does not depend on which block ran first.
   cpu::Snapshot snapshot;

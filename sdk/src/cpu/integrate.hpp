@@ -30,16 +30,22 @@ inline void add(float* const* a, std::size_t i, Vec3 d) {
 }
 }  // namespace
 
-// Adds one force's acceleration at (p, v, t). `L` gives the per-particle constants (charge,
-// mass, id); `c` the step (its random numbers are the same in every stage of a step).
+// Adds one force's acceleration at (p, v, t), from its record (c.record()) by the shared
+// kernel functions (kernels/forces.h), which add to the stage's sums as the device's do. `L`
+// gives the per-particle constants (charge, mass, id); `c` the step (its random numbers are the
+// same in every stage of a step).
 inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std::size_t n,
                        const BlockContext& c, double t) {
+  const cl::FlActionParams& r = c.record();
+  const cl::FlFalloffParams f = r.falloff;
   // Gravity without a falloff weighs 1 everywhere (fl_falloff_weight): its constant added as a
   // vector loop gives the same sums as the general loop below.
-  if (const auto* g = std::get_if<Gravity>(&action); g && !(g->falloff.radius < kInfinity)) {
+  if (std::holds_alternative<Gravity>(action) && !(f.radius < kInfinity)) {
+    const cl::FlXyz g = r.own.gravity.acceleration;
+    const float k[3] = {g.x, g.y, g.z};
     for (int d = 0; d < 3; ++d) {
       float* __restrict a = s.a[d];
-      const float x = g->acceleration[d];
+      const float x = k[d];
       for (std::size_t i = 0; i < n; ++i) a[i] += x;
     }
     return;
@@ -49,64 +55,61 @@ inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std
         using A = std::decay_t<decltype(a)>;
         for (std::size_t i = 0; i < n; ++i) {
           const Vec3 p = get(s.p, i), v = get(s.v, i);
-          Vec3 acc(0.0f);
+          float ax = s.a[0][i], ay = s.a[1][i], az = s.a[2][i];
+          Vec3 acc(0.0f);  // drawn from the CPU's own domains, or summed over neighbours
           if constexpr (std::is_same_v<A, Gravity>) {
-            acc = a.acceleration * falloffWeight(a.falloff, p);
+            kernel::fl_gravity_acc(r.own.gravity, f, p.x, p.y, p.z, &ax, &ay, &az);
           } else if constexpr (std::is_same_v<A, Damping>) {
-            kernel::fl_damping_accel(a.rate.x, a.rate.y, a.rate.z, falloffWeight(a.falloff, p), v.x,
-                                     v.y, v.z, &acc.x, &acc.y, &acc.z);
+            kernel::fl_damping_acc(r.own.damping, f, p.x, p.y, p.z, v.x, v.y, v.z, &ax, &ay, &az);
           } else if constexpr (std::is_same_v<A, OrbitPoint>) {
-            acc = softPull(a.center - p, a.magnitude, a.epsilon, a.maxRadius);
+            kernel::fl_orbit_point_acc(r.own.orbitPoint, p.x, p.y, p.z, &ax, &ay, &az);
           } else if constexpr (std::is_same_v<A, OrbitLine>) {
-            const Vec3 u = glm::normalize(a.axis);
-            kernel::fl_orbit_line_pull(a.point.x, a.point.y, a.point.z, u.x, u.y, u.z, a.magnitude,
-                                       a.epsilon, a.maxRadius * a.maxRadius, p.x, p.y, p.z, &acc.x,
-                                       &acc.y, &acc.z);
+            kernel::fl_orbit_line_acc(r.own.orbitLine, p.x, p.y, p.z, &ax, &ay, &az);
           } else if constexpr (std::is_same_v<A, Gravitate>) {
             const Snapshot& sn = *c.snapshot;
             for (std::size_t j = 0; j < sn.size; ++j)
               if (j != c.base + i)
-                acc += softPull(Vec3(sn.p[0][j], sn.p[1][j], sn.p[2][j]) - p, a.magnitude,
-                                a.epsilon, a.maxRadius);
+                acc += softPull(Vec3(sn.p[0][j], sn.p[1][j], sn.p[2][j]) - p, r.own.pull);
           } else if constexpr (std::is_same_v<A, Follow>) {
             const Snapshot& sn = *c.snapshot;
             const std::size_t next = c.base + i + 1;
             if (next < sn.size)
-              acc = softPull(Vec3(sn.p[0][next], sn.p[1][next], sn.p[2][next]) - p, a.magnitude,
-                             a.epsilon, a.maxRadius);
+              acc = softPull(Vec3(sn.p[0][next], sn.p[1][next], sn.p[2][next]) - p, r.own.pull);
           } else if constexpr (std::is_same_v<A, Vortex>) {
-            kernel::fl_vortex_accel(flVortex(a), a.responsiveness, p.x, p.y, p.z, v.x, v.y, v.z,
-                                    &acc.x, &acc.y, &acc.z);
+            kernel::fl_vortex_acc(r.own.vortex, p.x, p.y, p.z, v.x, v.y, v.z, &ax, &ay, &az);
           } else if constexpr (std::is_same_v<A, Jet>) {
-            if (kernel::fl_in_ball(a.center.x, a.center.y, a.center.z, a.radius, p.x, p.y, p.z)) {
+            if (kernel::fl_jet_reaches(r.own.jet, p.x, p.y, p.z)) {
               Random rng = actionRandom(c, L, i);
               acc = a.acceleration.sample(rng);
             }
           } else if constexpr (std::is_same_v<A, Explosion>) {
-            if (t >= a.time)
-              kernel::fl_explosion_accel(
-                  a.center.x, a.center.y, a.center.z, a.magnitude, 2 * a.stddev * a.stddev,
-                  a.epsilon, a.speed * float(t - a.time), p.x, p.y, p.z, &acc.x, &acc.y, &acc.z);
+            kernel::fl_explosion_acc(r.own.explosion, t, p.x, p.y, p.z, &ax, &ay, &az);
           } else if constexpr (std::is_same_v<A, RandomAccel>) {
             Random rng = actionRandom(c, L, i);
-            acc = a.acceleration.sample(rng) * falloffWeight(a.falloff, p);
+            acc = a.acceleration.sample(rng) * kernel::fl_falloff_weight(f, p.x, p.y, p.z);
           } else if constexpr (std::is_same_v<A, Turbulence>) {
-            kernel::fl_turbulence_accel(flTurbulence(a), float(t), falloffWeight(a.falloff, p), p.x,
-                                        p.y, p.z, &acc.x, &acc.y, &acc.z);
+            kernel::fl_turbulence_acc(r.own.turbulence, f, t, p.x, p.y, p.z, &ax, &ay, &az);
           } else if constexpr (std::is_same_v<A, ElectricField>) {
-            acc = a.field * chargePerMass(L, i) * falloffWeight(a.falloff, p);
+            kernel::fl_electric_acc(r.own.electric, f, p.x, p.y, p.z, L.charge[i], L.mass[i], &ax,
+                                    &ay, &az);
           } else if constexpr (std::is_same_v<A, MagneticField>) {
-            kernel::fl_magnetic_accel(a.field.x, a.field.y, a.field.z, chargePerMass(L, i),
-                                      falloffWeight(a.falloff, p), v.x, v.y, v.z, &acc.x, &acc.y,
-                                      &acc.z);
+            kernel::fl_magnetic_acc(r.own.magnetic, f, p.x, p.y, p.z, v.x, v.y, v.z, L.charge[i],
+                                    L.mass[i], &ax, &ay, &az);
           } else if constexpr (std::is_same_v<A, SampledField>) {
-            const Vec3 u = sampleTrilinear(*a.field, p) * a.strength;
-            acc = (a.mode == SampledField::Mode::Acceleration ? u : (u - v) * a.responsiveness) *
-                  falloffWeight(a.falloff, p);
-          } else if constexpr (std::is_same_v<A, TargetVelocity>) {
-            acc = (a.velocity - v) * a.rate;
+            const Vec3 u = sampleTrilinear(*a.field, p);
+            kernel::fl_sampled_field_acc(r.own.sampledField,
+                                         kernel::fl_falloff_weight(f, p.x, p.y, p.z), u.x, u.y, u.z,
+                                         v.x, v.y, v.z, &ax, &ay, &az);
           }
-          add(s.a, i, acc);
+          if constexpr (std::is_same_v<A, Gravitate> || std::is_same_v<A, Follow> ||
+                        std::is_same_v<A, Jet> || std::is_same_v<A, RandomAccel>) {
+            ax += acc.x;
+            ay += acc.y;
+            az += acc.z;
+          }
+          s.a[0][i] = ax;
+          s.a[1][i] = ay;
+          s.a[2][i] = az;
         }
       },
       action);
@@ -230,9 +233,11 @@ inline void integrate(Integrator integrator, const std::vector<Action>& acts,
         std::fill_n(a1[d], n, 0.0f);
       }
       for (std::uint32_t k : forces) {
-        if (const auto* dmp = std::get_if<Damping>(&acts[k])) {
+        if (std::holds_alternative<Damping>(acts[k])) {
+          const cl::FlXyz r = c.records[k].own.damping.rate;
+          const float rate[3] = {r.x, r.y, r.z};
           for (int d = 0; d < 3; ++d)
-            for (std::size_t i = 0; i < n; ++i) a1[d][i] += dmp->rate[d];
+            for (std::size_t i = 0; i < n; ++i) a1[d][i] += rate[d];
         } else {
           BlockContext ck = c;
           ck.action = k;

@@ -12,6 +12,7 @@
 #include <type_traits>
 
 #include "../action_params.hpp"
+#include "../forces_kernel.hpp"
 #include "../group_impl.hpp"
 #include "../isa_namespace.hpp"
 #include "../kernel_compat.hpp"
@@ -23,11 +24,8 @@
 namespace flurry::detail {
 inline namespace FLURRY_ISA_NAMESPACE {
 namespace kernel {
-using cl::FlBounceParams;  // the records deflect.h reads (params.h)
-using cl::FlXyz;
 #include "../../kernels/absorb.h"
 #include "../../kernels/deflect.h"
-#include "../../kernels/forces.h"
 #include "../../kernels/integrate.h"
 }  // namespace kernel
 }  // namespace FLURRY_ISA_NAMESPACE
@@ -69,8 +67,12 @@ struct BlockContext {
   /// `dead`; null when every particle of the block steps `dt`.
   const float* ownDt = nullptr;
   CollisionLog* collisions = nullptr;  ///< non-null while the group records collisions
+  /// The list's records (actionRecords), made for the sub-step's length.
+  const cl::FlActionParams* records = nullptr;
   /// Particle i's step length.
   float dtAt(std::size_t i) const { return ownDt ? ownDt[i] : dt; }
+  /// The running action's record.
+  const cl::FlActionParams& record() const { return records[action]; }
 };
 
 // The loops take their arrays as __restrict parameters: GCC 12 vectorises these, but not
@@ -102,38 +104,6 @@ inline void withDt(const BlockContext& c, F&& f) {
     f(OwnDt{c.ownDt});
   else
     f(UniformDt{c.dt});
-}
-
-/// v *= exp(-rate·dt) per component: the exact solution of dv/dt = -rate·v over each
-/// particle's step (one exp per component for a uniform step).
-template <class Dt>
-inline void dampLoop(float* __restrict x, float* __restrict y, float* __restrict z, std::size_t n,
-                     Vec3 rate, Dt dt) {
-  if constexpr (std::is_same_v<Dt, UniformDt>) {
-    const float fx = std::exp(-rate.x * dt.h), fy = std::exp(-rate.y * dt.h),
-                fz = std::exp(-rate.z * dt.h);
-    for (std::size_t i = 0; i < n; ++i) {
-      x[i] *= fx;
-      y[i] *= fy;
-      z[i] *= fz;
-    }
-  } else {
-    for (std::size_t i = 0; i < n; ++i) {
-      x[i] *= std::exp(-rate.x * dt[i]);
-      y[i] *= std::exp(-rate.y * dt[i]);
-      z[i] *= std::exp(-rate.z * dt[i]);
-    }
-  }
-}
-
-/// v += a·dt with each particle's own dt.
-inline void addScaledLoop(float* __restrict x, float* __restrict y, float* __restrict z,
-                          const float* __restrict h, std::size_t n, float ax, float ay, float az) {
-  for (std::size_t i = 0; i < n; ++i) {
-    x[i] += ax * h[i];
-    y[i] += ay * h[i];
-    z[i] += az * h[i];
-  }
 }
 
 inline void addLoop(float* __restrict x, float* __restrict y, float* __restrict z, std::size_t n,
@@ -195,23 +165,70 @@ inline void sinkLoop(const Shape& shape, const float* __restrict px, const float
   }
 }
 
-inline void applyWeighted(const Gravity& a, const Lanes& L, std::size_t n, const BlockContext& c);
-inline void applyWeighted(const Damping& a, const Lanes& L, std::size_t n, const BlockContext& c);
-
-inline void apply(const Gravity& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  if (a.falloff.radius < kInfinity) return applyWeighted(a, L, n, c);
-  if (c.ownDt)
-    addScaledLoop(L.v[0], L.v[1], L.v[2], c.ownDt, n, a.acceleration.x, a.acceleration.y,
-                  a.acceleration.z);
-  else
-    addLoop(L.v[0], L.v[1], L.v[2], n, a.acceleration.x * c.dt, a.acceleration.y * c.dt,
-            a.acceleration.z * c.dt);
+// A force's update of each particle's velocity from its position, f(px, py, pz, dt, &vx, &vy,
+// &vz) (a shared kernel function with the force's record bound): through locals and
+// __restrict parameters, so that a branch-free f vectorises.
+template <class Dt, class F>
+inline void velocityLoop(const float* __restrict px, const float* __restrict py,
+                         const float* __restrict pz, float* __restrict vx, float* __restrict vy,
+                         float* __restrict vz, std::size_t n, Dt dt, F f) {
+  for (std::size_t i = 0; i < n; ++i) {
+    float x = vx[i], y = vy[i], z = vz[i];
+    f(px[i], py[i], pz[i], dt[i], &x, &y, &z);
+    vx[i] = x, vy[i] = y, vz[i] = z;
+  }
+}
+template <class F>
+inline void velocityLoop(const Lanes& L, std::size_t n, const BlockContext& c, F f) {
+  withDt(c,
+         [&](auto dt) { velocityLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, dt, f); });
 }
 
-inline void apply(const Damping& a, const Lanes& L, std::size_t n, const BlockContext& c) {
-  if (a.falloff.radius < kInfinity) return applyWeighted(a, L, n, c);
-  // The exact solution of dv/dt = -k v over the step: independent of the step size.
-  withDt(c, [&](auto dt) { dampLoop(L.v[0], L.v[1], L.v[2], n, a.rate, dt); });
+inline void apply(const Gravity&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const cl::FlActionParams& r = c.record();
+  const cl::FlGravityParams g = r.own.gravity;
+  if (r.falloff.radius < kInfinity) {
+    const cl::FlFalloffParams f = r.falloff;
+    velocityLoop(L, n, c,
+                 [g, f](float px, float py, float pz, float dt, float* x, float* y, float* z) {
+                   kernel::fl_gravity_falloff(g, f, dt, px, py, pz, x, y, z);
+                 });
+    return;
+  }
+  velocityLoop(L, n, c, [g](float, float, float, float dt, float* x, float* y, float* z) {
+    kernel::fl_gravity(g, dt, x, y, z);
+  });
+}
+
+// Damping and RotDamping without a falloff: the record's factors for a block's step (one
+// fl_damping_factors a block), each newborn's own for its rest of the step.
+inline void dampLanes(const cl::FlDampingParams& d, float* const* lane, std::size_t n,
+                      const BlockContext& c) {
+  if (c.ownDt) {
+    float* __restrict x = lane[0];
+    float* __restrict y = lane[1];
+    float* __restrict z = lane[2];
+    for (std::size_t i = 0; i < n; ++i) kernel::fl_damping(d, c.ownDt[i], &x[i], &y[i], &z[i]);
+    return;
+  }
+  float fx, fy, fz;
+  kernel::fl_damping_factors(d, c.dt, &fx, &fy, &fz);
+  scaleLoop(lane[0], lane[1], lane[2], n, fx, fy, fz);
+}
+
+inline void apply(const Damping&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const cl::FlActionParams& r = c.record();
+  const cl::FlDampingParams d = r.own.damping;
+  if (r.falloff.radius < kInfinity) {
+    const cl::FlFalloffParams f = r.falloff;
+    for (std::size_t i = 0; i < n; ++i) {
+      float x = L.v[0][i], y = L.v[1][i], z = L.v[2][i];
+      kernel::fl_damping_falloff(d, f, c.dtAt(i), L.p[0][i], L.p[1][i], L.p[2][i], &x, &y, &z);
+      L.v[0][i] = x, L.v[1][i] = y, L.v[2][i] = z;
+    }
+    return;
+  }
+  dampLanes(d, L.v, n, c);
 }
 
 inline void apply(const Move&, const Lanes& L, std::size_t n, const BlockContext& c) {

@@ -43,8 +43,8 @@ bool generateCoreAction(const Action& act, ActionSource& s) {
     return true;
   }
   if (std::holds_alternative<Restore>(act)) {
-    s.apply =
-        "fl_restore(" + s.in.params + ", dt, time, &px, &py, &pz, &vx, &vy, &vz, pbx, pby, pbz);\n";
+    s.apply = "fl_restore(" + s.in.params +
+              "->own.restore, dt, time, &px, &py, &pz, &vx, &vy, &vz, pbx, pby, pbz);\n";
     return true;
   }
   if (const auto* c = std::get_if<Callback>(&act)) {
@@ -67,15 +67,11 @@ bool generateCoreAction(const Action& act, ActionSource& s) {
   return false;
 }
 
-bool packCoreAction(const Action& act, ActionPack& p) {
-  if (const auto* r = std::get_if<Restore>(&act)) {
-    // kernels.hpp apply(Restore) works in double from these (as bit patterns: params.h).
-    p.p.own.restore = {std::bit_cast<cl::fl_u64>(double(r->start)),
-                       std::bit_cast<cl::fl_u64>(double(r->start) + r->duration)};
-    return true;
-  }
-  return std::holds_alternative<KillOld>(act) || std::holds_alternative<Move>(act) ||
-         std::holds_alternative<CopyVertexB>(act) || std::holds_alternative<Callback>(act);
+bool packCoreAction(const Action& act, ActionPack&) {
+  // (Restore's record is actionParams()'s; the others have none.)
+  return std::holds_alternative<Restore>(act) || std::holds_alternative<KillOld>(act) ||
+         std::holds_alternative<Move>(act) || std::holds_alternative<CopyVertexB>(act) ||
+         std::holds_alternative<Callback>(act);
 }
 
 }  // namespace flurry::detail::ocl

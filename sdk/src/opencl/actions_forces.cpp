@@ -9,6 +9,7 @@
 #include <cmath>
 #include <string>
 
+#include "../action_traits.hpp"
 #include "codegen.hpp"
 #include "emission.hpp"
 
@@ -49,40 +50,44 @@ const std::string kP = "px, py, pz", kV = "vx, vy, vz", kPV = "&vx, &vy, &vz",
 
 bool generateForceAction(const Action& act, ActionSource& s) {
   const std::string& ap = s.in.params;
-  const std::string apDt = ap + ", dt";
+  // The record and the falloff, passed by value to kernels/forces.h's functions.
+  auto own = [&](const char* member) { return ap + "->own." + member; };
+  const std::string fo = ap + "->falloff";
   if (const auto* g = std::get_if<Gravity>(&act)) {
-    // Without a falloff the CPU adds a·dt (kernels.hpp addLoop), with one a·(dt·w).
-    s.apply = g->falloff.radius < kInfinity
-                  ? call("fl_gravity_falloff", apDt + ", " + kP + ", " + kPV)
-                  : call("fl_gravity", apDt + ", " + kPV);
-    s.accel = acc("fl_gravity_acc", ap + ", " + kP);
+    // Without a falloff the CPU adds a·dt, with one a·(dt·w).
+    s.apply =
+        g->falloff.radius < kInfinity
+            ? call("fl_gravity_falloff", own("gravity") + ", " + fo + ", dt, " + kP + ", " + kPV)
+            : call("fl_gravity", own("gravity") + ", dt, " + kPV);
+    s.accel = acc("fl_gravity_acc", own("gravity") + ", " + fo + ", " + kP);
     return true;
   }
   if (const auto* d = std::get_if<Damping>(&act)) {
-    // Without a falloff the CPU scales by exp(-rate·dt) made once per step (the host's).
-    s.apply = d->falloff.radius < kInfinity
-                  ? call("fl_damping_falloff", apDt + ", " + kP + ", " + kPV)
-                  : call("fl_damping", apDt + ", " + kPV);
-    s.accel = acc("fl_damping_acc", ap + ", " + kP + ", " + kV);
+    // Without a falloff the CPU scales by the record's exp(-rate·dt).
+    s.apply =
+        d->falloff.radius < kInfinity
+            ? call("fl_damping_falloff", own("damping") + ", " + fo + ", dt, " + kP + ", " + kPV)
+            : call("fl_damping", own("damping") + ", dt, " + kPV);
+    s.accel = acc("fl_damping_acc", own("damping") + ", " + fo + ", " + kP + ", " + kV);
     return true;
   }
   if (std::holds_alternative<RotDamping>(act)) {
-    s.apply = call("fl_damping", apDt + ", &rotx, &roty, &rotz");
+    s.apply = call("fl_damping", own("damping") + ", dt, &rotx, &roty, &rotz");
     return true;
   }
   if (std::holds_alternative<OrbitPoint>(act)) {
-    s.apply = call("fl_orbit_point", apDt + ", " + kP + ", " + kPV);
-    s.accel = acc("fl_orbit_point_acc", ap + ", " + kP);
+    s.apply = call("fl_orbit_point", own("orbitPoint") + ", dt, " + kP + ", " + kPV);
+    s.accel = acc("fl_orbit_point_acc", own("orbitPoint") + ", " + kP);
     return true;
   }
   if (std::holds_alternative<OrbitLine>(act)) {
-    s.apply = call("fl_orbit_line", apDt + ", " + kP + ", " + kPV);
-    s.accel = acc("fl_orbit_line_acc", ap + ", " + kP);
+    s.apply = call("fl_orbit_line", own("orbitLine") + ", dt, " + kP + ", " + kPV);
+    s.accel = acc("fl_orbit_line_acc", own("orbitLine") + ", " + kP);
     return true;
   }
   if (std::holds_alternative<Vortex>(act)) {
-    s.apply = call("fl_vortex", apDt + ", " + kP + ", " + kPV);
-    s.accel = acc("fl_vortex_acc", ap + ", " + kP + ", " + kV);
+    s.apply = call("fl_vortex", own("vortex") + ", dt, " + kP + ", " + kPV);
+    s.accel = acc("fl_vortex_acc", own("vortex") + ", " + kP + ", " + kV);
     return true;
   }
   if (const auto* j = std::get_if<Jet>(&act)) {
@@ -93,8 +98,8 @@ bool generateForceAction(const Action& act, ActionSource& s) {
     return true;
   }
   if (std::holds_alternative<Explosion>(act)) {
-    s.apply = call("fl_explosion", apDt + ", time, " + kP + ", " + kPV);
-    s.accel = acc("fl_explosion_acc", ap + ", t, " + kP);
+    s.apply = call("fl_explosion", own("explosion") + ", dt, time, " + kP + ", " + kPV);
+    s.accel = acc("fl_explosion_acc", own("explosion") + ", t, " + kP);
     return true;
   }
   if (const auto* r = std::get_if<RandomAccel>(&act)) {
@@ -121,43 +126,47 @@ bool generateForceAction(const Action& act, ActionSource& s) {
     return true;
   }
   if (std::holds_alternative<Turbulence>(act)) {
-    s.apply = call("fl_turbulence", apDt + ", time, " + kP + ", " + kPV);
-    s.accel = acc("fl_turbulence_acc", ap + ", t, " + kP);
+    s.apply =
+        call("fl_turbulence", own("turbulence") + ", " + fo + ", dt, time, " + kP + ", " + kPV);
+    s.accel = acc("fl_turbulence_acc", own("turbulence") + ", " + fo + ", t, " + kP);
     return true;
   }
   if (std::holds_alternative<ElectricField>(act)) {
-    s.apply = call("fl_electric", apDt + ", " + kP + ", " + kPV + ", charge, mass");
-    s.accel = acc("fl_electric_acc", ap + ", " + kP + ", charge, mass");
+    s.apply = call("fl_electric",
+                   own("electric") + ", " + fo + ", dt, " + kP + ", " + kPV + ", charge, mass");
+    s.accel = acc("fl_electric_acc", own("electric") + ", " + fo + ", " + kP + ", charge, mass");
     return true;
   }
   if (std::holds_alternative<MagneticField>(act)) {
-    s.apply = call("fl_magnetic", apDt + ", " + kP + ", " + kPV + ", charge, mass");
-    s.accel = acc("fl_magnetic_acc", ap + ", " + kP + ", " + kV + ", charge, mass");
+    s.apply = call("fl_magnetic",
+                   own("magnetic") + ", " + fo + ", dt, " + kP + ", " + kPV + ", charge, mass");
+    s.accel = acc("fl_magnetic_acc",
+                  own("magnetic") + ", " + fo + ", " + kP + ", " + kV + ", charge, mass");
     return true;
   }
   if (std::holds_alternative<SampledField>(act)) {
-    s.apply = call("fl_sampled_field", ap + ", extra, dt, " + kP + ", " + kPV);
-    s.accel = acc("fl_sampled_field_acc", ap + ", extra, " + kP + ", " + kV);
+    s.apply = call("fl_grid_field", ap + ", extra, dt, " + kP + ", " + kPV);
+    s.accel = acc("fl_grid_field_acc", ap + ", extra, " + kP + ", " + kV);
     return true;
   }
   if (std::holds_alternative<TargetVelocity>(act)) {
-    s.apply = call("fl_target3", apDt + ", " + kPV);
+    s.apply = call("fl_target3", own("target") + ", dt, " + kPV);
     return true;
   }
   if (std::holds_alternative<TargetRotVelocity>(act)) {
-    s.apply = call("fl_target3", apDt + ", &rotx, &roty, &rotz");
+    s.apply = call("fl_target3", own("target") + ", dt, &rotx, &roty, &rotz");
     return true;
   }
   if (std::holds_alternative<TargetColor>(act)) {
-    s.apply = call("fl_target_color", apDt + ", &r, &g, &b, &a");
+    s.apply = call("fl_target_color", own("target") + ", dt, &r, &g, &b, &a");
     return true;
   }
   if (std::holds_alternative<TargetSize>(act)) {
-    s.apply = call("fl_target_size", apDt + ", &size");
+    s.apply = call("fl_target_size", own("target") + ", dt, &size");
     return true;
   }
   if (std::holds_alternative<SpeedClamp>(act)) {
-    s.apply = call("fl_speed_clamp", ap + ", " + kPV);
+    s.apply = call("fl_speed_clamp", own("speedClamp") + ", " + kPV);
     return true;
   }
   // Multiply scales the birth value, Replace sets the curve's (actions_more.hpp).
@@ -182,96 +191,22 @@ bool generateForceAction(const Action& act, ActionSource& s) {
 }
 
 bool packForceAction(const Action& act, ActionPack& p) {
-  const float dt = p.dt;
+  // The records are actionParams()'s; here what lives in the device's storage: a domain's
+  // packed form, a grid's or a curve's floats in `extra` and where they start.
   auto& own = p.p.own;
-  // exp(-rate·dt) as the CPU makes it, for the step's dt (fl_force_decay).
-  auto decay = [&](float rate) { return std::exp(-rate * dt); };
-  auto falloff = [&](const Falloff& f) {
-    p.p.falloff = {f.center.x, f.center.y, f.center.z, f.radius, f.power};
-  };
-  auto target = [&](float x, float y, float z, float w, float rate) {
-    own.target = {{x, y, z, w}, rate, dt, decay(rate)};
-  };
-  auto damping = [&](Vec3 rate) {
-    own.damping = {xyz(Vec3(decay(rate.x), decay(rate.y), decay(rate.z))), xyz(rate), dt};
-  };
-  if (const auto* g = std::get_if<Gravity>(&act)) {
-    own.gravity = {xyz(g->acceleration)};
-    falloff(g->falloff);
-  } else if (const auto* d = std::get_if<Damping>(&act)) {
-    damping(d->rate);
-    falloff(d->falloff);
-  } else if (const auto* rd = std::get_if<RotDamping>(&act)) {
-    damping(rd->rate);
-  } else if (const auto* o = std::get_if<OrbitPoint>(&act)) {
-    own.orbitPoint = {xyz(o->center), o->magnitude, o->epsilon, o->maxRadius};
-  } else if (const auto* ol = std::get_if<OrbitLine>(&act)) {
-    // The axis normalised as the CPU normalises it, per block.
-    own.orbitLine = {xyz(ol->point), xyz(glm::normalize(ol->axis)), ol->magnitude, ol->epsilon,
-                     ol->maxRadius};
-  } else if (const auto* v = std::get_if<Vortex>(&act)) {
-    own.vortex = {xyz(v->center),
-                  xyz(glm::normalize(v->axis)),
-                  v->aroundSpeed,
-                  v->coreRadius,
-                  v->tightness,
-                  v->inSpeed,
-                  v->upSpeed,
-                  v->maxRadius,
-                  v->responsiveness,
-                  dt,
-                  decay(v->responsiveness)};
-  } else if (const auto* j = std::get_if<Jet>(&act)) {
-    own.jet = {xyz(j->center), j->radius};
+  if (const auto* j = std::get_if<Jet>(&act)) {
     p.p.domain = packSampled(j->acceleration, p);
-  } else if (const auto* e = std::get_if<Explosion>(&act)) {
-    const float twoVariance = 2 * e->stddev * e->stddev;  // accumulate()'s; apply() its inverse
-    own.explosion = {xyz(e->center), e->speed,           e->magnitude, e->epsilon,
-                     e->time,        1.0f / twoVariance, twoVariance};
   } else if (const auto* ra = std::get_if<RandomAccel>(&act)) {
     p.p.domain = packSampled(ra->acceleration, p);
-    falloff(ra->falloff);
   } else if (const auto* rp = std::get_if<RandomDisplace>(&act)) {
     p.p.domain = packSampled(rp->displacement, p);
   } else if (const auto* rv = std::get_if<RandomVelocity>(&act)) {
     p.p.domain = packSampled(rv->velocity, p);
   } else if (const auto* rr = std::get_if<RandomRotVelocity>(&act)) {
     p.p.domain = packSampled(rr->rotVelocity, p);
-  } else if (const auto* t = std::get_if<Turbulence>(&act)) {
-    own.turbulence = {t->amplitude, t->frequency, xyz(t->drift), cl::fl_u32(t->octaves)};
-    falloff(t->falloff);
-  } else if (const auto* ef = std::get_if<ElectricField>(&act)) {
-    own.electric = {xyz(ef->field)};
-    falloff(ef->falloff);
-  } else if (const auto* m = std::get_if<MagneticField>(&act)) {
-    const float B = glm::length(m->field);
-    own.magnetic = {xyz(B > 0.0f ? m->field / B : Vec3(0.0f)), B, xyz(m->field)};
-    falloff(m->falloff);
   } else if (const auto* sf = std::get_if<SampledField>(&act)) {
-    const VectorField& field = *sf->field;
-    own.sampledField = {xyz(field.origin),
-                        field.voxelSize,
-                        sf->strength,
-                        sf->responsiveness,
-                        dt,
-                        decay(sf->responsiveness),
-                        cl::fl_u32(p.extra.size()),
-                        cl::fl_u32(field.dims.x),
-                        cl::fl_u32(field.dims.y),
-                        cl::fl_u32(field.dims.z),
-                        sf->mode == SampledField::Mode::Velocity ? 1u : 0u};
-    for (const Vec3& v : field.data) p.extra.insert(p.extra.end(), {v.x, v.y, v.z});
-    falloff(sf->falloff);
-  } else if (const auto* tv = std::get_if<TargetVelocity>(&act)) {
-    target(tv->velocity.x, tv->velocity.y, tv->velocity.z, 0.0f, tv->rate);
-  } else if (const auto* tr = std::get_if<TargetRotVelocity>(&act)) {
-    target(tr->rotVelocity.x, tr->rotVelocity.y, tr->rotVelocity.z, 0.0f, tr->rate);
-  } else if (const auto* tc = std::get_if<TargetColor>(&act)) {
-    target(tc->color.x, tc->color.y, tc->color.z, tc->alpha, tc->rate);
-  } else if (const auto* ts = std::get_if<TargetSize>(&act)) {
-    target(ts->size, 0.0f, 0.0f, 0.0f, ts->rate);
-  } else if (const auto* c = std::get_if<SpeedClamp>(&act)) {
-    own.speedClamp = {c->minSpeed, c->maxSpeed};
+    own.sampledField.first = cl::fl_u32(p.extra.size());
+    for (const Vec3& v : sf->field->data) p.extra.insert(p.extra.end(), {v.x, v.y, v.z});
   } else if (const auto* co = std::get_if<ColorOverLife>(&act)) {
     own.curve = {cl::fl_u32(p.extra.size()), cl::fl_u32(co->keys.size())};
     for (const auto& k : co->keys)
@@ -280,7 +215,11 @@ bool packForceAction(const Action& act, ActionPack& p) {
     own.curve = {cl::fl_u32(p.extra.size()), cl::fl_u32(so->keys.size())};
     for (const auto& k : so->keys) p.extra.insert(p.extra.end(), {k.t, k.size});
   } else {
-    return false;
+    return isForce(act) || std::holds_alternative<RotDamping>(act) ||
+           std::holds_alternative<TargetVelocity>(act) ||
+           std::holds_alternative<TargetRotVelocity>(act) ||
+           std::holds_alternative<TargetColor>(act) || std::holds_alternative<TargetSize>(act) ||
+           std::holds_alternative<SpeedClamp>(act);
   }
   return true;
 }

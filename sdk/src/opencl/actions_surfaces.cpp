@@ -92,7 +92,7 @@ bool generateSurfaceAction(const Action& act, ActionSource& s) {
     return true;
   }
   if (std::holds_alternative<Constrain2D>(act)) {
-    s.apply = "fl_constrain2d(" + ap + ", " + pv;
+    s.apply = "fl_constrain2d(" + ap + "->own.constrain2d, " + pv;
     return true;
   }
   if (std::holds_alternative<Gravitate>(act) || std::holds_alternative<Follow>(act)) {
@@ -118,35 +118,21 @@ bool generateSurfaceAction(const Action& act, ActionSource& s) {
 }
 
 bool packSurfaceAction(const Action& act, ActionPack& p) {
-  auto& own = p.p.own;
+  // The records are actionParams()'s; here the regions' packed form.
   if (const auto* b = std::get_if<Bounce>(&act)) {
     p.p.domain = packDomain(b->surface);  // boxes, and the integrators' guard
-    own.bounce = bounceParams(*b);
   } else if (const auto* k = std::get_if<Sink>(&act)) {
     p.p.domain = packRegion(k->region, p);
-    own.sink = {k->passThrough};
   } else if (const auto* sv = std::get_if<SinkVelocity>(&act)) {
     p.p.domain = packRegion(sv->velocity, p);
   } else if (const auto* bl = std::get_if<Block>(&act)) {
     p.p.domain = packRegion(bl->region, p);
   } else if (const auto* av = std::get_if<Avoid>(&act)) {
     p.p.domain = packRegion(av->obstacle, p);
-    own.avoid = {av->magnitude, av->epsilon, av->lookAhead};
-  } else if (const auto* c = std::get_if<Constrain2D>(&act)) {
-    own.constrain2d = {xyz(c->point), xyz(glm::normalize(c->normal))};
-  } else if (const auto* g = std::get_if<Gravitate>(&act)) {
-    own.pull = {g->magnitude, g->epsilon, g->maxRadius * g->maxRadius};
-  } else if (const auto* f = std::get_if<Follow>(&act)) {
-    own.pull = {f->magnitude, f->epsilon, f->maxRadius * f->maxRadius};
-  } else if (const auto* mv = std::get_if<MatchVelocity>(&act)) {
-    // actions_more.hpp approach(rate, dt) for the step's dt; sub-steps compute their own.
-    own.match = {mv->magnitude, p.dt, mv->maxRadius * mv->maxRadius,
-                 1.0f - std::exp(-mv->magnitude * p.dt)};
-  } else if (const auto* mr = std::get_if<MatchRotVelocity>(&act)) {
-    own.match = {mr->magnitude, p.dt, mr->maxRadius * mr->maxRadius,
-                 1.0f - std::exp(-mr->magnitude * p.dt)};
   } else {
-    return false;
+    return std::holds_alternative<Constrain2D>(act) || std::holds_alternative<Gravitate>(act) ||
+           std::holds_alternative<Follow>(act) || std::holds_alternative<MatchVelocity>(act) ||
+           std::holds_alternative<MatchRotVelocity>(act);
   }
   return true;
 }

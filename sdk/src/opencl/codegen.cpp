@@ -7,6 +7,7 @@
 #include <sstream>
 #include <type_traits>
 
+#include "../action_params.hpp"
 #include "../action_traits.hpp"
 #include "../shape_math.hpp"
 #include "flurry/callback.hpp"
@@ -177,6 +178,7 @@ void packActions(const ActionList& actions, float dt, std::vector<cl::FlActionPa
   extra.clear();
   for (std::size_t k = 0; k < actions.size(); ++k) {
     const Action& a = actions.actions()[k];
+    out[k] = actionParams(a, dt);  // the record, as the CPU's pass makes it
     ActionPack p{dt, out[k], extra};
     if (!packCoreAction(a, p) && !packForceAction(a, p) && !packSurfaceAction(a, p))
       notOnDevice("action '" + actionName(a) + "' (actions[" + std::to_string(k) + "])");
