@@ -195,6 +195,11 @@ inline void apply(const Gravity&, const Lanes& L, std::size_t n, const BlockCont
                  });
     return;
   }
+  if (!c.ownDt) {  // fl_gravity with a·dt made once for the block
+    const cl::FlXyz a = g.acceleration;
+    addLoop(L.v[0], L.v[1], L.v[2], n, a.x * c.dt, a.y * c.dt, a.z * c.dt);
+    return;
+  }
   velocityLoop(L, n, c, [g](float, float, float, float dt, float* x, float* y, float* z) {
     kernel::fl_gravity(g, dt, x, y, z);
   });
