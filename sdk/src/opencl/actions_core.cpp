@@ -1,6 +1,5 @@
 // The core actions on the device: Move, KillOld, CopyVertexB, Restore, Callback (its OpenCL
 // body). Their functions are in kernels/actions.cl.
-#include <bit>
 #include <regex>
 #include <string>
 
@@ -65,13 +64,6 @@ bool generateCoreAction(const Action& act, ActionSource& s) {
     return true;
   }
   return false;
-}
-
-bool packCoreAction(const Action& act, ActionPack&) {
-  // (Restore's record is actionParams()'s; the others have none.)
-  return std::holds_alternative<Restore>(act) || std::holds_alternative<KillOld>(act) ||
-         std::holds_alternative<Move>(act) || std::holds_alternative<CopyVertexB>(act) ||
-         std::holds_alternative<Callback>(act);
 }
 
 }  // namespace flurry::detail::ocl

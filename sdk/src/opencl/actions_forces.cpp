@@ -9,7 +9,6 @@
 #include <cmath>
 #include <string>
 
-#include "../action_traits.hpp"
 #include "codegen.hpp"
 #include "emission.hpp"
 
@@ -20,13 +19,10 @@ namespace {
 using A = Attribute;
 
 // A domain the device samples: its kind as a literal (fl_sample_any folds its switch on
-// it); a mesh's or union's data is in the list's `extra` (packSampled), which the calls pass.
+// it); a mesh's or union's data is in the list's `extra` (codegen.cpp packStorage), which the
+// calls pass.
 std::string kindOf(const Domain& d) {
   return std::to_string(d.shape().index()) + "u";
-}
-
-cl::FlDomain packSampled(const Domain& d, ActionPack& p) {
-  return ShapePacker{p.extra, {}, {}}.pack(d);
 }
 
 // The random-stream arguments the fl_* functions take after the lanes.
@@ -188,40 +184,6 @@ bool generateForceAction(const Action& act, ActionSource& s) {
     return true;
   }
   return false;
-}
-
-bool packForceAction(const Action& act, ActionPack& p) {
-  // The records are actionParams()'s; here what lives in the device's storage: a domain's
-  // packed form, a grid's or a curve's floats in `extra` and where they start.
-  auto& own = p.p.own;
-  if (const auto* j = std::get_if<Jet>(&act)) {
-    p.p.domain = packSampled(j->acceleration, p);
-  } else if (const auto* ra = std::get_if<RandomAccel>(&act)) {
-    p.p.domain = packSampled(ra->acceleration, p);
-  } else if (const auto* rp = std::get_if<RandomDisplace>(&act)) {
-    p.p.domain = packSampled(rp->displacement, p);
-  } else if (const auto* rv = std::get_if<RandomVelocity>(&act)) {
-    p.p.domain = packSampled(rv->velocity, p);
-  } else if (const auto* rr = std::get_if<RandomRotVelocity>(&act)) {
-    p.p.domain = packSampled(rr->rotVelocity, p);
-  } else if (const auto* sf = std::get_if<SampledField>(&act)) {
-    own.sampledField.first = cl::fl_u32(p.extra.size());
-    for (const Vec3& v : sf->field->data) p.extra.insert(p.extra.end(), {v.x, v.y, v.z});
-  } else if (const auto* co = std::get_if<ColorOverLife>(&act)) {
-    own.curve = {cl::fl_u32(p.extra.size()), cl::fl_u32(co->keys.size())};
-    for (const auto& k : co->keys)
-      p.extra.insert(p.extra.end(), {k.t, k.color.r, k.color.g, k.color.b, k.color.a});
-  } else if (const auto* so = std::get_if<SizeOverLife>(&act)) {
-    own.curve = {cl::fl_u32(p.extra.size()), cl::fl_u32(so->keys.size())};
-    for (const auto& k : so->keys) p.extra.insert(p.extra.end(), {k.t, k.size});
-  } else {
-    return isForce(act) || std::holds_alternative<RotDamping>(act) ||
-           std::holds_alternative<TargetVelocity>(act) ||
-           std::holds_alternative<TargetRotVelocity>(act) ||
-           std::holds_alternative<TargetColor>(act) || std::holds_alternative<TargetSize>(act) ||
-           std::holds_alternative<SpeedClamp>(act);
-  }
-  return true;
 }
 
 }  // namespace flurry::detail::ocl

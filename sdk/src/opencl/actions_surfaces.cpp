@@ -13,14 +13,9 @@ namespace flurry::detail::ocl {
 namespace {
 
 // The kind literal of a region the device tests. The calls pass the list's `extra` as the
-// table where a mesh's or union's data is (packRegion), read for those kinds only.
+// table where a mesh's or union's data is (codegen.cpp packStorage), read for those kinds only.
 std::string kindOf(const Domain& d) {
   return std::to_string(d.shape().index()) + "u";
-}
-
-// A region, obstacle or velocity domain: a mesh's or union's data into `extra`.
-cl::FlDomain packRegion(const Domain& d, ActionPack& p) {
-  return ShapePacker{p.extra, {}, {}}.pack(d);
 }
 
 const char* kSnapArgs = "snap, snapStride, snapN, i";
@@ -115,26 +110,6 @@ bool generateSurfaceAction(const Action& act, ActionSource& s) {
     return true;
   }
   return false;
-}
-
-bool packSurfaceAction(const Action& act, ActionPack& p) {
-  // The records are actionParams()'s; here the regions' packed form.
-  if (const auto* b = std::get_if<Bounce>(&act)) {
-    p.p.domain = packDomain(b->surface);  // boxes, and the integrators' guard
-  } else if (const auto* k = std::get_if<Sink>(&act)) {
-    p.p.domain = packRegion(k->region, p);
-  } else if (const auto* sv = std::get_if<SinkVelocity>(&act)) {
-    p.p.domain = packRegion(sv->velocity, p);
-  } else if (const auto* bl = std::get_if<Block>(&act)) {
-    p.p.domain = packRegion(bl->region, p);
-  } else if (const auto* av = std::get_if<Avoid>(&act)) {
-    p.p.domain = packRegion(av->obstacle, p);
-  } else {
-    return std::holds_alternative<Constrain2D>(act) || std::holds_alternative<Gravitate>(act) ||
-           std::holds_alternative<Follow>(act) || std::holds_alternative<MatchVelocity>(act) ||
-           std::holds_alternative<MatchRotVelocity>(act);
-  }
-  return true;
 }
 
 }  // namespace flurry::detail::ocl

@@ -10,6 +10,7 @@
 #include "../action_params.hpp"
 #include "../action_traits.hpp"
 #include "../shape_math.hpp"
+#include "emission.hpp"
 #include "flurry/callback.hpp"
 #include "flurry/error.hpp"
 
@@ -172,6 +173,48 @@ cl::FlDomain packDomain(const Domain& d) {
   throw Error("OpenCL backend: " + what + " does not run on the device yet; use Backend::Cpu");
 }
 
+namespace {
+
+// What of an action lives in the device's storage, beside its record: the packed form of the
+// domain it samples or tests (a mesh's or union's data into `extra`, which the calls pass),
+// a grid's or a curve's floats and where they start.
+void packStorage(const Action& act, cl::FlActionParams& p, std::vector<float>& extra) {
+  auto shape = [&](const Domain& d) { p.domain = ShapePacker{extra, {}, {}}.pack(d); };
+  if (const auto* b = std::get_if<Bounce>(&act)) {
+    p.domain = packDomain(b->surface);  // boxes, and the integrators' guard
+  } else if (const auto* k = std::get_if<Sink>(&act)) {
+    shape(k->region);
+  } else if (const auto* sv = std::get_if<SinkVelocity>(&act)) {
+    shape(sv->velocity);
+  } else if (const auto* bl = std::get_if<Block>(&act)) {
+    shape(bl->region);
+  } else if (const auto* av = std::get_if<Avoid>(&act)) {
+    shape(av->obstacle);
+  } else if (const auto* j = std::get_if<Jet>(&act)) {
+    shape(j->acceleration);
+  } else if (const auto* ra = std::get_if<RandomAccel>(&act)) {
+    shape(ra->acceleration);
+  } else if (const auto* rp = std::get_if<RandomDisplace>(&act)) {
+    shape(rp->displacement);
+  } else if (const auto* rv = std::get_if<RandomVelocity>(&act)) {
+    shape(rv->velocity);
+  } else if (const auto* rr = std::get_if<RandomRotVelocity>(&act)) {
+    shape(rr->rotVelocity);
+  } else if (const auto* sf = std::get_if<SampledField>(&act)) {
+    p.own.sampledField.first = cl::fl_u32(extra.size());
+    for (const Vec3& v : sf->field->data) extra.insert(extra.end(), {v.x, v.y, v.z});
+  } else if (const auto* co = std::get_if<ColorOverLife>(&act)) {
+    p.own.curve = {cl::fl_u32(extra.size()), cl::fl_u32(co->keys.size())};
+    for (const auto& k : co->keys)
+      extra.insert(extra.end(), {k.t, k.color.r, k.color.g, k.color.b, k.color.a});
+  } else if (const auto* so = std::get_if<SizeOverLife>(&act)) {
+    p.own.curve = {cl::fl_u32(extra.size()), cl::fl_u32(so->keys.size())};
+    for (const auto& k : so->keys) extra.insert(extra.end(), {k.t, k.size});
+  }
+}
+
+}  // namespace
+
 void packActions(const ActionList& actions, float dt, std::vector<cl::FlActionParams>& out,
                  std::vector<float>& extra) {
   out.assign(std::max<std::size_t>(actions.size(), 1), cl::FlActionParams{});
@@ -179,9 +222,7 @@ void packActions(const ActionList& actions, float dt, std::vector<cl::FlActionPa
   for (std::size_t k = 0; k < actions.size(); ++k) {
     const Action& a = actions.actions()[k];
     out[k] = actionParams(a, dt);  // the record, as the CPU's pass makes it
-    ActionPack p{dt, out[k], extra};
-    if (!packCoreAction(a, p) && !packForceAction(a, p) && !packSurfaceAction(a, p))
-      notOnDevice("action '" + actionName(a) + "' (actions[" + std::to_string(k) + "])");
+    packStorage(a, out[k], extra);
   }
   if (extra.empty()) extra.push_back(0.0f);  // a buffer is never empty
 }

@@ -89,24 +89,14 @@ struct ActionSource {
   std::string accel;
 };
 
-/// The constants of one action for a step of dt seconds.
-struct ActionPack {
-  float dt;
-  cl::FlActionParams& p;
-  std::vector<float>& extra;
-};
-
-// Each family's generator and packer: false when the action is not the family's.
+// Each family's generator: false when the action is not the family's.
 // actions_core.cpp: Move, KillOld, CopyVertexB, Restore, Callback.
 bool generateCoreAction(const Action& a, ActionSource& s);
-bool packCoreAction(const Action& a, ActionPack& p);
 // actions_forces.cpp (kernels/forces.cl): forces, random and target actions, over-life curves.
 bool generateForceAction(const Action& a, ActionSource& s);
-bool packForceAction(const Action& a, ActionPack& p);
 // actions_surfaces.cpp (kernels/surfaces.cl): deflectors, absorbers, blockers, 2-D, and the
 // actions that read neighbours.
 bool generateSurfaceAction(const Action& a, ActionSource& s);
-bool packSurfaceAction(const Action& a, ActionPack& p);
 /// A planar Bounce's call when the next Move integrates with the acceleration held in the
 /// variables `acc` + "x", "y", "z" (fl_bounce_planar_accel); "" for other surfaces.
 std::string bounceOnCurve(const Bounce& b, const std::string& params, const std::string& acc);
@@ -114,7 +104,10 @@ std::string bounceOnCurve(const Bounce& b, const std::string& params, const std:
 /// Throws the Error that says an action (or a variant of one) does not run on the device.
 [[noreturn]] void notOnDevice(const std::string& what);
 
-/// The actions' constants for a step of dt seconds (products with dt rounded as on the CPU).
+/// The actions' constants for a step of dt seconds: each one's record, as the CPU's pass
+/// makes it (actionParams), with what lives in the device's storage added (a domain's packed
+/// form; a mesh's, a grid's or a curve's floats in `extra`). The list went through
+/// generateProgram first, which refuses what does not run on the device.
 void packActions(const ActionList& actions, float dt, std::vector<cl::FlActionParams>& out,
                  std::vector<float>& extra);
 
