@@ -26,7 +26,9 @@ inline void put(float* const* a, std::size_t i, Vec3 v) {
   a[2][i] = v.z;
 }
 // The per-particle math of the forces and absorbers is kernels/forces.h and absorb.h, shared
-// with the device (kernels.hpp includes them in namespace kernel); these adapt its arguments.
+// with the device (forces_kernel.hpp and kernels.hpp include them in namespace kernel); each
+// apply below reads its action's record (BlockContext::record(), made by actionParams as the
+// device's is) and calls them.
 // Gravitate's and Follow's pull towards a neighbour d away (kernels/forces.h fl_pull).
 inline Vec3 softPull(Vec3 d, const cl::FlPullParams& q) {
   Vec3 o;
