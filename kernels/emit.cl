@@ -49,16 +49,15 @@ FL_INLINE float3 fl_emitter_at(__global const FlEmitter* e, __global const FlKey
 }
 
 
-/* emission.cpp chooseType: the first draw of an emitter with several types. */
+/* The first draw of an emitter with several types picks one (newborn.h FL_CHOOSE_TYPE, as
+ * emission_plan.hpp chooseType on the CPU). */
 FL_INLINE uint fl_choose_type(__global const FlEmitter* em, __global const FlParticleType* types,
                               FlRandom* rng) {
-  float u = fl_uniform(rng) * em->totalWeight;
-  for (uint j = 0; j < em->typeCount; ++j) {
-    const float w = types[em->typeFirst + j].weight;
-    if (u < w) return j;
-    u -= w;
-  }
-  return em->typeCount - 1;
+  uint type;
+#define FL_WEIGHT_OF(k) types[em->typeFirst + (k)].weight
+  FL_CHOOSE_TYPE(type, em->typeCount, FL_WEIGHT_OF, fl_uniform(rng) * em->totalWeight);
+#undef FL_WEIGHT_OF
+  return type;
 }
 
 /* One newborn of type `type`: each value from where kernels/newborn.h says its draws start

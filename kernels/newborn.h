@@ -46,4 +46,24 @@ FL_INLINE FlNewbornDraws fl_newborn_draws(uint nType, uint nVelocity, uint nShap
   return d;
 }
 
+/* The type a newborn of an emitter with several types takes, into `out`: the first of `count`
+ * types whose weight its draw `u` (a uniform times the weights' total) falls under, taking
+ * each weight off as it passes; the last if rounding carries u past them all. `weightOf(k)`
+ * is type k's weight, read from each side's own storage (the CPU's ParticleType vector, the
+ * device's type table): a macro, as OpenCL C 1.2 has neither templates nor one pointer for
+ * both address spaces. */
+#define FL_CHOOSE_TYPE(out, count, weightOf, u)                                  \
+  do {                                                                           \
+    float fl_left_ = (u);                                                        \
+    (out) = (count)-1u;                                                          \
+    for (unsigned int fl_k_ = 0u; fl_k_ < (count); ++fl_k_) {                    \
+      const float fl_w_ = weightOf(fl_k_);                                       \
+      if (fl_left_ < fl_w_) {                                                    \
+        (out) = fl_k_;                                                           \
+        break;                                                                   \
+      }                                                                          \
+      fl_left_ -= fl_w_;                                                         \
+    }                                                                            \
+  } while (0)
+
 #endif /* FLURRY_KERNELS_NEWBORN_H */

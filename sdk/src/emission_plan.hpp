@@ -9,6 +9,7 @@
 
 #include "backend.hpp"
 #include "isa_namespace.hpp"
+#include "kernel_compat.hpp"
 
 namespace flurry::detail {
 
@@ -79,16 +80,15 @@ inline const Emitter& emitterOf(const GroupImpl& g, const BirthRun& run) {
   return run.live ? g.live[run.index].emitter : g.emitters[run.index];
 }
 
-/// The type a newborn takes, by the types' weights, from the uniform u.
+/// The type a newborn takes, by the types' weights, from the uniform u (kernels/newborn.h
+/// FL_CHOOSE_TYPE, the device's walk too; the total summed in order, as its host does).
 inline std::size_t chooseType(const std::vector<ParticleType>& types, float u) {
   float total = 0;
   for (const auto& t : types) total += t.weight;
-  u *= total;
-  for (std::size_t k = 0; k < types.size(); ++k) {
-    if (u < types[k].weight) return k;
-    u -= types[k].weight;
-  }
-  return types.size() - 1;
+  const auto weightOf = [&](kernel::uint k) { return types[k].weight; };
+  kernel::uint type;
+  FL_CHOOSE_TYPE(type, kernel::uint(types.size()), weightOf, u * total);
+  return type;
 }
 /// The same from rng's next draw, when there are several (one type draws nothing).
 inline std::size_t chooseType(const std::vector<ParticleType>& types, Random& rng) {
