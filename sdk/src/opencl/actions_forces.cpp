@@ -10,7 +10,6 @@
 #include <string>
 
 #include "codegen.hpp"
-#include "emission.hpp"
 
 namespace flurry::detail::ocl {
 

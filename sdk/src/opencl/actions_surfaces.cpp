@@ -6,7 +6,6 @@
 
 #include "../action_params.hpp"
 #include "codegen.hpp"
-#include "emission.hpp"
 
 namespace flurry::detail::ocl {
 

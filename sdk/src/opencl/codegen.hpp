@@ -121,11 +121,6 @@ inline std::uint64_t doubleBits(double d) {
   return b;
 }
 
-/// A vector as the params' records hold it.
-inline cl::FlXyz xyz(Vec3 v) {
-  return {v.x, v.y, v.z};
-}
-
 inline void putVec(float* v, int at, Vec3 x) {
   v[at] = x.x;
   v[at + 1] = x.y;
