@@ -584,38 +584,60 @@ void compact(GroupImpl& g, const StepParams& sp) {
   // Where the act pass stopped filling holes (none filled: from the top).
   const std::size_t filled = std::exchange(g.holesFilled, 0);
   const std::size_t from = filled > 0 ? g.filledFrom : g.size;
+  // Holes [filled, filled + count) take the live particles below `from`, highest first.
+  const std::size_t count =
+      std::size_t(std::lower_bound(left + filled, left + leftCount, newSize) - (left + filled));
+  g.size = newSize;
+  if (count == 0) return;
   thread_local std::vector<std::pair<std::uint32_t, std::uint32_t>> movesStore;
   auto& moves = movesStore;  // (from, to)
-  moves.clear();
   // As many as the holes may ever be (their capacity only grows): a step that leaves more
   // holes than any before does not allocate.
-  if (moves.capacity() < leftCount) moves.reserve(std::max(leftCount, g.holes.capacity()));
-  std::size_t src = from;  // candidates below this
-  // Holes at or above src are left[back..].
-  std::size_t back = std::size_t(std::lower_bound(left, left + leftCount, from) - left);
-  for (std::size_t h = filled; h < leftCount && left[h] < newSize; ++h) {
-    do {
-      --src;
-    } while (back > 0 && left[back - 1] == src && (--back, true));
-    moves.emplace_back(std::uint32_t(src), left[h]);
-  }
-  g.size = newSize;
-  if (moves.empty()) return;
+  if (moves.size() < count) moves.resize(std::max(count, g.holes.capacity()));
   StoredLanes stored;
   const std::size_t lanes = storedLanes(g, stored);
-  auto moveLane = [&](std::uint32_t* lane, std::size_t a, std::size_t b) {
-    for (std::size_t k = a; k < b; ++k) lane[moves[k].second] = lane[moves[k].first];
+  // Moves [a, b): the live particles below `src` (the one move a - 1 took, or `from`) go to
+  // holes filled + a on, each lane in turn.
+  auto fill = [&](std::size_t a, std::size_t b, std::size_t src) {
+    // Holes at or above src are left[back..].
+    std::size_t back = std::size_t(std::lower_bound(left, left + leftCount, src) - left);
+    for (std::size_t j = a; j < b; ++j) {
+      do {
+        --src;
+      } while (back > 0 && left[back - 1] == src && (--back, true));
+      moves[j] = {std::uint32_t(src), left[filled + j]};
+    }
+    for (std::size_t l = 0; l < lanes; ++l) {
+      std::uint32_t* __restrict lane = stored[l];
+      for (std::size_t j = a; j < b; ++j) lane[moves[j].second] = lane[moves[j].first];
+    }
   };
   // A few moves (a small group, or a near-steady one) cost less than waking a worker.
-  if (moves.size() * lanes <= kInlineMoves) {
-    for (std::size_t l = 0; l < lanes; ++l) moveLane(stored[l], 0, moves.size());
+  if (count * lanes <= kInlineMoves || sp.pool->size() == 1) {
+    fill(0, count, from);
     return;
   }
-  const std::size_t perTask = 65536;
-  const std::size_t chunks = (moves.size() + perTask - 1) / perTask;
-  sp.pool->parallelFor(lanes * chunks, [&](std::size_t t) {
-    const std::size_t a = (t % chunks) * perTask;
-    moveLane(stored[t / chunks], a, std::min(moves.size(), a + perTask));
+  // In parallel: a piece of the moves starts below the j-th live particle under `from`,
+  // found by bisection (the live in [x, from) are those not among the holes there).
+  auto liveAbove = [&](std::size_t x) {
+    const auto holesIn = std::size_t(std::lower_bound(left, left + leftCount, from) -
+                                     std::lower_bound(left, left + leftCount, x));
+    return (from - x) - holesIn;
+  };
+  auto below = [&](std::size_t j) {  // the j-th live particle under from (j = 0: from)
+    if (j == 0) return from;
+    std::size_t lo = newSize, hi = from;  // the largest x with liveAbove(x) >= j
+    while (hi - lo > 1) {
+      const std::size_t mid = lo + (hi - lo) / 2;
+      (liveAbove(mid) >= j ? lo : hi) = mid;
+    }
+    return lo;
+  };
+  constexpr std::size_t kPerTask = 8192;
+  const std::size_t tasks = (count + kPerTask - 1) / kPerTask;
+  sp.pool->parallelFor(tasks, [&](std::size_t t) {
+    const std::size_t a = t * kPerTask;
+    fill(a, std::min(count, a + kPerTask), below(a));
   });
 }
 
