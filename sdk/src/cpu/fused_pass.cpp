@@ -37,7 +37,6 @@ constexpr std::size_t kParticlesPerTask = 32768;  // below this a group is stepp
 struct Plan {
   const ActionPlan& list;
   std::uint32_t substeps = 1;
-  const float* start[3] = {};  // positions when the step (or sub-step) began, for the guard
 };
 
 std::uint32_t substepCount(GroupImpl& g, const StepParams& sp, ThreadPool& pool) {
@@ -240,10 +239,8 @@ void runActions(const std::vector<Action>& acts, const Plan& plan, std::size_t f
                        dt);
       });
       if (!plan.list.guardsOf[k].empty()) {
-        const float* start[3];
-        for (int c = 0; c < 3; ++c) start[c] = plan.start[c] + ctx.base;
         for (std::uint32_t b : plan.list.guardsOf[k])
-          guard(std::get<Bounce>(acts[b]), lanes, start, n);
+          guard(std::get<Bounce>(acts[b]), lanes, ctx.stepStart, n);
       }
       continue;
     }
@@ -272,6 +269,12 @@ void runActions(const std::vector<Action>& acts, const Plan& plan, std::size_t f
       cpu::logCollisions(std::get<Bounce>(acts[k]), std::uint32_t(k), lanes, n, ctx, before,
                          nullptr);
   }
+}
+
+// A context for the particles from `by` on: where they began the step, too.
+void shiftStart(cpu::BlockContext& c, std::size_t by) {
+  for (const float*& s : c.stepStart)
+    if (s) s += by;
 }
 
 // Whether an action reads the time itself, not only the step's length.
@@ -329,6 +332,7 @@ void runNewborns(const std::vector<Action>& acts, const Plan& plan, std::size_t 
       c.time = (t1 - double(remaining[i])) + double(sub) * double(c.dt);
       c.base += i;
       c.dead += i;
+      shiftStart(c, i);
       runActions(acts, plan, k, k + 1, lanes.offset(i), 1, c);
     }
   }
@@ -346,6 +350,7 @@ void runBlock(const std::vector<Action>& acts, const Plan& plan, std::size_t fir
   cpu::BlockContext c = ctx;
   c.base += old;
   c.dead += old;
+  shiftStart(c, old);
   runNewborns(acts, plan, first, last, lanes.offset(old), m - old, c, remaining, sub, t1);
 }
 
@@ -495,6 +500,7 @@ std::uint32_t collectDead(PassScratch& pass, std::size_t base, std::size_t n,
 struct DeadFlags {
   std::vector<std::uint32_t> flags;
   bool clean = true;
+  std::vector<float> start;  ///< the block's positions at the step's start (a guarded list)
 };
 
 // The blocks [0, blocks) run by one thread (runOne(b)), in an order that lets it close the
@@ -595,14 +601,12 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
   const Lanes lanes = g.lanePointers();
   const bool bounds = g.boundsWanted && lanes.p[0];
   if (bounds) pass.blockBounds.resize(6 * blocks);  // grows, never shrinks
-  Plan plan{planActions(g), substepCount(g, sp, *sp.pool)};
-  if (plan.list.guarded) {
-    // Where each particle began the step: the guard compares with it.
+  const Plan plan{planActions(g), substepCount(g, sp, *sp.pool)};
+  if (plan.list.guarded && !sp.fused) {
+    // Where each particle began the step: the guard compares with it. (The fused pass keeps
+    // each block's own while the block is in cache.)
     pass.stepStart.resize(3 * n);
-    for (int c = 0; c < 3; ++c) {
-      std::copy_n(lanes.p[c], n, pass.stepStart.data() + c * n);
-      plan.start[c] = pass.stepStart.data() + c * n;
-    }
+    for (int c = 0; c < 3; ++c) std::copy_n(lanes.p[c], n, pass.stepStart.data() + c * n);
   }
   const float subDt = float(sp.dt / plan.substeps);
   cpu::BlockContext base{subDt, sp.seed, std::uint32_t(sp.step), g.streamKey() << 16, 0, nullptr};
@@ -671,6 +675,13 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
       store.clean = false;
       ctx.dead = dead.data();
       const Lanes blockLanes = lanes.offset(first);
+      if (plan.list.guarded) {
+        if (store.start.size() < 3 * B) store.start.resize(3 * B);
+        for (int c = 0; c < 3; ++c) {
+          std::copy_n(blockLanes.p[c], m, store.start.data() + c * B);
+          ctx.stepStart[c] = store.start.data() + c * B;
+        }
+      }
       const std::size_t old = oldIn(first, m);
       cpu::CollisionLog log{&g, b, t1, plan.substeps, 0};
       ctx.collisions = logHits ? &log : nullptr;
@@ -723,6 +734,8 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
             cpu::BlockContext ctx = base;
             ctx.base = first;
             ctx.dead = g.deadFlags.data() + first;
+            if (plan.list.guarded)
+              for (int c = 0; c < 3; ++c) ctx.stepStart[c] = pass.stepStart.data() + c * n + first;
             cpu::CollisionLog log{&g, b, t1, plan.substeps, s};
             ctx.collisions = logHits ? &log : nullptr;
             const std::size_t old = oldIn(first, m);

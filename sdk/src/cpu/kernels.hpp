@@ -69,6 +69,9 @@ struct BlockContext {
   CollisionLog* collisions = nullptr;  ///< non-null while the group records collisions
   /// The list's records (actionRecords), made for the sub-step's length.
   const cl::FlActionParams* records = nullptr;
+  /// Positions when the step began, indexed as `dead` (set where the list guards a curved
+  /// step: the guard compares with them).
+  const float* stepStart[3] = {};
   /// Particle i's step length.
   float dtAt(std::size_t i) const { return ownDt ? ownDt[i] : dt; }
   /// The running action's record.
