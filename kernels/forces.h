@@ -422,6 +422,12 @@ FL_INLINE void fl_gravity_acc(FlGravityParams g, FlFalloffParams f, float px, fl
  * at its rate times the weight. */
 FL_INLINE void fl_damping_factors(FlDampingParams d, float dt, float* fx, float* fy, float* fz) {
   *fx = fl_force_decay(d.rate.x, dt, d.dt, d.decay.x);
+  /* The same rate on every axis (the usual damping) decays the same: one exp, not three (a
+   * newborn's own step length has no exp made for it). */
+  if (d.rate.y == d.rate.x && d.rate.z == d.rate.x) {
+    *fy = *fz = *fx;
+    return;
+  }
   *fy = fl_force_decay(d.rate.y, dt, d.dt, d.decay.y);
   *fz = fl_force_decay(d.rate.z, dt, d.dt, d.decay.z);
 }
