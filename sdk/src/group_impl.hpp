@@ -205,7 +205,7 @@ struct PassScratch {
   std::vector<std::uint32_t> blockKills;
   std::vector<float> blockBounds;       ///< per block: min xyz, max xyz of its live particles
   std::vector<std::size_t> deathStart;  ///< each block's first death event
-  std::vector<float> stepStart;         ///< positions at the step's start, for the guard
+  std::vector<float> stepStart;  ///< the unfused pass: positions at the step's start, for the guard
   /// A pass that fills holes as it goes: the live particles of the blocks it took from the
   /// back, highest first, the fillers still to give.
   std::vector<std::uint32_t> spare;

@@ -445,7 +445,7 @@ std::uint32_t collectDead(PassScratch& pass, std::size_t base, std::size_t n,
         _mm512_add_epi32(_mm512_set1_epi32(int(base + i0)),
                          _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
     // Compressed in a register and stored whole: a compressing store to memory is
-    // microcoded on AMD Zen 4 (~20x slower; it was 18 % of the Fountain's step there).
+    // microcoded on AMD Zen 4 (it was 18 % of the Fountain's step there).
     _mm512_storeu_si512(idx + count, _mm512_maskz_compress_epi32(mask, at));
     const __m512i codes = _mm512_maskz_compress_epi32(mask, flags);
     _mm_storeu_si128(reinterpret_cast<__m128i*>(code + count),
