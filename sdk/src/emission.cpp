@@ -589,15 +589,17 @@ void compact(GroupImpl& g, const StepParams& sp) {
       std::size_t(std::lower_bound(left + filled, left + leftCount, newSize) - (left + filled));
   g.size = newSize;
   if (count == 0) return;
-  thread_local std::vector<std::pair<std::uint32_t, std::uint32_t>> movesStore;
-  auto& moves = movesStore;  // (from, to)
+  // Move j takes fillers[j] into holes[j].
+  thread_local std::vector<std::uint32_t> fillersStore;
+  auto& fillers = fillersStore;
   // As many as the holes may ever be (their capacity only grows): a step that leaves more
   // holes than any before does not allocate.
-  if (moves.size() < count) moves.resize(std::max(count, g.holes.capacity()));
+  if (fillers.size() < count) fillers.resize(std::max(count, g.holes.capacity()));
+  const std::uint32_t* holes = left + filled;
   StoredLanes stored;
   const std::size_t lanes = storedLanes(g, stored);
   // Moves [a, b): the live particles below `src` (the one move a - 1 took, or `from`) go to
-  // holes filled + a on, each lane in turn.
+  // holes a on, each lane in turn.
   auto fill = [&](std::size_t a, std::size_t b, std::size_t src) {
     // Holes at or above src are left[back..].
     std::size_t back = std::size_t(std::lower_bound(left, left + leftCount, src) - left);
@@ -605,11 +607,11 @@ void compact(GroupImpl& g, const StepParams& sp) {
       do {
         --src;
       } while (back > 0 && left[back - 1] == src && (--back, true));
-      moves[j] = {std::uint32_t(src), left[filled + j]};
+      fillers[j] = std::uint32_t(src);
     }
     for (std::size_t l = 0; l < lanes; ++l) {
       std::uint32_t* __restrict lane = stored[l];
-      for (std::size_t j = a; j < b; ++j) lane[moves[j].second] = lane[moves[j].first];
+      for (std::size_t j = a; j < b; ++j) lane[holes[j]] = lane[fillers[j]];
     }
   };
   // A few moves (a small group, or a near-steady one) cost less than waking a worker.
@@ -619,10 +621,10 @@ void compact(GroupImpl& g, const StepParams& sp) {
   }
   // In parallel: a piece of the moves starts below the j-th live particle under `from`,
   // found by bisection (the live in [x, from) are those not among the holes there).
+  const auto holesBelowFrom = std::size_t(std::lower_bound(left, left + leftCount, from) - left);
   auto liveAbove = [&](std::size_t x) {
-    const auto holesIn = std::size_t(std::lower_bound(left, left + leftCount, from) -
-                                     std::lower_bound(left, left + leftCount, x));
-    return (from - x) - holesIn;
+    return (from - x) -
+           (holesBelowFrom - std::size_t(std::lower_bound(left, left + leftCount, x) - left));
   };
   auto below = [&](std::size_t j) {  // the j-th live particle under from (j = 0: from)
     if (j == 0) return from;
