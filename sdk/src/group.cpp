@@ -120,8 +120,8 @@ Lanes Lanes::offset(std::size_t b) const {
   return r;
 }
 
-Lanes GroupImpl::lanePointers() const {
-  Lanes l;
+void GroupImpl::cacheLanes() {
+  Lanes& l = laneCache;
   auto f = [&](Attribute a, int c) { return lanes[std::size_t(a)][c].f(); };
   for (int c = 0; c < 3; ++c) {
     l.p[c] = f(Attribute::Position, c);
@@ -145,7 +145,6 @@ Lanes GroupImpl::lanePointers() const {
   l.charge = f(Attribute::Charge, 0);
   l.visible = lanes[std::size_t(Attribute::Visible)][0].u();
   l.user = f(Attribute::UserData, 0);
-  return l;
 }
 
 void writeParticle(const Lanes& l, std::size_t i, const Particle& q) {
@@ -262,6 +261,7 @@ void GroupImpl::ensureStorage() {
       for (auto& lane : slot) lane = LaneBuffer();
     }
   }
+  cacheLanes();
   const AttributeSet before = stored;
   stored = want;
   if (size == 0) return;
@@ -522,13 +522,14 @@ void detail::GroupImpl::operator delete(void* group, std::size_t bytes) noexcept
 }
 
 void detail::GroupImpl::prefetchSelf() const {
-  prefetchBytes(this, sizeof(*this));
+  // Up to the lane table, which a step does not read (laneCache).
+  prefetchBytes(this, std::size_t(reinterpret_cast<const char*>(&lanes) -
+                                  reinterpret_cast<const char*>(this)));
 }
 
 void detail::GroupImpl::prefetchData() const {
-  for (const auto& attribute : lanes)
-    for (const LaneBuffer& lane : attribute)
-      if (lane) prefetchBytes(lane.data(), size * sizeof(float) + 64);
+  const std::size_t bytes = size * sizeof(float) + 64;
+  forEachLane(laneCache, [&](const std::uint32_t* lane) { prefetchBytes(lane, bytes); });
   prefetchVector(actions.actions());
   prefetchVector(emitters);
   prefetchVector(emitterState);

@@ -68,6 +68,36 @@ struct Lanes {
   Lanes offset(std::size_t b) const;
 };
 
+/// Calls f(lane) for every stored lane of `l` (as 32-bit words), in a fixed order.
+template <class F>
+void forEachLane(const Lanes& l, F&& f) {
+  auto one = [&](auto* lane) {
+    if (lane) f(reinterpret_cast<std::uint32_t*>(lane));
+  };
+  for (int c = 0; c < 3; ++c) {
+    one(l.p[c]);
+    one(l.v[c]);
+    one(l.prev[c]);
+    one(l.up[c]);
+    one(l.rot[c]);
+    one(l.posB[c]);
+    one(l.velB[c]);
+  }
+  for (int c = 0; c < 4; ++c) {
+    one(l.color[c]);
+    one(l.birthColor[c]);
+  }
+  one(l.size);
+  one(l.birthSize);
+  one(l.mass);
+  one(l.age);
+  one(l.lifetime);
+  one(l.id);
+  one(l.charge);
+  one(l.visible);
+  one(l.user);
+}
+
 /// Gathers / scatters one particle's stored attributes (others read as Particle's defaults).
 Particle readParticle(const Lanes& L, std::size_t i);
 void writeParticle(const Lanes& L, std::size_t i, const Particle& p);
@@ -254,6 +284,9 @@ struct GroupImpl {
 
   std::size_t capacity = 0;
   std::size_t size = 0;
+  /// The stored lanes' pointers (lanePointers()), taken again whenever `lanes` changes
+  /// (ensureStorage): a step reads these 6 cache lines, not the 18 of the table.
+  Lanes laneCache;
   AttributeSet required{Attribute::Position, Attribute::Id};
   AttributeSet stored;  ///< what the lanes hold now
   ActionList actions;   ///< replace through Group::setActions, which bumps actionsVersion
@@ -309,7 +342,6 @@ struct GroupImpl {
   /// without a trail; marks the step's positions as recorded by the pass. Out of line for
   /// the reason of assignFill.
   std::uint32_t* nextTrailSlot(float** slot);
-  std::array<std::array<LaneBuffer, 4>, std::size_t(Attribute::Count)> lanes;
   GroupStats stats;
   std::uint32_t nextId = 0;
 
@@ -467,7 +499,9 @@ struct GroupImpl {
   /// Allocates the lanes of wanted() not yet stored (existing particles get defaults) and
   /// frees lanes nobody uses any more.
   void ensureStorage();
-  Lanes lanePointers() const;
+  Lanes lanePointers() const { return laneCache; }
+  /// Takes laneCache again from `lanes`.
+  void cacheLanes();
   /// The step's dead (deadIndex/deadCode of `blocks` blocks of B, their lanes not yet
   /// compacted) as DeathEvents at time t1, in particle order up to deathRoom(); the rest
   /// counted. Out of line in group.cpp for the reason of assignFill.
@@ -481,6 +515,10 @@ struct GroupImpl {
   Particle read(std::size_t i) const { return readParticle(lanePointers(), i); }
   /// Copies every stored lane's element `from` to `to`.
   void move(std::size_t from, std::size_t to);
+
+  /// The lanes, by attribute and component (null where not stored). Last, apart from what
+  /// a step reads (laneCache): prefetchSelf() asks for the object up to here.
+  std::array<std::array<LaneBuffer, 4>, std::size_t(Attribute::Count)> lanes;
 };
 
 /// A group's internals, for the library's own code: the public Group does not expose them.
