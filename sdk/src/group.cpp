@@ -193,14 +193,6 @@ Particle readParticle(const Lanes& l, std::size_t i) {
   return q;
 }
 
-void GroupImpl::move(std::size_t from, std::size_t to) {
-  for (auto& attr : lanes)
-    for (auto& lane : attr)
-      if (lane) lane.u()[to] = lane.u()[from];
-  for (auto& lane : trailLanes) lane.u()[to] = lane.u()[from];
-  if (trailCount) trailCount.u()[to] = trailCount.u()[from];
-}
-
 void GroupImpl::startTrails(std::size_t from, std::size_t to) {
   if (trail.length == 0) return;
   const Lanes L = lanePointers();

@@ -513,8 +513,6 @@ struct GroupImpl {
   /// Writes particle p's stored attributes at index i.
   void write(std::size_t i, const Particle& p) { writeParticle(lanePointers(), i, p); }
   Particle read(std::size_t i) const { return readParticle(lanePointers(), i); }
-  /// Copies every stored lane's element `from` to `to`.
-  void move(std::size_t from, std::size_t to);
 
   /// The lanes, by attribute and component (null where not stored). Last, apart from what
   /// a step reads (laneCache): prefetchSelf() asks for the object up to here.
