@@ -96,27 +96,9 @@ void assignFill(std::vector<float>& v, std::size_t n, float value) {
 
 Lanes Lanes::offset(std::size_t b) const {
   Lanes r = *this;
-  auto shift = [b](auto*& ptr) {
+  forEachLanePointer(r, [b](auto*& ptr) {
     if (ptr) ptr += b;
-  };
-  for (auto& q : r.p) shift(q);
-  for (auto& q : r.v) shift(q);
-  for (auto& q : r.color) shift(q);
-  for (auto& q : r.prev) shift(q);
-  for (auto& q : r.up) shift(q);
-  for (auto& q : r.rot) shift(q);
-  for (auto& q : r.posB) shift(q);
-  for (auto& q : r.velB) shift(q);
-  for (auto& q : r.birthColor) shift(q);
-  shift(r.birthSize);
-  shift(r.size);
-  shift(r.mass);
-  shift(r.age);
-  shift(r.lifetime);
-  shift(r.id);
-  shift(r.charge);
-  shift(r.visible);
-  shift(r.user);
+  });
   return r;
 }
 

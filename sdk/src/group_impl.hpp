@@ -68,34 +68,40 @@ struct Lanes {
   Lanes offset(std::size_t b) const;
 };
 
+/// Calls f(pointer) with a reference to each of `l`'s lane pointers, null or not, in a fixed
+/// order: the one list of a Lanes' members (Lanes::offset, forEachLane).
+template <class L, class F>
+void forEachLanePointer(L& l, F&& f) {
+  for (int c = 0; c < 3; ++c) {
+    f(l.p[c]);
+    f(l.v[c]);
+    f(l.prev[c]);
+    f(l.up[c]);
+    f(l.rot[c]);
+    f(l.posB[c]);
+    f(l.velB[c]);
+  }
+  for (int c = 0; c < 4; ++c) {
+    f(l.color[c]);
+    f(l.birthColor[c]);
+  }
+  f(l.size);
+  f(l.birthSize);
+  f(l.mass);
+  f(l.age);
+  f(l.lifetime);
+  f(l.id);
+  f(l.charge);
+  f(l.visible);
+  f(l.user);
+}
+
 /// Calls f(lane) for every stored lane of `l` (as 32-bit words), in a fixed order.
 template <class F>
 void forEachLane(const Lanes& l, F&& f) {
-  auto one = [&](auto* lane) {
+  forEachLanePointer(l, [&](auto* const& lane) {
     if (lane) f(reinterpret_cast<std::uint32_t*>(lane));
-  };
-  for (int c = 0; c < 3; ++c) {
-    one(l.p[c]);
-    one(l.v[c]);
-    one(l.prev[c]);
-    one(l.up[c]);
-    one(l.rot[c]);
-    one(l.posB[c]);
-    one(l.velB[c]);
-  }
-  for (int c = 0; c < 4; ++c) {
-    one(l.color[c]);
-    one(l.birthColor[c]);
-  }
-  one(l.size);
-  one(l.birthSize);
-  one(l.mass);
-  one(l.age);
-  one(l.lifetime);
-  one(l.id);
-  one(l.charge);
-  one(l.visible);
-  one(l.user);
+  });
 }
 
 /// Gathers / scatters one particle's stored attributes (others read as Particle's defaults).
