@@ -9,6 +9,7 @@
 #include <cstring>
 #include <map>
 #include <set>
+#include <tuple>
 
 #include "builtin.hpp"
 #include "flurry/effect.hpp"
@@ -162,32 +163,38 @@ TEST(Group, CompactionKeepsEverySurvivorOnceWithItsLanes) {
   }
 }
 
-// One thread walking a group's blocks fills the holes as it goes, from blocks it takes from
-// the back (fused_pass.cpp fillingWalk), and leaves compaction the rest where the front meets
-// the back: the particles end where compaction alone puts them (two threads share the pass
-// out and leave every hole to it), every lane and trail point bit for bit, however the dead
-// fall.
+// The pass fills the holes as it goes (fused_pass.cpp fillingWalk): one thread walks the
+// blocks from the front and fills each one's holes from the back's blocks, which the other
+// threads run (or it runs itself), and leaves compaction the rest where the front meets the
+// back. The particles end where compaction alone puts them (a group with death events is
+// compacted alone), every lane and trail point bit for bit, on any number of threads, however
+// the dead fall.
 TEST(Group, AWalkThatFillsHolesLeavesWhatCompactionWould) {
-  const std::pair<const char*, bool (*)(std::size_t)> patterns[] = {
-      {"every third, and the tail", [](std::size_t i) { return i % 3 == 0 || i >= 70000; }},
-      {"nine in ten", [](std::size_t i) { return (i * 2654435761u) % 10 != 0; }},
-      {"the first half", [](std::size_t i) { return i < 40000; }},
-      {"the last block", [](std::size_t i) { return i >= 79000; }},
-      {"one in a hundred", [](std::size_t i) { return i % 100 == 7; }}};
-  for (const auto& [name, dies] : patterns) {
+  // (The last block's holes are the back's on more than one thread: compaction's alone.)
+  const std::tuple<const char*, bool (*)(std::size_t), bool> patterns[] = {
+      {"every third, and the tail", [](std::size_t i) { return i % 3 == 0 || i >= 70000; }, true},
+      {"nine in ten", [](std::size_t i) { return (i * 2654435761u) % 10 != 0; }, true},
+      {"the first half", [](std::size_t i) { return i < 40000; }, true},
+      {"the last block", [](std::size_t i) { return i >= 79000; }, false},
+      {"one in a hundred", [](std::size_t i) { return i % 100 == 7; }, true}};
+  for (const auto& [name, dies, front] : patterns) {
     SCOPED_TRACE(name);
-    auto run = [&, dies = dies](unsigned threads, std::uint64_t* filled) {
+    auto run = [&, dies = dies](unsigned threads, std::uint64_t* filled, bool events = false) {
       Context ctx({.seed = 3, .dt = 0.1, .threads = threads});
       Group& g = ctx.createGroup("g", 81000);  // room for the newborns
+      if (events) g.recordDeaths(100);
       g.require({Attribute::Color});
       g.setTrail({.length = 3});
+      // One dies in the first step: threads walk a group where particles died in the last.
+      g.setActions({Sink{Domain::box(Vec3(-6.0f, -6.0f, -1.0f), Vec3(-4.0f, -4.0f, 1.0f))}});
+      EXPECT_TRUE(g.add(Particle{.position = Vec3(-5.0f, -5.0f, 0.0f)}));
       for (std::size_t i = 0; i < 80000; ++i) {
         Particle p;
         p.position = Vec3(float(i), dies(i) ? -1.0f : 1.0f, 0.0f);
         p.velocity = Vec3(0.5f, float(i % 7), 0.0f);
         p.color = Vec4(float(i), 0.0f, 1.0f, 1.0f);
         EXPECT_TRUE(g.add(p));
-        if (i == 40000) ctx.step();  // (no actions yet) the first half's trails one point longer
+        if (i == 40000) ctx.step();  // the first half's trails one point longer
       }
       // Born in the step too (newborns at the tail, which the walk takes from first).
       Emitter e;
@@ -213,12 +220,17 @@ TEST(Group, AWalkThatFillsHolesLeavesWhatCompactionWould) {
       }
       return all;
     };
-    std::uint64_t walked = 0, shared = 0;
-    const auto one = run(1, &walked), two = run(2, &shared);
-    EXPECT_GT(walked, 0u) << "the walk filled no hole";
-    EXPECT_EQ(shared, 0u);
-    ASSERT_EQ(one.size(), two.size());
-    EXPECT_EQ(std::memcmp(one.data(), two.data(), one.size() * sizeof(float)), 0);
+    std::uint64_t none = 0;
+    const auto alone = run(2, &none, true);
+    EXPECT_EQ(none, 0u) << "holes filled in the pass of a group that records its deaths";
+    for (unsigned threads : {1u, 2u, 3u, 4u}) {
+      SCOPED_TRACE(threads);
+      std::uint64_t walked = 0;
+      const auto got = run(threads, &walked);
+      if (threads == 1 || front) EXPECT_GT(walked, 0u) << "the walk filled no hole";
+      ASSERT_EQ(got.size(), alone.size());
+      EXPECT_EQ(std::memcmp(got.data(), alone.data(), got.size() * sizeof(float)), 0);
+    }
   }
 }
 

@@ -242,9 +242,11 @@ struct PassScratch {
   std::vector<float> blockBounds;       ///< per block: min xyz, max xyz of its live particles
   std::vector<std::size_t> deathStart;  ///< each block's first death event
   std::vector<float> stepStart;  ///< the unfused pass: positions at the step's start, for the guard
-  /// A pass that fills holes as it goes: the live particles of the blocks it took from the
-  /// back, highest first, the fillers still to give.
+  /// A pass that fills holes as it goes: the fillers of the block being filled (room for a
+  /// block), and per block whether it has run (set by the worker that ran it, read through
+  /// std::atomic_ref by the one that fills from it).
   std::vector<std::uint32_t> spare;
+  std::vector<std::uint32_t> blockDone;
   bool busy = false;  ///< a step on this thread is using it
 };
 

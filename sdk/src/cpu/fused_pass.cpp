@@ -6,8 +6,10 @@
 // many actions there are, and each action's loop is vectorised on its own. Sub-steps, the
 // integrator's stages and the NaN guard all happen while the block is in cache.
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
+#include <thread>
 #include <vector>
 
 #if defined(__SSE2__)
@@ -503,68 +505,159 @@ struct DeadFlags {
   std::vector<float> start;  ///< the block's positions at the step's start (a guarded list)
 };
 
-// The blocks [0, blocks) run by one thread (runOne(b)), in an order that lets it close the
-// step's holes while each block is still in cache: after a block from the front, each of its
-// holes takes the highest live particle, from blocks run from the back as needed. Those are
-// compact()'s moves, in its order (the lowest hole takes the last live particle), made here
-// instead of in a pass of their own that would read and write every lane again; the walk
-// stops filling where the front meets the back (a hole whose filler would be below it, or in
-// its own block) and leaves compact() the rest (GroupImpl::holesFilled).
+// The pass's blocks, handed out from both ends: [lo, hi) are not taken yet. One word, so that
+// a take from either end is one compare-and-swap.
+class BlockEnds {
+ public:
+  explicit BlockEnds(std::size_t blocks) : ends_(std::uint64_t(blocks) << 32) {}
+  /// The lowest block not taken; false when none is left.
+  bool takeFront(std::size_t& b) {
+    std::uint64_t e = ends_.load(std::memory_order_relaxed);
+    do {
+      if (lo(e) >= hi(e)) return false;
+    } while (!ends_.compare_exchange_weak(e, e + 1, std::memory_order_relaxed));
+    b = lo(e);
+    return true;
+  }
+  /// The highest `most` blocks not taken (fewer where fewer are left), as [b, b + count);
+  /// false when none is left.
+  bool takeBack(std::size_t most, std::size_t& b, std::size_t& count) {
+    std::uint64_t e = ends_.load(std::memory_order_relaxed);
+    do {
+      if (lo(e) >= hi(e)) return false;
+      count = std::min(most, hi(e) - lo(e));
+    } while (!ends_.compare_exchange_weak(e, e - (std::uint64_t(count) << 32),
+                                          std::memory_order_relaxed));
+    b = hi(e) - count;
+    return true;
+  }
+  /// Takes block b from the back if it is the highest not taken (and above the front's);
+  /// false if another worker has it already.
+  bool takeBackAt(std::size_t b) {
+    std::uint64_t e = ends_.load(std::memory_order_relaxed);
+    do {
+      if (hi(e) != b + 1 || lo(e) > b) return false;
+    } while (
+        !ends_.compare_exchange_weak(e, e - (std::uint64_t(1) << 32), std::memory_order_relaxed));
+    return true;
+  }
+
+ private:
+  static std::size_t lo(std::uint64_t e) { return std::size_t(e & 0xffffffffu); }
+  static std::size_t hi(std::uint64_t e) { return std::size_t(e >> 32); }
+  std::atomic<std::uint64_t> ends_;
+};
+
+// The blocks [0, blocks) run by `workers` threads (runOne(b)) so that the step's holes are
+// closed while each block is still in cache: the first worker takes blocks from the front and,
+// after each, moves into its holes the highest live particles, from the blocks the others take
+// from the back (it runs such a block itself when none has taken it, as one thread alone
+// does). Those are compact()'s moves, in its order (the lowest hole takes the last live
+// particle), made here instead of in a pass of their own that would read and write every lane
+// again; the front stops filling where it meets the back (a hole whose filler would be below
+// it, or in its own block) and leaves compact() the rest (GroupImpl::holesFilled). Which
+// worker ran a block changes nothing: the result is the same on any number of threads.
+// Blocks the back takes at a time (a few: the front waits for the first of them).
+constexpr std::size_t kBackBlocks = 8;
 template <class RunOne>
 void fillingWalk(GroupImpl& g, PassScratch& pass, std::size_t B, std::size_t blocks,
-                 RunOne&& runOne) {
-  const std::size_t n = g.size;
-  StoredLanes stored;
-  const std::size_t laneCount = storedLanes(g, stored);
-  std::vector<std::uint32_t>& spare = pass.spare;
-  spare.clear();  // (room for n: actFusedImpl)
-  std::size_t next = 0, lo = 0, hi = blocks;
-  std::uint32_t filled = 0, from = 0;
-  // Runs the last block not run yet and keeps its live particles, highest first.
-  auto takeBack = [&] {
-    runOne(--hi);
-    const std::size_t first = hi * B;
-    const std::uint32_t* dead = pass.deadIndex.data() + first;  // ascending
-    std::uint32_t k = pass.deadCount[hi];
-    for (std::size_t i = std::min(n, first + B); i-- > first;) {
-      if (k > 0 && dead[k - 1] == i) {
-        --k;
-        continue;
+                 std::size_t workers, ThreadPool& pool, RunOne&& runOne) {
+  assignFill(pass.blockDone, blocks, 0u);
+  BlockEnds ends(blocks);
+  std::atomic<bool> failed{false};  // a worker's block threw: nothing more to wait for
+  auto markDone = [&](std::size_t b) {
+    std::atomic_ref<std::uint32_t>(pass.blockDone[b]).store(1u, std::memory_order_release);
+  };
+  auto front = [&] {
+    const std::size_t n = g.size;
+    StoredLanes stored;
+    const std::size_t laneCount = storedLanes(g, stored);
+    std::uint32_t* const fillers = pass.spare.data();  // (room for a block: actFusedImpl)
+    // The fillers come from block c down, the next candidate below index i; its dead (the
+    // block's, ascending) are dead[0, k).
+    std::size_t c = blocks, i = 0, first = 0, lo = 0;
+    const std::uint32_t* dead = nullptr;
+    std::uint32_t k = 0;
+    // Whether block b (above the front's) has run, running it here if no one has taken it.
+    auto ready = [&](std::size_t b) {
+      if (ends.takeBackAt(b)) {
+        runOne(b);
+        return true;
       }
-      spare.push_back(std::uint32_t(i));
+      std::atomic_ref<std::uint32_t> done(pass.blockDone[b]);
+      for (unsigned spins = 0; done.load(std::memory_order_acquire) == 0u; ++spins) {
+        if (failed.load(std::memory_order_relaxed)) return false;
+        if (spins > 64) std::this_thread::yield();
+      }
+      return true;
+    };
+    auto nextFiller = [&](std::uint32_t& f) {
+      for (;;) {
+        while (i > first) {
+          --i;
+          if (k > 0 && dead[k - 1] == i) {
+            --k;
+            continue;
+          }
+          f = std::uint32_t(i);
+          return true;
+        }
+        if (c <= lo + 1 || !ready(c - 1)) return false;  // the next block down is the front's
+        --c;
+        first = c * B;
+        i = std::min(n, first + B);
+        dead = pass.deadIndex.data() + first;
+        k = pass.deadCount[c];
+      }
+    };
+    bool filling = true;
+    std::uint32_t filled = 0, from = 0;
+    while (ends.takeFront(lo)) {
+      runOne(lo);
+      if (!filling) continue;
+      const std::uint32_t* holes = pass.deadIndex.data() + lo * B;
+      // The block's fillers first, then lane by lane: one stream at a time (the lanes the
+      // actions did not touch are not in cache).
+      std::uint32_t m = 0;
+      for (const std::uint32_t count = pass.deadCount[lo]; m < count; ++m)
+        if (!nextFiller(fillers[m])) {
+          filling = false;
+          break;
+        }
+      for (std::size_t l = 0; l < laneCount; ++l) {
+        std::uint32_t* __restrict lane = stored[l];
+        for (std::uint32_t j = 0; j < m; ++j) lane[holes[j]] = lane[fillers[j]];
+      }
+      if (m > 0) from = fillers[m - 1];
+      filled += m;
+    }
+    g.holesFilled = filled;
+    g.filledFrom = from;
+    g.filledByPass += filled;
+  };
+  // The others take a few blocks at a time and run them upwards, as the memory streams best;
+  // the front waits at most that long for its first fillers.
+  auto back = [&] {
+    std::size_t b = 0, count = 0;
+    while (ends.takeBack(kBackBlocks, b, count)) {
+      for (std::size_t j = b; j < b + count; ++j) {
+        try {
+          runOne(j);
+        } catch (...) {
+          failed.store(true, std::memory_order_relaxed);
+          throw;
+        }
+        markDone(j);
+      }
     }
   };
-  bool filling = true;
-  for (; lo < hi; ++lo) {
-    runOne(lo);
-    const std::uint32_t* holes = pass.deadIndex.data() + lo * B;
-    // The block's fillers first, then lane by lane: one stream at a time (the lanes the
-    // actions did not touch are not in cache).
-    std::uint32_t k = 0;
-    for (const std::uint32_t dead = filling ? pass.deadCount[lo] : 0; k < dead; ++k) {
-      while (next + k == spare.size() && hi > lo + 1) takeBack();
-      if (next + k == spare.size()) {
-        filling = false;
-        break;
-      }
-    }
-    const std::uint32_t* fillers = spare.data() + next;
-    for (std::size_t l = 0; l < laneCount; ++l) {
-      std::uint32_t* __restrict lane = stored[l];
-      for (std::uint32_t j = 0; j < k; ++j) lane[holes[j]] = lane[fillers[j]];
-    }
-    if (k > 0) from = fillers[k - 1];
-    next += k;
-    filled += k;
-  }
-  g.holesFilled = filled;
-  g.filledFrom = from;
-  g.filledByPass += filled;
+  pool.parallelFor(workers, [&](std::size_t w) { w == 0 ? front() : back(); });
 }
 
 }  // namespace
 
 void actFusedImpl(GroupImpl& g, const StepParams& sp) {
+  const bool diedBefore = !g.holes.empty();  // (the last step's dead)
   g.holes.clear();
   g.holesFilled = 0;
   g.trailRecorded = false;  // until the pass below records them
@@ -582,10 +675,6 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
   const PassScratchUse scratch(g);
   PassScratch& pass = *scratch;
   pass.deadIndex.resize(n);
-  // The filling walk's fillers, at most n: grown with the dead list, so that a step that
-  // walks alone for the first time does not allocate either.
-  if (pass.spare.capacity() < pass.deadIndex.capacity())
-    pass.spare.reserve(pass.deadIndex.capacity());
   pass.deadCode.resize(n);
   assignFill(pass.deadCount, blocks, 0);
   assignFill(pass.culledCount, blocks, 0);
@@ -703,17 +792,24 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
       tally(b, pass.deadCount[b]);
       store.clean = true;
     };
-    // One thread walking every block fills the holes as it goes (fillingWalk), unless the
-    // dead must stay in place for their death events, or a user's action could throw midway
-    // (the group would keep a particle twice).
+    // The pass fills the holes as it goes (fillingWalk), unless the dead must stay in place
+    // for their death events, or a user's action could throw midway (the group would keep a
+    // particle twice). Threads that share a group out walk it so only where particles died
+    // in the last step: where none die, each takes its own run of blocks, as the memory
+    // streams best. (Either way the particles end in the same places.)
     const bool alone = sp.pool->size() == 1 || tasks == 1;
-    const bool fill = alone && blocks > 1 && g.deathRoom() == 0 &&
+    const bool fill = blocks > 1 && (alone || diedBefore) && g.deathRoom() == 0 &&
                       std::none_of(acts.begin(), acts.end(), [](const Action& a) {
                         return std::holds_alternative<Callback>(a);
                       });
     if (fill) {
-      thread_local DeadFlags deadStore;
-      fillingWalk(g, pass, B, blocks, [&](std::size_t b) { runOne(b, deadStore); });
+      if (pass.spare.size() < B) pass.spare.resize(B);  // grows, never shrinks
+      // A group of one task's blocks is walked by one thread, as it would be stepped.
+      const std::size_t workers = alone ? 1 : std::min<std::size_t>(sp.pool->size(), blocks);
+      fillingWalk(g, pass, B, blocks, workers, *sp.pool, [&](std::size_t b) {
+        thread_local DeadFlags deadStore;
+        runOne(b, deadStore);
+      });
     } else {
       sp.pool->parallelFor(tasks, [&](std::size_t t) {
         thread_local DeadFlags deadStore;
