@@ -146,6 +146,34 @@ TEST(Scheduler, AGameJobSystemGivesTheBuiltInThreadsParticles) {
   }
 }
 
+namespace {
+// A job system that claims four threads but runs every task on the calling thread, one after
+// another, first to last or last to first: the pass that fills holes as it goes (one task
+// from the front, the others from the back) never waits on a task that has not started.
+class OneByOne final : public TaskScheduler {
+ public:
+  explicit OneByOne(bool reversed) : reversed_(reversed) {}
+  unsigned concurrency() const override { return 4; }
+  void parallelFor(std::size_t count, TaskRef task) override {
+    for (std::size_t i = 0; i < count; ++i) task(reversed_ ? count - 1 - i : i);
+  }
+
+ private:
+  bool reversed_;
+};
+}  // namespace
+
+TEST(Scheduler, TasksRunOneByOneInEitherOrderGiveTheSameParticles) {
+  ContextOptions own;
+  own.threads = 1;
+  const std::vector<float> reference = simulate(own, 30);
+  for (bool reversed : {false, true}) {
+    ContextOptions o;
+    o.scheduler = std::make_shared<OneByOne>(reversed);
+    EXPECT_TRUE(bitwiseEqual(simulate(o, 30), reference)) << (reversed ? "last first" : "first");
+  }
+}
+
 TEST(Scheduler, WhatTheWorkThrowsReachesTheCallerNotTheScheduler) {
   auto jobs = std::make_shared<JobSystem>(2);
   ContextOptions o;
