@@ -505,6 +505,9 @@ struct DeadFlags {
   std::vector<float> start;  ///< the block's positions at the step's start (a guarded list)
 };
 
+// Blocks the back of the filling walk takes at a time (a few: the front waits for the first).
+constexpr std::size_t kBackBlocks = 8;
+
 // The pass's blocks, handed out from both ends: [lo, hi) are not taken yet. One word, so that
 // a take from either end is one compare-and-swap.
 class BlockEnds {
@@ -557,8 +560,6 @@ class BlockEnds {
 // again; the front stops filling where it meets the back (a hole whose filler would be below
 // it, or in its own block) and leaves compact() the rest (GroupImpl::holesFilled). Which
 // worker ran a block changes nothing: the result is the same on any number of threads.
-// Blocks the back takes at a time (a few: the front waits for the first of them).
-constexpr std::size_t kBackBlocks = 8;
 template <class RunOne>
 void fillingWalk(GroupImpl& g, PassScratch& pass, std::size_t B, std::size_t blocks,
                  std::size_t workers, ThreadPool& pool, RunOne&& runOne) {
