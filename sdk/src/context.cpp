@@ -439,22 +439,24 @@ void Context::step() {
   impl_->shareBudget();
   const detail::StepParams sp = impl_->params();
   impl_->splitGroups();
-  // Steps `list[from, to)` in order, asking the memory for a group's state two groups before
-  // its step and for what that points to one group before: a game's thousands of groups are
-  // each out of cache by their next step, and would otherwise wait on one miss after another.
-  // (A group that sits this step out needs only its count of skipped steps, and after a step
-  // of its own a few more lines of its state.)
+  // Steps `list[from, to)` in order, asking the memory for a group's state three groups
+  // before its step, for what that points to two groups before, and for what those point to
+  // one before: a game's thousands of groups are each out of cache by their next step, and
+  // would otherwise wait on one miss after another. (A group that sits this step out needs
+  // only its count of skipped steps, and after a step of its own a few more lines of its
+  // state.)
   auto stepInOrder = [&](std::vector<Impl::Scheduled>& list, std::size_t from, std::size_t to,
                          const detail::StepParams& params) {
     for (std::size_t i = from; i < to; ++i) {
-      if (i + 2 < to) {
-        const Impl::Scheduled& next = list[i + 2];
+      if (i + 3 < to) {
+        const Impl::Scheduled& next = list[i + 3];
         if (next.due(params.step) || next.stepped)
           next.group->prefetchSelf();
         else
           next.group->prefetchSkip();
       }
-      if (i + 1 < to && list[i + 1].due(params.step)) list[i + 1].group->prefetchData();
+      if (i + 2 < to && list[i + 2].due(params.step)) list[i + 2].group->prefetchData();
+      if (i + 1 < to && list[i + 1].due(params.step)) list[i + 1].group->prefetchDeep();
       Impl::Scheduled& at = list[i];
       detail::GroupImpl& gi = *at.group;
       if (!at.due(params.step)) {

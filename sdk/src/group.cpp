@@ -523,6 +523,14 @@ void detail::GroupImpl::prefetchData() const {
   if (frame) prefetchBytes(frame.get(), sizeof(Frame));
 }
 
+void detail::GroupImpl::prefetchDeep() const {
+  for (const Emitter& e : emitters) {
+    prefetchVector(e.types);
+    prefetchVector(e.bursts);
+    prefetchVector(e.path);
+  }
+}
+
 void detail::GroupImpl::placeEmitters() {
   if (!frame || frame->emittersDerived == emittersVersion) return;
   deriveEmitters(*this, frame->transform);

@@ -489,9 +489,11 @@ struct GroupImpl {
   /// (Context::step): a game's thousands of small groups are each out of cache by the next
   /// step, and their step would otherwise wait on one miss after another. prefetchSelf()
   /// first (this object), then, a group later, prefetchData() (its lanes and vectors, up to a
-  /// small group's worth).
+  /// small group's worth), then prefetchDeep() (what those vectors point to: the emitters'
+  /// particle types, bursts and paths). Each reads only what the one before asked for.
   void prefetchSelf() const;
   void prefetchData() const;
+  void prefetchDeep() const;
   /// What a step it sits out touches after its first (skippedSteps).
   void prefetchSkip() const { __builtin_prefetch(&skippedSteps); }
 
