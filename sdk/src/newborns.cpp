@@ -21,7 +21,15 @@ namespace {
 constexpr std::size_t kNewbornsPerTask = 8192;  // a multiple of kBatch
 
 constexpr std::size_t kBatch = 256;
-static_assert(kBatch % 16 == 0, "a batch pads its newborns to whole vectors of 16");
+// The floats in this build's widest vector: a batch is drawn and shaped in whole ones.
+#if defined(__AVX512F__)
+constexpr std::size_t kVector = 16;
+#elif defined(__AVX2__)
+constexpr std::size_t kVector = 8;
+#else
+constexpr std::size_t kVector = 4;
+#endif
+static_assert(kBatch % kVector == 0, "a batch pads its newborns to whole vectors");
 // The most draws a newborn takes (kernels/newborn.h): its type's, five domains of at most
 // kMaxDomainDraws each and six fuzzy values of at most two.
 constexpr int kMaxDraws = 1 + 5 * kMaxDomainDraws + 6 * 2;
@@ -128,10 +136,11 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
   const kernel::FlNewbornDraws at = newbornDraws(L, em, type);
   const int draws = int(at.total);
   const std::uint32_t firstId = nc.firstId + std::uint32_t(i0);
-  // Drawn and shaped in whole vectors of the widest set (16 floats): a small group's few
-  // newborns a step then run the vector loops alone, not their scalar remainders. Each
-  // newborn's values depend on its own draws only; the extra lanes are never stored.
-  const std::size_t mv = std::min(kBatch, (m + 15) / 16 * 16);
+  // Drawn and shaped in whole vectors (of this build's width: 16 floats would cost an AVX2
+  // build twice the work): a small group's few newborns a step then run the vector loops
+  // alone, not their scalar remainders. Each newborn's values depend on its own draws only;
+  // the extra lanes are never stored.
+  const std::size_t mv = std::min(kBatch, (m + kVector - 1) / kVector * kVector);
   for (int blk = 0; blk * 4 < draws; ++blk)
     uniformBatch(nc.sp.seed, firstId, nc.g.streamKey(), stream::kEmission, std::uint32_t(blk), mv,
                  rows[4 * blk], rows[4 * blk + 1], rows[4 * blk + 2], rows[4 * blk + 3]);
