@@ -6,12 +6,19 @@
 // construction. Names in source stay unqualified; only the mangled names differ.
 #pragma once
 
+//
+// FLURRY_ISA_FLOATS: the floats in the widest vector of that instruction set (what a loop
+// pads a few items to, so as to run whole vectors and no scalar remainder).
 #if defined(__AVX512F__)
 #define FLURRY_ISA_NAMESPACE isa_avx512
+#define FLURRY_ISA_FLOATS 16
 #elif defined(__AVX2__)
 #define FLURRY_ISA_NAMESPACE isa_avx2
+#define FLURRY_ISA_FLOATS 8
 #elif defined(__AVX__)
 #define FLURRY_ISA_NAMESPACE isa_avx
+#define FLURRY_ISA_FLOATS 8
 #else
 #define FLURRY_ISA_NAMESPACE isa_baseline
+#define FLURRY_ISA_FLOATS 4
 #endif

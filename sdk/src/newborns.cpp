@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "emission_plan.hpp"
+#include "isa_namespace.hpp"
 #include "kernel_compat.hpp"
 #include "sampling.hpp"
 
@@ -22,13 +23,7 @@ constexpr std::size_t kNewbornsPerTask = 8192;  // a multiple of kBatch
 
 constexpr std::size_t kBatch = 256;
 // The floats in this build's widest vector: a batch is drawn and shaped in whole ones.
-#if defined(__AVX512F__)
-constexpr std::size_t kVector = 16;
-#elif defined(__AVX2__)
-constexpr std::size_t kVector = 8;
-#else
-constexpr std::size_t kVector = 4;
-#endif
+constexpr std::size_t kVector = FLURRY_ISA_FLOATS;
 static_assert(kBatch % kVector == 0, "a batch pads its newborns to whole vectors");
 // The most draws a newborn takes (kernels/newborn.h): its type's, five domains of at most
 // kMaxDomainDraws each and six fuzzy values of at most two.

@@ -342,14 +342,7 @@ inline void bouncePlanarLoop(float* __restrict px, float* __restrict py, float* 
                              std::size_t n, Dt dts, Vec3 P, Vec3 N, OnPiece onPiece,
                              const Bounce& b) {
   constexpr std::size_t kChunk = 256;
-  // Floats in this build's widest vector (kernels.hpp is compiled once per instruction set).
-#if defined(__AVX512F__)
-  constexpr std::size_t kPad = 16;
-#elif defined(__AVX2__)
-  constexpr std::size_t kPad = 8;
-#else
-  constexpr std::size_t kPad = 4;
-#endif
+  constexpr std::size_t kPad = FLURRY_ISA_FLOATS;  // this build's widest vector
   const Reflect reflect{b.restitution, 1.0f - b.friction, b.cutoff * b.cutoff};
   alignas(32) std::uint8_t reaches[kChunk];
   // A floor, a wall: a normal along an axis makes the test read two lanes, not six.
