@@ -4,11 +4,10 @@
 // headers therefore put their functions in an inline namespace named after the instruction
 // set the translation unit is compiled for, so each build keeps its own copies by
 // construction. Names in source stay unqualified; only the mangled names differ.
+// FLURRY_ISA_FLOATS is the floats in that instruction set's widest vector (what a loop pads a
+// few items to, so as to run whole vectors and no scalar remainder).
 #pragma once
 
-//
-// FLURRY_ISA_FLOATS: the floats in the widest vector of that instruction set (what a loop
-// pads a few items to, so as to run whole vectors and no scalar remainder).
 #if defined(__AVX512F__)
 #define FLURRY_ISA_NAMESPACE isa_avx512
 #define FLURRY_ISA_FLOATS 16
