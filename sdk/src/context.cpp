@@ -15,6 +15,7 @@
 #include "flurry/version.hpp"
 #include "log.hpp"
 #include "pass_options.hpp"
+#include "tick_clock.hpp"
 
 namespace flurry {
 
@@ -485,6 +486,7 @@ void Context::step() {
   impl_->runDeathEmitters({});
   impl_->lastStepSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  detail::recalibrateTicks();  // the groups' phases' clock, against this one
   ++impl_->step;
   ++impl_->stepsSinceDtChange;
   impl_->time = impl_->timeAtDtChange + double(impl_->stepsSinceDtChange) * impl_->options.dt;

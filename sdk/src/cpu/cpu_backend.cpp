@@ -1,6 +1,5 @@
 #include <algorithm>
 #include <bit>
-#include <chrono>
 #include <cmath>
 #include <utility>
 #include <vector>
@@ -8,6 +7,7 @@
 #include "../action_params.hpp"
 #include "../action_traits.hpp"
 #include "../backend.hpp"
+#include "../tick_clock.hpp"
 #include "actions_more.hpp"  // (defines what kernels.hpp declares)
 
 namespace flurry::detail {
@@ -219,12 +219,11 @@ class CpuBackend final : public BackendImpl {
       ++group.stats.idleSteps;
       return;
     }
-    // Each part's time, for GroupStats::stepSeconds.
-    using Clock = std::chrono::steady_clock;
-    auto last = Clock::now();
+    // Each part's time, for GroupStats::stepSeconds (tick_clock.hpp: a cheap clock).
+    std::uint64_t last = ticksNow();
     auto lap = [&](double& total, double& thisStep) {
-      const auto now = Clock::now();
-      thisStep = std::chrono::duration<double>(now - last).count();
+      const std::uint64_t now = ticksNow();
+      thisStep = ticksToSeconds(now - last);
       total += thisStep;
       last = now;
     };
