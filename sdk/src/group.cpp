@@ -515,6 +515,9 @@ void detail::GroupImpl::prefetchData() const {
   prefetchVector(emitters);
   prefetchVector(emitterState);
   prefetchVector(stats.killedByAction);
+  prefetchVector(stats.emittedByGeneration);
+  prefetchVector(bornRemaining);
+  if (holes.capacity() > 0) prefetchBytes(holes.data(), 64);  // written: the first line
   prefetchVector(plan.reach);
   prefetchVector(plan.timeFree);
   prefetchVector(plan.moves);
