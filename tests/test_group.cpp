@@ -744,6 +744,33 @@ TEST(Context, StatsSumTheGroupsForAnOverlay) {
                                      ctx.group("fountain").stats().stepSeconds.act);
 }
 
+// The parts of a step (GroupStats::stepSeconds, timed by tick_clock.hpp's counter where it
+// has one) are seconds of the same clock as the step's wall time: on one thread the groups'
+// parts add up to at most the whole step, and to most of it.
+TEST(Context, StepPartsAreSecondsOfTheStep) {
+  ContextOptions o;
+  o.threads = 1;
+  Context ctx(o);
+  const Effect fx = parseEffect(R"({"name": "spray", "groups": [{"name": "p", "capacity": 20000,
+      "emitters": [{"rate": 100000, "types": [{"velocity": {"type": "sphere",
+                    "center": [0, 3, 0], "outerRadius": 1}, "lifetime": 0.3}]}],
+      "actions": [{"type": "Gravity", "acceleration": [0, -9.81, 0]}, {"type": "Move"},
+                  {"type": "KillOld"}]}]})");
+  std::vector<EffectInstance> all;
+  for (int k = 0; k < 3; ++k) all.push_back(fx.instantiate(ctx, std::to_string(k)));
+  double parts = 0.0, whole = 0.0;
+  for (int s = 0; s < 40; ++s) {
+    ctx.step();
+    const ContextStats st = ctx.stats();
+    const double p = st.lastStepParts.emit + st.lastStepParts.act + st.lastStepParts.compact;
+    EXPECT_GT(p, 0.0);
+    EXPECT_LE(p, st.lastStepSeconds * 1.01 + 1e-6) << "step " << s;
+    parts += p;
+    whole += st.lastStepSeconds;
+  }
+  EXPECT_GT(parts, 0.5 * whole);  // the groups' steps are most of the context's
+}
+
 // Collision events: where, when and how fast each deflected particle met the surface, with
 // the surface's normal on its side; exact on known paths, the first kept past the room, the
 // same on any thread count.
