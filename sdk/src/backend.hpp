@@ -23,6 +23,10 @@ struct StepParams {
   bool fused = true;
   bool cull = true;
   ThreadPool* pool = nullptr;
+  /// The group this thread steps two after this one: Context::step asks for the first half
+  /// of its data (GroupImpl::prefetchData) before this step, the CPU backend for the second
+  /// between this step's phases. (In one burst the prefetches stall the core.)
+  const GroupImpl* ahead = nullptr;
 };
 
 class BackendImpl {

@@ -441,11 +441,11 @@ void Context::step() {
   const detail::StepParams sp = impl_->params();
   impl_->splitGroups();
   // Steps `list[from, to)` in order, asking the memory for a group's state three groups
-  // before its step, for what that points to two groups before, and for what those point to
-  // one before: a game's thousands of groups are each out of cache by their next step, and
-  // would otherwise wait on one miss after another. (A group that sits this step out needs
-  // only its count of skipped steps, and after a step of its own a few more lines of its
-  // state.)
+  // before its step, for what that points to two groups before (half before that step, half
+  // during it: StepParams::ahead), and for what those point to one before: a game's
+  // thousands of groups are each out of cache by their next step, and would otherwise wait
+  // on one miss after another. (A group that sits this step out needs only its count of
+  // skipped steps, and after a step of its own a few more lines of its state.)
   auto stepInOrder = [&](std::vector<Impl::Scheduled>& list, std::size_t from, std::size_t to,
                          const detail::StepParams& params) {
     for (std::size_t i = from; i < to; ++i) {
@@ -456,7 +456,9 @@ void Context::step() {
         else
           next.group->prefetchSkip();
       }
-      if (i + 2 < to && list[i + 2].due(params.step)) list[i + 2].group->prefetchData();
+      const detail::GroupImpl* ahead =
+          i + 2 < to && list[i + 2].due(params.step) ? list[i + 2].group : nullptr;
+      if (ahead) ahead->prefetchData(0, 2);
       if (i + 1 < to && list[i + 1].due(params.step)) list[i + 1].group->prefetchDeep();
       Impl::Scheduled& at = list[i];
       detail::GroupImpl& gi = *at.group;
@@ -468,8 +470,10 @@ void Context::step() {
         at.stepped = false;
         continue;
       }
-      stepGroup(*impl_->backend, gi,
-                groupStep(params, gi, impl_->timeAtDtChange, impl_->stepsSinceDtChange, 0));
+      detail::StepParams own =
+          groupStep(params, gi, impl_->timeAtDtChange, impl_->stepsSinceDtChange, 0);
+      own.ahead = ahead;
+      stepGroup(*impl_->backend, gi, own);
       at.stepped = true;
     }
   };

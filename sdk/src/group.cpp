@@ -508,9 +508,13 @@ void detail::GroupImpl::prefetchSelf() const {
                                   reinterpret_cast<const char*>(this)));
 }
 
-void detail::GroupImpl::prefetchData() const {
+void detail::GroupImpl::prefetchData(int part, int parts) const {
   const std::size_t bytes = size * sizeof(float) + 64;
-  forEachLane(laneCache, [&](const std::uint32_t* lane) { prefetchBytes(lane, bytes); });
+  int k = 0;
+  forEachLane(laneCache, [&](const std::uint32_t* lane) {
+    if (k++ % parts == part) prefetchBytes(lane, bytes);
+  });
+  if (part != 0) return;
   prefetchVector(actions.actions());
   prefetchVector(emitters);
   prefetchVector(emitterState);

@@ -492,7 +492,10 @@ struct GroupImpl {
   /// small group's worth), then prefetchDeep() (what those vectors point to: the emitters'
   /// particle types, bursts and paths). Each reads only what the one before asked for.
   void prefetchSelf() const;
-  void prefetchData() const;
+  /// Part `part` of `parts` of it (every parts-th lane; the vectors with part 0): asked for
+  /// at once, a group's ~100 lines hold the L1's miss buffers until they arrive and stall
+  /// the core, so the CPU backend asks for the rest between its phases (StepParams::ahead).
+  void prefetchData(int part = 0, int parts = 1) const;
   void prefetchDeep() const;
   /// What a step it sits out touches after its first (skippedSteps).
   void prefetchSkip() const { __builtin_prefetch(&skippedSteps); }

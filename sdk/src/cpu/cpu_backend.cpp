@@ -233,6 +233,9 @@ class CpuBackend final : public BackendImpl {
     if (group.bornCount > 0) group.startTrails(group.bornFirst, group.bornFirst + group.bornCount);
     if (group.birthsFeed) group.recordBirths(params.time + params.dt);
     lap(group.stats.stepSeconds.emit, parts.emit);
+    // The rest of a later group's data, asked for here rather than with the first part
+    // before this step (StepParams::ahead).
+    if (params.ahead) params.ahead->prefetchData(1, 2);
     actFused(group, params);
     lap(group.stats.stepSeconds.act, parts.act);
     compact(group, params);
