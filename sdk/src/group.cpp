@@ -526,6 +526,7 @@ void detail::GroupImpl::prefetchData(int part, int parts) const {
   prefetchVector(plan.timeFree);
   prefetchVector(plan.moves);
   prefetchVector(plan.gathered);
+  prefetchVector(plan.curvedBy);
   prefetchVector(plan.records);
   if (frame) prefetchBytes(frame.get(), sizeof(Frame));
 }
