@@ -93,10 +93,22 @@ void moveKey(const ActionList& list, std::vector<std::uint32_t>& out) {
 
 }  // namespace
 
-/// What every group of one Context shares: the device's runtime and one in-order queue.
+/// What every group of one Context shares: the device's runtime and a few in-order queues.
+/// A group's commands all go to one queue, in order; groups on different queues run side by
+/// side (a small group's step is one work-group: on one queue, a game's hundreds of them
+/// would run one after another on one compute unit).
 struct Shared {
   std::shared_ptr<Runtime> runtime;
-  Queue queue;
+  std::vector<Queue> queues;
+  std::uint64_t groupsMade = 0;
+  /// The queue of the next group made: by a hash of the count, not round robin, so that a
+  /// scene whose busy groups come at a regular stride (every other one, every tenth) still
+  /// spreads them over the queues.
+  cl_command_queue nextQueue() {
+    std::uint64_t h = groupsMade++ * 0x9E3779B97F4A7C15ull;  // Fibonacci hashing
+    h ^= h >> 29;
+    return queues[std::size_t(h % queues.size())].get();
+  }
   bool profile = false;  // FLURRY_OPENCL_PROFILE=1: per-kernel device times, logged
   cl_device_id device() const { return runtime->device().id; }
   bool cpu() const { return runtime->device().cpu; }
@@ -166,10 +178,11 @@ struct GrowBuffer {
 
 class ClGroup final : public DeviceMirror {
  public:
-  explicit ClGroup(std::shared_ptr<Shared> shared) : shared_(std::move(shared)) {}
+  explicit ClGroup(std::shared_ptr<Shared> shared)
+      : shared_(std::move(shared)), queue_(shared_->nextQueue()) {}
   ~ClGroup() override {
     if (!shared_) return;
-    clFinish(shared_->queue.get());  // buffers must outlive queued work
+    clFinish(queue_);  // buffers must outlive queued work
     if (shared_->profile) {
       collectProfile();
       for (const auto& [name, t] : profile_) {
@@ -280,7 +293,7 @@ class ClGroup final : public DeviceMirror {
   void step(GroupImpl& g, const StepParams& sp);
 
  private:
-  cl_command_queue queue() const { return shared_->queue.get(); }
+  cl_command_queue queue() const { return queue_; }
   cl_context context() const { return shared_->runtime->context(); }
 
   void allocate(GroupImpl& g);
@@ -300,6 +313,7 @@ class ClGroup final : public DeviceMirror {
   void readBirths(GroupImpl& g, double t1);
 
   std::shared_ptr<Shared> shared_;
+  cl_command_queue queue_;  ///< one of shared_'s, for all of this group's commands
   std::vector<DeviceLane> lanes_;
   AttributeSet laneSet_;
   bool allocated_ = false;
@@ -1318,10 +1332,16 @@ std::unique_ptr<BackendImpl> makeOpenCLBackend(const ContextOptions& options) {
   cl_int err = CL_SUCCESS;
   const char* profile = std::getenv("FLURRY_OPENCL_PROFILE");
   shared->profile = profile && *profile && std::string(profile) != "0";
-  shared->queue =
-      ocl::Queue(clCreateCommandQueue(shared->runtime->context(), shared->device(),
-                                      shared->profile ? CL_QUEUE_PROFILING_ENABLE : 0, &err));
-  ocl::check(err, "clCreateCommandQueue");
+  // As many queues as the device has compute units, up to four: enough for PoCL's cores and
+  // for a GPU to overlap small groups' launches.
+  const std::size_t queues =
+      std::clamp<std::size_t>(shared->runtime->device().info.computeUnits, 1, 4);
+  for (std::size_t k = 0; k < queues; ++k) {
+    shared->queues.emplace_back(
+        clCreateCommandQueue(shared->runtime->context(), shared->device(),
+                             shared->profile ? CL_QUEUE_PROFILING_ENABLE : 0, &err));
+    ocl::check(err, "clCreateCommandQueue");
+  }
   return std::make_unique<ocl::OpenCLBackend>(std::move(shared));
 }
 
