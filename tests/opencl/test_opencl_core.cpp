@@ -113,6 +113,42 @@ TEST(OpenCLCore, ClocksSeedsAndUpdateIntervalsAsOnTheCpu) {
   checkParity(build);
 }
 
+// Groups of one context spread over the device's queues (as many as it has compute units,
+// up to four) and run side by side: each is still what the CPU makes of it, and one read
+// back while the others' steps are queued sees its own.
+TEST(OpenCLCore, ManyGroupsOnSeveralQueuesAsOnTheCpu) {
+  FLURRY_REQUIRE_OPENCL();
+  auto run = [](Backend backend) {
+    Context ctx(parityOptions(backend));
+    std::vector<Group*> groups;
+    for (int k = 0; k < 8; ++k) {
+      Group& g = ctx.createGroup("g" + std::to_string(k), 3000);
+      g.addEmitter(spray(Vec3(float(k), 1.0f, 0.0f), 300.0 + 100.0 * k));
+      g.setActions({Gravity{kDown},
+                    Bounce{Domain::plane(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f)), 0.5f, 0.1f, 0.0f},
+                    Move{}, KillOld{}});
+      groups.push_back(&g);
+    }
+    std::vector<std::size_t> midway;
+    for (int s = 0; s < 60; ++s) {
+      ctx.step();
+      if (s % 20 == 19) midway.push_back(groups[std::size_t(s / 20)]->size());
+    }
+    std::vector<RunResult> results;
+    for (Group* g : groups) results.push_back(resultOf(*g));
+    return std::pair{results, midway};
+  };
+  const auto [cpu, cpuMidway] = run(Backend::Cpu);
+  const auto [cl, clMidway] = run(Backend::OpenCL);
+  EXPECT_EQ(cpuMidway, clMidway);
+  ASSERT_EQ(cpu.size(), cl.size());
+  for (std::size_t k = 0; k < cpu.size(); ++k) {
+    SCOPED_TRACE("group " + std::to_string(k));
+    EXPECT_GT(cpu[k].size, 0u);
+    expectSame(cpu[k], cl[k]);
+  }
+}
+
 TEST(OpenCLCore, ACallbackWithoutAnOpenCLBodyIsRefusedByName) {
   FLURRY_REQUIRE_OPENCL();
   ContextOptions o;
