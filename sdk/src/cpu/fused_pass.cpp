@@ -213,12 +213,23 @@ void applyCulled(const Action& a, const Lanes& L, std::size_t n, const cpu::Bloc
   }
 }
 
+// The thread's scratch for an integrating Move's stages, and for a Bounce's state before it
+// while the group records collisions: reached only where needed (in a shared library each
+// reach of a thread_local is a call, and runActions runs a few times a small group's step).
+cpu::IntegratorScratch& integratorScratch() {
+  thread_local cpu::IntegratorScratch scratch;
+  return scratch;
+}
+cpu::IntegratorScratch& keptScratch() {
+  thread_local cpu::IntegratorScratch scratch;
+  return scratch;
+}
+
 // Runs actions [first, last) of the list over one block, as the plan says; skips those
 // that `cull` (null: never) finds out of the block's reach.
 void runActions(const std::vector<Action>& acts, const Plan& plan, std::size_t first,
                 std::size_t last, const Lanes& lanes, std::size_t n, cpu::BlockContext ctx,
                 Culler* cull = nullptr) {
-  thread_local cpu::IntegratorScratch scratchStore, keepStore;
   for (std::size_t k = first; k < last; ++k) {
     ctx.action = std::uint32_t(k);
     if (plan.list.gathered[k]) continue;  // evaluated inside its Move
@@ -235,7 +246,7 @@ void runActions(const std::vector<Action>& acts, const Plan& plan, std::size_t f
     }
     if (plan.list.integrator != Integrator::SemiImplicitEuler &&
         std::holds_alternative<Move>(acts[k])) {
-      cpu::IntegratorScratch& scratch = scratchStore;
+      cpu::IntegratorScratch& scratch = integratorScratch();
       cpu::withDt(ctx, [&](auto dt) {
         cpu::integrate(plan.list.integrator, acts, plan.list.forcesOf[k], lanes, n, ctx, scratch,
                        dt);
@@ -249,14 +260,14 @@ void runActions(const std::vector<Action>& acts, const Plan& plan, std::size_t f
     // While the group records collisions, a Bounce's state before it is kept to find them.
     float* before = nullptr;
     if (ctx.collisions && std::holds_alternative<Bounce>(acts[k])) {
-      cpu::IntegratorScratch& keep = keepStore;
+      cpu::IntegratorScratch& keep = keptScratch();
       keep.reset(n, 6);
       before = keep.take(6 * n);
       cpu::keepState(lanes, n, before);
     }
     if (plan.list.curvedBy[k]) {
       // The acceleration the Move's integrator starts from, taken as constant over the step.
-      cpu::IntegratorScratch& scratch = scratchStore;
+      cpu::IntegratorScratch& scratch = integratorScratch();
       scratch.reset(n, 3);
       float* acc[3] = {scratch.take(n), scratch.take(n), scratch.take(n)};
       cpu::startAcceleration(acts, plan.list.forcesOf[plan.list.curvedBy[k] - 1], lanes, n, ctx,
