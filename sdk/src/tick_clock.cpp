@@ -16,15 +16,20 @@ std::uint64_t steadyNanoseconds() {
                            .count());
 }
 
-bool counterUsed() {
+namespace {
+bool invariantCounter() {
 #ifdef FLURRY_TICKS_TSC
-  // CPUID 0x80000007, EDX bit 8: the invariant TSC.
+  // CPUID 0x80000007, EDX bit 8: the invariant TSC. (Under a hypervisor CPUID traps and
+  // costs microseconds: asked once.)
   unsigned a = 0, b = 0, c = 0, d = 0;
   return __get_cpuid(0x80000007u, &a, &b, &c, &d) && (d >> 8 & 1u);
 #else
   return false;
 #endif
 }
+}  // namespace
+
+const bool counterUsed = invariantCounter();
 }  // namespace ticks
 
 namespace {
@@ -32,20 +37,18 @@ struct Baseline {
   std::uint64_t steady, ticks;
 };
 
-// Both clocks read together at the first use: rates are measured from here on.
-const Baseline& baseline() {
-  static const Baseline b{ticks::steadyNanoseconds(), ticksNow()};
-  return b;
-}
+// Both clocks read together when the library loads (after counterUsed, defined above it in
+// this file): rates are measured from here on.
+const Baseline baseline{ticks::steadyNanoseconds(), ticksNow()};
 
 std::atomic<double> secondsPerTick{0.0};
 
 // The rate over [baseline, now]; at least 50 µs of it, so the first figure is already
-// within a fraction of a percent (the wait is taken once, if the first step comes that soon
-// after the first read).
+// within a fraction of a percent (waited for only if the first step comes sooner than that
+// after the library loaded).
 double measure() {
-  const Baseline& b = baseline();
-  if (!ticks::counterUsed()) return 1e-9;
+  const Baseline& b = baseline;
+  if (!ticks::counterUsed) return 1e-9;
   std::uint64_t s = ticks::steadyNanoseconds(), t = ticksNow();
   while (s - b.steady < 50'000 || t == b.ticks) {
     s = ticks::steadyNanoseconds();

@@ -14,26 +14,26 @@
 namespace flurry::detail {
 
 namespace ticks {
-/// Whether now() reads the time-stamp counter (x86 with an invariant one: the same rate on
-/// every core and in every power state); otherwise it reads steady_clock in nanoseconds.
-bool counterUsed();
+/// Whether ticksNow() reads the time-stamp counter (x86 with an invariant one: the same rate
+/// on every core and in every power state; asked of CPUID once, when the library loads);
+/// otherwise it reads steady_clock in nanoseconds.
+extern const bool counterUsed;
 std::uint64_t steadyNanoseconds();
 }  // namespace ticks
 
 /// Ticks of an unspecified unit; differences turn into seconds by ticksToSeconds.
 inline std::uint64_t ticksNow() {
 #ifdef FLURRY_TICKS_TSC
-  static const bool counter = ticks::counterUsed();
-  if (counter) return __rdtsc();
+  if (ticks::counterUsed) return __rdtsc();
 #endif
   return ticks::steadyNanoseconds();
 }
 
 /// Seconds of `ticks` (a difference of ticksNow()), at the counter's rate as measured against
-/// steady_clock since the process first asked (recalibrateTicks refines it).
+/// steady_clock since the library loaded (recalibrateTicks refines it).
 double ticksToSeconds(std::uint64_t ticks);
 
-/// Measures the counter's rate again over the whole time since the first measurement (more
+/// Measures the counter's rate again over the whole time since the library loaded (more
 /// exact the longer it runs). Context::step calls it once a step, beside its own
 /// steady_clock reads. Thread-safe.
 void recalibrateTicks();
