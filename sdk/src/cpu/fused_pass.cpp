@@ -156,37 +156,43 @@ struct Culler {
 
   // The box the block's straight paths p .. p + v·dt lie in.
   void gather(const Lanes& L, std::size_t n, float dt) {
-    constexpr std::size_t W = 16;  // independent lanes: the loops vectorise without -ffast-math
+    // 16 independent lanes in vector registers (as liveBounds): the loops vectorise without
+    // -ffast-math, and no lane waits on a store of the last iteration.
+    constexpr std::size_t W = 16;
+    using F = float __attribute__((vector_size(4 * W)));
+    using U = std::uint32_t __attribute__((vector_size(4 * W)));
     float check = 0.0f;
     scale = 0.0f;
     for (int c = 0; c < 3; ++c) {
       const float* __restrict p = L.p[c];
       const float* __restrict v = L.v[c];
-      float mn[W], mx[W], sp[W], ck[W];
-      for (std::size_t j = 0; j < W; ++j)
-        mn[j] = kInfinity, mx[j] = -kInfinity, sp[j] = 0.0f, ck[j] = 0.0f;
+      F mn = F{} + kInfinity, mx = F{} - kInfinity, sp = F{}, ck = F{};
       std::size_t i = 0;
-      for (; i + W <= n; i += W)
-        for (std::size_t j = 0; j < W; ++j) {
-          const float x = p[i + j], s = std::abs(v[i + j]);
-          mn[j] = x < mn[j] ? x : mn[j];
-          mx[j] = x > mx[j] ? x : mx[j];
-          sp[j] = s > sp[j] ? s : sp[j];
-          ck[j] += (x - x) + (s - s);  // NaN if x or s is NaN or infinite
-        }
-      for (std::size_t j = 0; i < n; ++i, ++j) {
-        const float x = p[i], s = std::abs(v[i]);
-        mn[j] = x < mn[j] ? x : mn[j];
-        mx[j] = x > mx[j] ? x : mx[j];
-        sp[j] = s > sp[j] ? s : sp[j];
-        ck[j] += (x - x) + (s - s);
+      for (; i + W <= n; i += W) {
+        F x, s;
+        std::memcpy(&x, p + i, sizeof x);
+        std::memcpy(&s, v + i, sizeof s);
+        s = (F)((U)s & 0x7fffffffu);  // |v|
+        mn = x < mn ? x : mn;
+        mx = x > mx ? x : mx;
+        sp = s > sp ? s : sp;
+        ck += (x - x) + (s - s);  // NaN if x or s is NaN or infinite
       }
       float a = kInfinity, b = -kInfinity, s = 0.0f;
-      for (std::size_t j = 0; j < W; ++j) {
-        a = std::min(a, mn[j]);
-        b = std::max(b, mx[j]);
-        s = std::max(s, sp[j]);
-        check += ck[j];
+      for (std::size_t j = 0; j < W; ++j, ++i) {
+        // The remainder into the lanes it would have had, then the lanes together.
+        float lmn = mn[j], lmx = mx[j], lsp = sp[j], lck = ck[j];
+        if (i < n) {
+          const float x = p[i], sv = std::abs(v[i]);
+          lmn = x < lmn ? x : lmn;
+          lmx = x > lmx ? x : lmx;
+          lsp = sv > lsp ? sv : lsp;
+          lck += (x - x) + (sv - sv);
+        }
+        a = std::min(a, lmn);
+        b = std::max(b, lmx);
+        s = std::max(s, lsp);
+        check += lck;
       }
       lo[c] = a - s * dt;
       hi[c] = b + s * dt;
