@@ -1611,6 +1611,65 @@ TEST(Instance, TheIdentityIsBitwiseNoTransform) {
   }
 }
 
+// Context::step runs a few groups' emissions before their act passes (CpuBackend's parts):
+// each instance of many ends bitwise as the same instance alone in a context of its own.
+TEST(Instance, ManyInstancesStepAsEachAlone) {
+  const Effect fx = dropEffect("world");
+  for (const unsigned threads : {1u, 2u}) {
+    ContextOptions o = fx.contextOptions();
+    o.threads = threads;
+    Context many(o);
+    std::vector<EffectInstance> all;
+    for (int k = 0; k < 40; ++k) {
+      all.push_back(fx.instantiate(many, std::to_string(k)));
+      Transform t;
+      t.position = Vec3(float(k % 7) * 3.0f, 0.0f, float(k / 7) * 3.0f);
+      all.back().setTransform(t);
+      all.back().setSeed(std::uint64_t(k) + 1);
+    }
+    many.run(50);
+    for (const int k : {0, 17, 39}) {
+      Context alone(o);
+      EffectInstance one = fx.instantiate(alone, std::to_string(k));
+      one.setTransform(all[std::size_t(k)].transform());
+      one.setSeed(std::uint64_t(k) + 1);
+      alone.run(50);
+      ASSERT_GT(one.groups()[0]->size(), 0u);
+      EXPECT_EQ(allLanes(*one.groups()[0]), allLanes(*all[std::size_t(k)].groups()[0]))
+          << "instance " << k << ", threads " << threads;
+    }
+  }
+}
+
+// A callback that throws in one instance of many: the step throws it, and no other instance
+// is left between its emission and its act pass (its newborns not acted on, its dead kept).
+TEST(Instance, AThrowInOneOfManyLeavesNoneHalfStepped) {
+  const Effect fx = dropEffect("world");
+  for (const unsigned threads : {1u, 2u}) {
+    ContextOptions o = fx.contextOptions();
+    o.threads = threads;
+    Context ctx(o);
+    std::vector<EffectInstance> all;
+    for (int k = 0; k < 40; ++k) all.push_back(fx.instantiate(ctx, std::to_string(k)));
+    ctx.run(10);
+    Group& cursed = *all[17].groups()[0];
+    ActionList list = cursed.actions();
+    list.add(Callback{[](Particle&, const CallbackContext&) {
+      throw std::runtime_error("instance 17 is cursed");
+    }});
+    cursed.setActions(list);
+    EXPECT_THROW(ctx.step(), std::runtime_error);
+    for (int k = 0; k < 40; ++k) {
+      if (k == 17) continue;
+      const auto& gi = detail::implOf(*all[std::size_t(k)].groups()[0]);
+      EXPECT_EQ(gi.bornCount, 0u) << "instance " << k << " between its parts, threads " << threads;
+    }
+    cursed.setActions(fx.groups[0].actions);
+    ctx.run(5);  // and it goes on
+    for (const EffectInstance& i : all) EXPECT_GT(i.groups()[0]->size(), 0u);
+  }
+}
+
 TEST(Instance, InvalidTransformsNameTheFieldAndChangeNothing) {
   const Effect fx = dropEffect("world");
   Context ctx(fx.contextOptions());

@@ -36,6 +36,13 @@ class BackendImpl {
   /// Emit the step's newborns, act on every particle (the newborns for what is left of the
   /// step after their birth), remove the dead.
   virtual void step(GroupImpl& group, const StepParams& params) = 0;
+  /// step() in two parts, so that Context::step can run several groups' first parts and then
+  /// their second parts (groups are independent): true when the second part is due.
+  virtual bool stepFirstPart(GroupImpl& group, const StepParams& params) {
+    step(group, params);
+    return false;
+  }
+  virtual void stepSecondPart(GroupImpl&, const StepParams&) {}
 };
 
 std::unique_ptr<BackendImpl> makeCpuBackend();

@@ -205,44 +205,74 @@ const cl::FlActionParams* actionRecords(GroupImpl& g, float dt) {
 }
 
 namespace {
+// Adds the time since `last` to a part of the step (GroupStats::stepSeconds, its total and
+// this step's), and moves `last` on.
+void lap(std::uint64_t& last, double& total, double& thisStep) {
+  const std::uint64_t now = ticksNow();
+  thisStep = ticksToSeconds(now - last);
+  total += thisStep;
+  last = now;
+}
+
+// A step's first part: its newborns. False when the group is idle (nothing alive and no
+// emitter that will fire): such a step would change nothing (its emitters' state included),
+// so it costs no pass, no clock and no worker.
+bool emitPart(GroupImpl& group, const StepParams& params, std::uint64_t& last) {
+  group.lastStepParts = {};
+  if (group.size == 0 && !group.hair.enabled && !mayEmit(group, params)) {
+    // What a step's planning would have done: count generation 0 (see planBirths).
+    if (!group.emitters.empty() && group.stats.emittedByGeneration.empty())
+      group.stats.emittedByGeneration.assign(1, 0);
+    ++group.stats.idleSteps;
+    return false;
+  }
+  // Each part's time, for GroupStats::stepSeconds (tick_clock.hpp: a cheap clock).
+  last = ticksNow();
+  emitNewborns(group, params);
+  // A newborn's trail starts where it was born, inside the step.
+  if (group.bornCount > 0) group.startTrails(group.bornFirst, group.bornFirst + group.bornCount);
+  if (group.birthsFeed) group.recordBirths(params.time + params.dt);
+  lap(last, group.stats.stepSeconds.emit, group.lastStepParts.emit);
+  return true;
+}
+
+// The rest: the act pass, then the dead removed, the budget kept, the trails turned, the
+// strands of hair mode.
+void actPart(GroupImpl& group, const StepParams& params, std::uint64_t& last) {
+  actFused(group, params);
+  lap(last, group.stats.stepSeconds.act, group.lastStepParts.act);
+  compact(group, params);
+  if (group.size > group.keepAtMost) group.dropOldest(group.size - group.keepAtMost, params);
+  group.recordTrails(*params.pool);
+  lap(last, group.stats.stepSeconds.compact, group.lastStepParts.compact);
+  if (group.hair.enabled) simulateHair(group, params);
+}
+
 class CpuBackend final : public BackendImpl {
  public:
   const char* name() const override { return "cpu"; }
   void step(GroupImpl& group, const StepParams& params) override {
-    // Idle: nothing alive and no emitter that will fire. Such a step would change nothing
-    // (its emitters' state included), so it costs no pass, no clock and no worker.
-    group.lastStepParts = {};
-    if (group.size == 0 && !group.hair.enabled && !mayEmit(group, params)) {
-      // What a step's planning would have done: count generation 0 (see planBirths).
-      if (!group.emitters.empty() && group.stats.emittedByGeneration.empty())
-        group.stats.emittedByGeneration.assign(1, 0);
-      ++group.stats.idleSteps;
-      return;
-    }
-    // Each part's time, for GroupStats::stepSeconds (tick_clock.hpp: a cheap clock).
-    std::uint64_t last = ticksNow();
-    auto lap = [&](double& total, double& thisStep) {
-      const std::uint64_t now = ticksNow();
-      thisStep = ticksToSeconds(now - last);
-      total += thisStep;
-      last = now;
-    };
-    auto& parts = group.lastStepParts;
-    emitNewborns(group, params);
-    // A newborn's trail starts where it was born, inside the step.
-    if (group.bornCount > 0) group.startTrails(group.bornFirst, group.bornFirst + group.bornCount);
-    if (group.birthsFeed) group.recordBirths(params.time + params.dt);
-    lap(group.stats.stepSeconds.emit, parts.emit);
+    std::uint64_t last = 0;
+    if (!emitPart(group, params, last)) return;
     // The rest of a later group's data, asked for here rather than with the first part
     // before this step (StepParams::ahead).
     if (params.ahead) params.ahead->prefetchData(1, 2);
-    actFused(group, params);
-    lap(group.stats.stepSeconds.act, parts.act);
-    compact(group, params);
-    if (group.size > group.keepAtMost) group.dropOldest(group.size - group.keepAtMost, params);
-    group.recordTrails(*params.pool);
-    lap(group.stats.stepSeconds.compact, parts.compact);
-    if (group.hair.enabled) simulateHair(group, params);
+    actPart(group, params, last);
+  }
+
+  // The newborns first: Context::step runs a few groups' emission, then their act passes and
+  // compaction. A game's many small groups then run each phase's code while it is in the
+  // instruction cache, and a group's lanes, asked for before its emission, are in the data
+  // cache when its pass comes.
+  bool stepFirstPart(GroupImpl& group, const StepParams& params) override {
+    std::uint64_t last = 0;
+    if (!emitPart(group, params, last)) return false;
+    if (params.ahead) params.ahead->prefetchData(1, 2);
+    return true;
+  }
+  void stepSecondPart(GroupImpl& group, const StepParams& params) override {
+    std::uint64_t last = ticksNow();  // (the time between the parts counts to neither)
+    actPart(group, params, last);
   }
 };
 }  // namespace
