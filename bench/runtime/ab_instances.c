@@ -1,0 +1,184 @@
+/* Two builds of libflurry in one process, stepping the same game scene in turn.
+ *
+ * On a shared machine two benchmark runs minutes apart differ by more than most changes do
+ * (scripts/compare_libraries.py alternates whole runs: its same-library ratios still swing
+ * by 10 %). This loads each library, with the C API over it, into a link-map namespace of
+ * its own (dlmopen), builds the same scene in each (bench_runtime's: `instances` copies of a
+ * 100-particle puff of sparks falling on a floor, each placed and turned its own way), and
+ * steps them in alternating slices of a few milliseconds: both see the same load. It prints
+ * each one's time per instance-step and the median (and quartiles) of the slices' ratios.
+ *
+ *   build/release/bench/ab_instances OLD/libflurry.so.0.1.0 build/release/sdk/libflurry.so.0.1.0 \
+ *       --instances 1000 --threads 1 --slices 40 --steps 20
+ *
+ * (one command line; OLD built as scripts/compare_libraries.py says). The same library
+ * against itself gives ratios of 1 within a few percent: what a difference must beat.
+ */
+#define _GNU_SOURCE
+#include <dlfcn.h>
+#include <link.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "flurry.h"
+
+#ifndef FLURRY_C_LIBRARY
+#define FLURRY_C_LIBRARY "libflurry_c.so"
+#endif
+
+typedef struct {
+  flurry_status (*options_init)(flurry_context_options*);
+  flurry_status (*create)(const flurry_context_options*, flurry_context**);
+  flurry_status (*step)(flurry_context*);
+  flurry_status (*run)(flurry_context*, uint64_t);
+  flurry_status (*parse)(const char*, const char*, flurry_effect**);
+  flurry_status (*instantiate)(const flurry_effect*, flurry_context*, const char*, size_t,
+                               flurry_instance**);
+  flurry_status (*place)(flurry_instance*, const float*, const float*, float);
+  flurry_context* ctx;
+} Library;
+
+static void* symbol(void* lib, const char* name) {
+  void* p = dlsym(lib, name);
+  if (!p) {
+    fprintf(stderr, "ab_instances: %s\n", dlerror());
+    exit(1);
+  }
+  return p;
+}
+
+/* The library at `core` and the C API over it, in a namespace of their own: the C API's
+ * libflurry is the one loaded there first. */
+static void load(Library* L, const char* core, const char* capi) {
+  void* first = dlmopen(LM_ID_NEWLM, core, RTLD_NOW | RTLD_LOCAL);
+  if (!first) {
+    fprintf(stderr, "ab_instances: %s\n", dlerror());
+    exit(1);
+  }
+  Lmid_t id;
+  dlinfo(first, RTLD_DI_LMID, &id);
+  void* lib = dlmopen(id, capi, RTLD_NOW | RTLD_LOCAL);
+  if (!lib) {
+    fprintf(stderr, "ab_instances: %s\n", dlerror());
+    exit(1);
+  }
+  L->options_init = symbol(lib, "flurry_context_options_init");
+  L->create = symbol(lib, "flurry_context_create");
+  L->step = symbol(lib, "flurry_context_step");
+  L->run = symbol(lib, "flurry_context_run");
+  L->parse = symbol(lib, "flurry_effect_parse");
+  L->instantiate = symbol(lib, "flurry_effect_instantiate");
+  L->place = symbol(lib, "flurry_instance_set_transform");
+}
+
+static double seconds(void) {
+  struct timespec t;
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static int ascending(const void* a, const void* b) {
+  const double x = *(const double*)a, y = *(const double*)b;
+  return x < y ? -1 : x > y;
+}
+
+static void check(flurry_status s, const char* what) {
+  if (s != FLURRY_OK) {
+    fprintf(stderr, "ab_instances: %s failed (status %d)\n", what, (int)s);
+    exit(1);
+  }
+}
+
+int main(int argc, char** argv) {
+  if (argc < 3) {
+    fprintf(stderr,
+            "usage: ab_instances OLD.so NEW.so [--instances N] [--threads T] [--slices S]\n"
+            "       [--steps K] [--rate R] [--capi libflurry_c.so]\n");
+    return 2;
+  }
+  long instances = 1000, threads = 1, slices = 40, steps = 20, rate = 100;
+  const char* capi = FLURRY_C_LIBRARY;
+  for (int i = 3; i + 1 < argc; i += 2) {
+    const char* k = argv[i];
+    if (!strcmp(k, "--capi")) {
+      capi = argv[i + 1];
+      continue;
+    }
+    const long v = strtol(argv[i + 1], NULL, 10);
+    if (v <= 0) {
+      fprintf(stderr, "ab_instances: %s must be a positive integer\n", k);
+      return 2;
+    }
+    if (!strcmp(k, "--instances"))
+      instances = v;
+    else if (!strcmp(k, "--threads"))
+      threads = v;
+    else if (!strcmp(k, "--slices"))
+      slices = v;
+    else if (!strcmp(k, "--steps"))
+      steps = v;
+    else if (!strcmp(k, "--rate"))
+      rate = v;
+    else {
+      fprintf(stderr, "ab_instances: unknown option %s\n", k);
+      return 2;
+    }
+  }
+  char json[2048];
+  snprintf(json, sizeof json,
+           "{\"version\": 1, \"name\": \"sparks\", \"dt\": 0.0333333333333, \"seed\": 7, "
+           "\"groups\": [{\"name\": \"sparks\", \"capacity\": %ld, \"emitters\": [{\"shape\": "
+           "{\"type\": \"sphere\", \"center\": [0, 1, 0], \"outerRadius\": 0.1}, \"rate\": %ld, "
+           "\"types\": [{\"velocity\": {\"type\": \"sphere\", \"center\": [0, 2, 0], "
+           "\"outerRadius\": 1}, \"lifetime\": 1}]}], \"actions\": [{\"type\": \"Gravity\", "
+           "\"acceleration\": [0, -9.81, 0]}, {\"type\": \"Bounce\", \"surface\": {\"type\": "
+           "\"plane\", \"point\": [0, 0, 0], \"normal\": [0, 1, 0]}, \"restitution\": 0.5}, "
+           "{\"type\": \"Move\"}, {\"type\": \"KillOld\"}]}]}",
+           rate * 5 / 4 + 16, rate);
+  Library L[2];
+  for (int l = 0; l < 2; ++l) {
+    load(&L[l], argv[1 + l], capi);
+    flurry_context_options o;
+    check(L[l].options_init(&o), "flurry_context_options_init");
+    o.threads = (unsigned)threads;
+    check(L[l].create(&o, &L[l].ctx), "flurry_context_create");
+    flurry_effect* effect;
+    check(L[l].parse(json, "sparks", &effect), "flurry_effect_parse");
+    const long side = (long)ceil(sqrt((double)instances));
+    for (long k = 0; k < instances; ++k) {
+      char name[32];
+      snprintf(name, sizeof name, "%ld", k);
+      flurry_instance* instance;
+      check(L[l].instantiate(effect, L[l].ctx, name, 0, &instance), "flurry_effect_instantiate");
+      const float at[3] = {(float)(k % side) * 4.0f, 0.0f, (float)(k / side) * 4.0f};
+      const float half = (float)k * 0.185f; /* turned by 0.37 k about y (x, y, z, w) */
+      const float turn[4] = {0.0f, sinf(half), 0.0f, cosf(half)};
+      check(L[l].place(instance, at, turn, 1.0f), "flurry_instance_set_transform");
+    }
+    check(L[l].run(L[l].ctx, 45), "flurry_context_run"); /* births and deaths balance */
+  }
+  double* ratio = malloc(sizeof(double) * (size_t)slices);
+  double total[2] = {0.0, 0.0};
+  for (long s = 0; s < slices; ++s) {
+    double t[2];
+    for (int j = 0; j < 2; ++j) {
+      const int l = (s & 1) ? 1 - j : j; /* each goes first in turn */
+      const double t0 = seconds();
+      for (long k = 0; k < steps; ++k) check(L[l].step(L[l].ctx), "flurry_context_step");
+      t[l] = seconds() - t0;
+      total[l] += t[l];
+    }
+    ratio[s] = t[0] / t[1];
+  }
+  qsort(ratio, (size_t)slices, sizeof(double), ascending);
+  const double per = 1e6 / (double)(slices * steps * instances);
+  printf("%ld instances, %ld thread(s): old %.3f us an instance-step, new %.3f\n", instances,
+         threads, total[0] * per, total[1] * per);
+  printf("new faster by %.3fx (median of %ld slices; quartiles %.3f, %.3f)\n", ratio[slices / 2],
+         slices, ratio[slices / 4], ratio[(3 * slices) / 4]);
+  free(ratio);
+  return 0;
+}
