@@ -94,7 +94,7 @@ void assignFill(std::vector<float>& v, std::size_t n, float value) {
   v.assign(n, value);
 }
 
-Lanes Lanes::offset(std::size_t b) const {
+Lanes Lanes::offsetBy(std::size_t b) const {
   Lanes r = *this;
   forEachLanePointer(r, [b](auto*& ptr) {
     if (ptr) ptr += b;

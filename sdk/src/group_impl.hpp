@@ -65,7 +65,9 @@ struct Lanes {
   float* birthColor[4] = {};
   float* birthSize = nullptr;
 
-  Lanes offset(std::size_t b) const;
+  /// The lanes from particle b on (a small group's one block starts at 0: no call).
+  Lanes offset(std::size_t b) const { return b == 0 ? *this : offsetBy(b); }
+  Lanes offsetBy(std::size_t b) const;
 };
 
 /// Calls f(pointer) with a reference to each of `l`'s lane pointers, null or not, in a fixed
