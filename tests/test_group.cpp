@@ -227,7 +227,9 @@ TEST(Group, AWalkThatFillsHolesLeavesWhatCompactionWould) {
       SCOPED_TRACE(threads);
       std::uint64_t walked = 0;
       const auto got = run(threads, &walked);
-      if (threads == 1 || front) EXPECT_GT(walked, 0u) << "the walk filled no hole";
+      if (threads == 1 || front) {
+        EXPECT_GT(walked, 0u) << "the walk filled no hole";
+      }
       ASSERT_EQ(got.size(), alone.size());
       EXPECT_EQ(std::memcmp(got.data(), alone.data(), got.size() * sizeof(float)), 0);
     }
@@ -1611,21 +1613,34 @@ TEST(Instance, TheIdentityIsBitwiseNoTransform) {
   }
 }
 
+namespace {
+// The effect's context options on `threads` threads.
+ContextOptions onThreads(const Effect& fx, unsigned threads) {
+  ContextOptions o = fx.contextOptions();
+  o.threads = threads;
+  return o;
+}
+// `count` instances of the effect in ctx, named by their index.
+std::vector<EffectInstance> instancesOf(const Effect& fx, Context& ctx, int count) {
+  std::vector<EffectInstance> all;
+  for (int k = 0; k < count; ++k) all.push_back(fx.instantiate(ctx, std::to_string(k)));
+  return all;
+}
+}  // namespace
+
 // Context::step runs a few groups' emissions before their act passes (CpuBackend's parts):
 // each instance of many ends bitwise as the same instance alone in a context of its own.
 TEST(Instance, ManyInstancesStepAsEachAlone) {
   const Effect fx = dropEffect("world");
   for (const unsigned threads : {1u, 2u}) {
-    ContextOptions o = fx.contextOptions();
-    o.threads = threads;
+    const ContextOptions o = onThreads(fx, threads);
     Context many(o);
-    std::vector<EffectInstance> all;
+    std::vector<EffectInstance> all = instancesOf(fx, many, 40);
     for (int k = 0; k < 40; ++k) {
-      all.push_back(fx.instantiate(many, std::to_string(k)));
       Transform t;
       t.position = Vec3(float(k % 7) * 3.0f, 0.0f, float(k / 7) * 3.0f);
-      all.back().setTransform(t);
-      all.back().setSeed(std::uint64_t(k) + 1);
+      all[std::size_t(k)].setTransform(t);
+      all[std::size_t(k)].setSeed(std::uint64_t(k) + 1);
     }
     many.run(50);
     for (const int k : {0, 17, 39}) {
@@ -1646,11 +1661,8 @@ TEST(Instance, ManyInstancesStepAsEachAlone) {
 TEST(Instance, AThrowInOneOfManyLeavesNoneHalfStepped) {
   const Effect fx = dropEffect("world");
   for (const unsigned threads : {1u, 2u}) {
-    ContextOptions o = fx.contextOptions();
-    o.threads = threads;
-    Context ctx(o);
-    std::vector<EffectInstance> all;
-    for (int k = 0; k < 40; ++k) all.push_back(fx.instantiate(ctx, std::to_string(k)));
+    Context ctx(onThreads(fx, threads));
+    std::vector<EffectInstance> all = instancesOf(fx, ctx, 40);
     ctx.run(10);
     Group& cursed = *all[17].groups()[0];
     ActionList list = cursed.actions();

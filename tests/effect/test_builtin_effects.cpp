@@ -62,8 +62,9 @@ TEST_P(EachBuiltin, LoadsRuns100StepsAndStaysFinite) {
   std::uint64_t emitted = 0;
   for (int i = 0; i < 100; ++i) {
     ctx.step();
-    if (i % 25 == 24)
+    if (i % 25 == 24) {
       for (Group* g : ctx.groups()) ASSERT_TRUE(allFinite(*g)) << g->name() << " step " << i;
+    }
   }
   for (Group* g : ctx.groups()) {
     ASSERT_TRUE(allFinite(*g)) << g->name();
@@ -294,9 +295,10 @@ TEST(Effect, ScaleSpawningScalesWhatIsBornAndTheRoom) {
   for (; before && after; before = before->next.get(), after = after->next.get(), ++levels) {
     EXPECT_DOUBLE_EQ(after->emitter.rate, before->emitter.rate * 0.5);
     EXPECT_FLOAT_EQ(after->emitter.spacing, before->emitter.spacing * 2.0f);
-    if (before->deathBurst > 0)
+    if (before->deathBurst > 0) {
       EXPECT_EQ(after->deathBurst,
                 std::max(1u, std::uint32_t(std::round(before->deathBurst * 0.5))));
+    }
   }
   EXPECT_GE(levels, 2);
   EXPECT_NE(fireworks->effect->groups[0].primeEmitters[0].child.next.get(),

@@ -396,12 +396,18 @@ TEST(OpenCLBackend, ReadsBackOnlyWhatIsAsked) {
         const std::size_t n = reader.size();
         EXPECT_EQ(g.stats().bytesReadBack, before) << "size() reads no particles";
         const auto y = reader.lane(Attribute::Position, 1);
-        if (b == Backend::OpenCL) EXPECT_EQ(g.stats().bytesReadBack - before, 3 * lane * n);
+        if (b == Backend::OpenCL) {
+          EXPECT_EQ(g.stats().bytesReadBack - before, 3 * lane * n);
+        }
         reader.bounds();
         reader.lane(Attribute::Position, 2);
-        if (b == Backend::OpenCL) EXPECT_EQ(g.stats().bytesReadBack - before, 3 * lane * n);
+        if (b == Backend::OpenCL) {
+          EXPECT_EQ(g.stats().bytesReadBack - before, 3 * lane * n);
+        }
         reader.fetch({Attribute::Position, Attribute::Velocity, Attribute::Color});  // no colour
-        if (b == Backend::OpenCL) EXPECT_EQ(g.stats().bytesReadBack - before, 6 * lane * n);
+        if (b == Backend::OpenCL) {
+          EXPECT_EQ(g.stats().bytesReadBack - before, 6 * lane * n);
+        }
         seen.insert(seen.end(), y.begin(), y.end());
         const auto vz = reader.lane(Attribute::Velocity, 2);
         seen.insert(seen.end(), vz.begin(), vz.end());
@@ -413,7 +419,9 @@ TEST(OpenCLBackend, ReadsBackOnlyWhatIsAsked) {
             {{Attribute::Position, PackFormat::Float32}, {Attribute::Age, PackFormat::Float32}});
         std::vector<std::byte> out(reader.size() * layout.stride);
         const std::size_t n = packParticles(reader, layout, out);
-        if (b == Backend::OpenCL) EXPECT_EQ(g.stats().bytesReadBack - before, 4 * lane * n);
+        if (b == Backend::OpenCL) {
+          EXPECT_EQ(g.stats().bytesReadBack - before, 4 * lane * n);
+        }
       }
       if (s == 10) {
         // A write after a partial read: the device must take every attribute as it is.
@@ -425,7 +433,9 @@ TEST(OpenCLBackend, ReadsBackOnlyWhatIsAsked) {
       const Particle p = reader.particle(i);
       seen.insert(seen.end(), {p.position.x, p.position.y, p.velocity.y, p.age, p.lifetime});
     }
-    if (b == Backend::Cpu) EXPECT_EQ(g.stats().bytesReadBack, 0u);
+    if (b == Backend::Cpu) {
+      EXPECT_EQ(g.stats().bytesReadBack, 0u);
+    }
     EXPECT_GT(reader.size(), 0u);
     EXPECT_LT(reader.size(), 300u);
     return seen;
