@@ -214,65 +214,52 @@ void lap(std::uint64_t& last, double& total, double& thisStep) {
   last = now;
 }
 
-// A step's first part: its newborns. False when the group is idle (nothing alive and no
-// emitter that will fire): such a step would change nothing (its emitters' state included),
-// so it costs no pass, no clock and no worker.
-bool emitPart(GroupImpl& group, const StepParams& params, std::uint64_t& last) {
-  group.lastStepParts = {};
-  if (group.size == 0 && !group.hair.enabled && !mayEmit(group, params)) {
-    // What a step's planning would have done: count generation 0 (see planBirths).
-    if (!group.emitters.empty() && group.stats.emittedByGeneration.empty())
-      group.stats.emittedByGeneration.assign(1, 0);
-    ++group.stats.idleSteps;
-    return false;
-  }
-  // Each part's time, for GroupStats::stepSeconds (tick_clock.hpp: a cheap clock).
-  last = ticksNow();
-  emitNewborns(group, params);
-  // A newborn's trail starts where it was born, inside the step.
-  if (group.bornCount > 0) group.startTrails(group.bornFirst, group.bornFirst + group.bornCount);
-  if (group.birthsFeed) group.recordBirths(params.time + params.dt);
-  lap(last, group.stats.stepSeconds.emit, group.lastStepParts.emit);
-  return true;
-}
-
-// The rest: the act pass, then the dead removed, the budget kept, the trails turned, the
-// strands of hair mode.
-void actPart(GroupImpl& group, const StepParams& params, std::uint64_t& last) {
-  actFused(group, params);
-  lap(last, group.stats.stepSeconds.act, group.lastStepParts.act);
-  compact(group, params);
-  if (group.size > group.keepAtMost) group.dropOldest(group.size - group.keepAtMost, params);
-  group.recordTrails(*params.pool);
-  lap(last, group.stats.stepSeconds.compact, group.lastStepParts.compact);
-  if (group.hair.enabled) simulateHair(group, params);
-}
-
 class CpuBackend final : public BackendImpl {
  public:
   const char* name() const override { return "cpu"; }
   void step(GroupImpl& group, const StepParams& params) override {
-    std::uint64_t last = 0;
-    if (!emitPart(group, params, last)) return;
-    // The rest of a later group's data, asked for here rather than with the first part
-    // before this step (StepParams::ahead).
-    if (params.ahead) params.ahead->prefetchData(1, 2);
-    actPart(group, params, last);
+    if (stepFirstPart(group, params)) stepSecondPart(group, params);
   }
 
   // The newborns first: Context::step runs a few groups' emission, then their act passes and
   // compaction. A game's many small groups then run each phase's code while it is in the
   // instruction cache, and a group's lanes, asked for before its emission, are in the data
-  // cache when its pass comes.
+  // cache when its pass comes. False when the group is idle (nothing alive and no emitter
+  // that will fire): such a step would change nothing (its emitters' state included), so it
+  // costs no pass, no clock and no worker.
   bool stepFirstPart(GroupImpl& group, const StepParams& params) override {
-    std::uint64_t last = 0;
-    if (!emitPart(group, params, last)) return false;
+    group.lastStepParts = {};
+    if (group.size == 0 && !group.hair.enabled && !mayEmit(group, params)) {
+      // What a step's planning would have done: count generation 0 (see planBirths).
+      if (!group.emitters.empty() && group.stats.emittedByGeneration.empty())
+        group.stats.emittedByGeneration.assign(1, 0);
+      ++group.stats.idleSteps;
+      return false;
+    }
+    // Each part's time, for GroupStats::stepSeconds (tick_clock.hpp: a cheap clock).
+    std::uint64_t last = ticksNow();
+    emitNewborns(group, params);
+    // A newborn's trail starts where it was born, inside the step.
+    if (group.bornCount > 0) group.startTrails(group.bornFirst, group.bornFirst + group.bornCount);
+    if (group.birthsFeed) group.recordBirths(params.time + params.dt);
+    lap(last, group.stats.stepSeconds.emit, group.lastStepParts.emit);
+    // The rest of a later group's data, asked for here rather than with the first part
+    // before this step (StepParams::ahead).
     if (params.ahead) params.ahead->prefetchData(1, 2);
     return true;
   }
+
+  // The act pass, then the dead removed, the budget kept, the trails turned, the strands of
+  // hair mode. (The time between the parts counts to neither.)
   void stepSecondPart(GroupImpl& group, const StepParams& params) override {
-    std::uint64_t last = ticksNow();  // (the time between the parts counts to neither)
-    actPart(group, params, last);
+    std::uint64_t last = ticksNow();
+    actFused(group, params);
+    lap(last, group.stats.stepSeconds.act, group.lastStepParts.act);
+    compact(group, params);
+    if (group.size > group.keepAtMost) group.dropOldest(group.size - group.keepAtMost, params);
+    group.recordTrails(*params.pool);
+    lap(last, group.stats.stepSeconds.compact, group.lastStepParts.compact);
+    if (group.hair.enabled) simulateHair(group, params);
   }
 };
 }  // namespace
