@@ -516,13 +516,18 @@ void Context::step() {
         detail::StepParams own =
             groupStep(params, gi, impl_->timeAtDtChange, impl_->stepsSinceDtChange, 0);
         own.ahead = ahead;
-        at.stepped = true;
         if (!inParts) {
           stepGroup(*impl_->backend, gi, own);
+          at.stepped = true;
           continue;
         }
-        if (!beginGroupStep(gi, own)) continue;
-        if (!impl_->backend->stepFirstPart(gi, own)) {
+        if (!beginGroupStep(gi, own)) {  // paused
+          at.stepped = true;
+          continue;
+        }
+        const bool second = impl_->backend->stepFirstPart(gi, own);
+        at.stepped = true;
+        if (!second) {
           endGroupStep(gi, own);
           continue;
         }
