@@ -145,6 +145,16 @@ void guard(const Bounce& b, const Lanes& L, const float* const* start, std::size
   }
 }
 
+// 16 floats (or words) as one value of GCC's and Clang's vector extension: one AVX-512
+// register, two AVX2 ones, four SSE2 ones. The reductions over a block (its swept bounds, its
+// live bounds) keep 16 independent lanes in these: they vectorise without -ffast-math, and
+// no lane waits on a store of the last iteration (lanes kept in stack arrays did: 14 % of a
+// 1M-particle step with bounds).
+constexpr std::size_t kLanes16 = 16;
+using Floats16 = float __attribute__((vector_size(4 * kLanes16)));
+using Words16 = std::uint32_t __attribute__((vector_size(4 * kLanes16)));
+using Ints16 = std::int32_t __attribute__((vector_size(4 * kLanes16)));
+
 // Spatial culling of one block over one sub-step: the block's swept bounds, taken when an
 // action with a finite reach is reached and kept until an action that moves particles runs.
 struct Culler {
@@ -156,11 +166,9 @@ struct Culler {
 
   // The box the block's straight paths p .. p + v·dt lie in.
   void gather(const Lanes& L, std::size_t n, float dt) {
-    // 16 independent lanes in vector registers (as liveBounds): the loops vectorise without
-    // -ffast-math, and no lane waits on a store of the last iteration.
-    constexpr std::size_t W = 16;
-    using F = float __attribute__((vector_size(4 * W)));
-    using U = std::uint32_t __attribute__((vector_size(4 * W)));
+    constexpr std::size_t W = kLanes16;
+    using F = Floats16;
+    using U = Words16;
     float check = 0.0f;
     scale = 0.0f;
     for (int c = 0; c < 3; ++c) {
@@ -409,13 +417,10 @@ void guardFinite(const Lanes& L, std::size_t n, std::uint32_t* __restrict dead, 
 // max xyz, taken while the block is in cache, for Group::bounds. Every live position is
 // finite (guardFinite killed the others); a block of dead only gives an empty box.
 void liveBounds(const Lanes& L, std::size_t n, const std::uint32_t* __restrict dead, float* out) {
-  // 16 independent lanes in vector registers (GCC's and Clang's vector extension: one
-  // AVX-512 register, two AVX2 ones, four SSE2 ones). Arrays of 16 floats were kept on the
-  // stack, every iteration's min and max waiting on the last one's store (14 % of a 1M step).
-  constexpr std::size_t W = 16;
-  using F = float __attribute__((vector_size(4 * W)));
-  using U = std::uint32_t __attribute__((vector_size(4 * W)));
-  using I = std::int32_t __attribute__((vector_size(4 * W)));
+  constexpr std::size_t W = kLanes16;  // (in vector registers: Floats16)
+  using F = Floats16;
+  using U = Words16;
+  using I = Ints16;
   const F inf = F{} + kInfinity, ninf = F{} - kInfinity;
   for (int c = 0; c < 3; ++c) {
     const float* __restrict p = L.p[c];
