@@ -460,8 +460,9 @@ void Context::step() {
   // on one miss after another. (A group that sits this step out needs only its count of
   // skipped steps, and after a step of its own a few more lines of its state.)
   //
-  // On the CPU a few groups' first parts (their newborns) run before their second parts (act
-  // pass and compaction): BackendImpl::stepFirstPart.
+  // A few groups' first parts (on the CPU their newborns) run before their second parts (act
+  // pass and compaction): BackendImpl::stepFirstPart. (Other backends' first part is the
+  // whole step.)
   const bool inParts = impl_->backendKind == Backend::Cpu;
   // How many groups ahead a group's state, and then its data, is asked for: further when the
   // act passes wait for a few emissions (10,000 instances on 1 thread: 4 ahead 1.02x faster
@@ -516,11 +517,6 @@ void Context::step() {
         detail::StepParams own =
             groupStep(params, gi, impl_->timeAtDtChange, impl_->stepsSinceDtChange, 0);
         own.ahead = ahead;
-        if (!inParts) {
-          stepGroup(*impl_->backend, gi, own);
-          at.stepped = true;
-          continue;
-        }
         if (!beginGroupStep(gi, own)) {  // paused
           at.stepped = true;
           continue;
