@@ -671,7 +671,9 @@ TEST(Group, BoundsAreKeptEveryStepByThePass) {
     }
 }
 
-// An instance's box holds every live particle of its groups, wherever it is moved.
+// An instance's box holds every live particle of its groups, wherever it is moved. (Three
+// groups: the instance keeps the first two's internals at hand, the third is reached through
+// the group.)
 TEST(Instance, BoundsHoldEveryParticleOfItsGroups) {
   const Effect fx = parseEffect(R"({
     "name": "two", "dt": 0.05,
@@ -683,6 +685,10 @@ TEST(Instance, BoundsHoldEveryParticleOfItsGroups) {
       {"name": "side", "capacity": 500,
        "emitters": [{"shape": {"type": "point", "point": [1, 0, 0]}, "rate": 200,
                      "types": [{"lifetime": 2, "velocity": {"type": "point", "point": [2, 0, 0]}}]}],
+       "actions": [{"type": "Move"}, {"type": "KillOld"}]},
+      {"name": "down", "capacity": 500,
+       "emitters": [{"shape": {"type": "point", "point": [0, 0, 1]}, "rate": 200,
+                     "types": [{"lifetime": 2, "velocity": {"type": "point", "point": [0, -4, 0]}}]}],
        "actions": [{"type": "Move"}, {"type": "KillOld"}]}]})");
   Context ctx(fx.contextOptions());
   EffectInstance inst = fx.instantiate(ctx, "a");
@@ -699,11 +705,13 @@ TEST(Instance, BoundsHoldEveryParticleOfItsGroups) {
       EXPECT_EQ(b.min, glm::min(b.min, e.min));
       EXPECT_EQ(b.max, glm::max(b.max, e.max));
     }
-    const Bounds up = boundsByHand(*inst.groups()[0]), side = boundsByHand(*inst.groups()[1]);
-    EXPECT_EQ(b.min, glm::min(up.min, side.min));
-    EXPECT_EQ(b.max, glm::max(up.max, side.max));
+    const Bounds up = boundsByHand(*inst.groups()[0]), side = boundsByHand(*inst.groups()[1]),
+                 down = boundsByHand(*inst.groups()[2]);
+    EXPECT_EQ(b.min, glm::min(glm::min(up.min, side.min), down.min));
+    EXPECT_EQ(b.max, glm::max(glm::max(up.max, side.max), down.max));
   }
-  EXPECT_GT(inst.bounds().max.y, 2.0f);  // the upward group, in the world
+  EXPECT_GT(inst.bounds().max.y, 2.0f);   // the upward group, in the world
+  EXPECT_LT(inst.bounds().min.y, -4.0f);  // the third, downward
 }
 
 // Deaths are recorded where and when they happen: particles of known motion die of age at a

@@ -13,6 +13,9 @@
  *
  * (one command line; OLD built as scripts/compare_libraries.py says). The same library
  * against itself gives ratios of 1 within a few percent: what a difference must beat.
+ * `--bounds 1` also reads every instance's box after each step, as a game culling them does.
+ * Where the public headers changed between the two, give the old one the C API built with
+ * it (`--old-capi OLD/libflurry_c.so`).
  */
 #define _GNU_SOURCE
 #include <dlfcn.h>
@@ -38,7 +41,9 @@ typedef struct {
   flurry_status (*instantiate)(const flurry_effect*, flurry_context*, const char*, size_t,
                                flurry_instance**);
   flurry_status (*place)(flurry_instance*, const float*, const float*, float);
+  flurry_status (*bounds)(const flurry_instance*, float[3], float[3], int*);
   flurry_context* ctx;
+  flurry_instance** instances;
 } Library;
 
 static void* symbol(void* lib, const char* name) {
@@ -72,6 +77,7 @@ static void load(Library* L, const char* core, const char* capi) {
   L->parse = symbol(lib, "flurry_effect_parse");
   L->instantiate = symbol(lib, "flurry_effect_instantiate");
   L->place = symbol(lib, "flurry_instance_set_transform");
+  L->bounds = symbol(lib, "flurry_instance_bounds");
 }
 
 static double seconds(void) {
@@ -96,18 +102,24 @@ int main(int argc, char** argv) {
   if (argc < 3) {
     fprintf(stderr,
             "usage: ab_instances OLD.so NEW.so [--instances N] [--threads T] [--slices S]\n"
-            "       [--steps K] [--rate R] [--capi libflurry_c.so]\n");
+            "       [--steps K] [--rate R] [--bounds 0|1] [--capi libflurry_c.so]\n"
+            "       [--old-capi libflurry_c.so]\n");
     return 2;
   }
-  long instances = 1000, threads = 1, slices = 40, steps = 20, rate = 100;
+  long instances = 1000, threads = 1, slices = 40, steps = 20, rate = 100, bounds = 0;
   const char* capi = FLURRY_C_LIBRARY;
+  const char* oldCapi = NULL;
   for (int i = 3; i + 1 < argc; i += 2) {
     const char* k = argv[i];
-    if (!strcmp(k, "--capi")) {
-      capi = argv[i + 1];
+    if (!strcmp(k, "--capi") || !strcmp(k, "--old-capi")) {
+      *(!strcmp(k, "--capi") ? &capi : &oldCapi) = argv[i + 1];
       continue;
     }
     const long v = strtol(argv[i + 1], NULL, 10);
+    if (!strcmp(k, "--bounds") && (v == 0 || v == 1)) {
+      bounds = v;
+      continue;
+    }
     if (v <= 0) {
       fprintf(stderr, "ab_instances: %s must be a positive integer\n", k);
       return 2;
@@ -140,7 +152,8 @@ int main(int argc, char** argv) {
            rate * 5 / 4 + 16, rate);
   Library L[2];
   for (int l = 0; l < 2; ++l) {
-    load(&L[l], argv[1 + l], capi);
+    load(&L[l], argv[1 + l], l == 0 && oldCapi ? oldCapi : capi);
+    L[l].instances = malloc(sizeof(flurry_instance*) * (size_t)instances);
     flurry_context_options o;
     check(L[l].options_init(&o), "flurry_context_options_init");
     o.threads = (unsigned)threads;
@@ -157,17 +170,27 @@ int main(int argc, char** argv) {
       const float half = (float)k * 0.185f; /* turned by 0.37 k about y (x, y, z, w) */
       const float turn[4] = {0.0f, sinf(half), 0.0f, cosf(half)};
       check(L[l].place(instance, at, turn, 1.0f), "flurry_instance_set_transform");
+      L[l].instances[k] = instance;
     }
     check(L[l].run(L[l].ctx, 45), "flurry_context_run"); /* births and deaths balance */
   }
   double* ratio = malloc(sizeof(double) * (size_t)slices);
   double total[2] = {0.0, 0.0};
+  volatile float sink = 0.0f; /* the boxes read, kept */
   for (long s = 0; s < slices; ++s) {
     double t[2];
     for (int j = 0; j < 2; ++j) {
       const int l = (s & 1) ? 1 - j : j; /* each goes first in turn */
       const double t0 = seconds();
-      for (long k = 0; k < steps; ++k) check(L[l].step(L[l].ctx), "flurry_context_step");
+      for (long k = 0; k < steps; ++k) {
+        check(L[l].step(L[l].ctx), "flurry_context_step");
+        for (long i = 0; bounds && i < instances; ++i) {
+          float lo[3], hi[3];
+          int empty;
+          check(L[l].bounds(L[l].instances[i], lo, hi, &empty), "flurry_instance_bounds");
+          sink += hi[1];
+        }
+      }
       t[l] = seconds() - t0;
       total[l] += t[l];
     }
@@ -180,5 +203,6 @@ int main(int argc, char** argv) {
   printf("new faster by %.3fx (median of %ld slices; quartiles %.3f, %.3f)\n", ratio[slices / 2],
          slices, ratio[slices / 4], ratio[(3 * slices) / 4]);
   free(ratio);
+  for (int l = 0; l < 2; ++l) free(L[l].instances);
   return 0;
 }

@@ -985,8 +985,13 @@ std::span<const DeathEvent> Group::deaths() const {
 }
 
 Bounds Group::bounds() const {
-  auto& g = *impl_;
-  g.boundsWanted = true;  // the next steps' passes keep it
+  return detail::liveBox(*impl_);
+}
+
+Bounds detail::liveBox(GroupImpl& g) {
+  // The next steps' passes keep it. (Only written once: a line written every frame would be
+  // written back.)
+  if (!g.boundsWanted) g.boundsWanted = true;
   if (g.size == 0) return {};
   if (g.boundsValid) return g.stepBounds;
   g.syncHost({Attribute::Position});

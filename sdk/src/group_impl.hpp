@@ -294,6 +294,12 @@ struct GroupImpl {
 
   std::size_t capacity = 0;
   std::size_t size = 0;
+  /// Group::bounds() was asked: from then on the CPU pass takes the live particles' box
+  /// every step, each block while it is in cache (no pass of its own). Beside `size`: a game
+  /// asks every instance's box each frame, and then reads this one cache line of the group.
+  bool boundsWanted = false;
+  bool boundsValid = false;  ///< stepBounds is the live particles' box now
+  Bounds stepBounds;         ///< of the last step's pass, when boundsValid
   /// The stored lanes' pointers (lanePointers()), taken again whenever `lanes` changes
   /// (ensureStorage): a step reads these 6 cache lines, not the 18 of the table.
   Lanes laneCache;
@@ -403,12 +409,7 @@ struct GroupImpl {
   /// Keeps the step's newborns [bornFirst, bornFirst + bornCount) as birthEvents, before the
   /// pass moves them (t1: the step's end; each was born bornRemaining[r] before it).
   void recordBirths(double t1);
-  bool onDevice = false;  ///< its context runs a device backend
-  /// Group::bounds() was asked: from then on the CPU pass takes the live particles' box
-  /// every step, each block while it is in cache (no pass of its own).
-  bool boundsWanted = false;
-  bool boundsValid = false;          ///< stepBounds is the live particles' box now
-  Bounds stepBounds;                 ///< of the last step's pass, when boundsValid
+  bool onDevice = false;             ///< its context runs a device backend
   std::vector<std::uint32_t> holes;  ///< sorted dead indices of this step
   /// The first `holesFilled` of them the act pass has already filled, each with the live
   /// particle compact() would have moved there, the last from index `filledFrom`: compact()
@@ -545,5 +546,9 @@ inline GroupImpl& implOf(Group& g) {
 inline const GroupImpl& implOf(const Group& g) {
   return GroupAccess::of(g);
 }
+
+/// Group::bounds(): the live particles' box, the pass's when it kept one (and the passes
+/// keep it from now on).
+Bounds liveBox(GroupImpl& g);
 
 }  // namespace flurry::detail

@@ -130,6 +130,8 @@ EffectInstance Effect::instantiate(Context& ctx, std::string_view instance,
   EffectInstance fx;
   fx.groups_ = build(ctx, maxCapacity, instance);
   fx.context_ = &ctx;
+  for (std::size_t k = 0; k < std::size(fx.impls_) && k < fx.groups_.size(); ++k)
+    fx.impls_[k] = &detail::implOf(*fx.groups_[k]);
   return fx;
 }
 
@@ -150,8 +152,9 @@ EffectInstance& EffectInstance::setTransform(const Transform& transform) {
 
 Bounds EffectInstance::bounds() const {
   Bounds all;
-  for (const Group* g : groups_) {
-    const Bounds b = g->bounds();
+  for (std::size_t k = 0; k < groups_.size(); ++k) {
+    const Bounds b =
+        detail::liveBox(k < std::size(impls_) ? *impls_[k] : detail::implOf(*groups_[k]));
     if (b.empty) continue;
     all.min = all.empty ? b.min : glm::min(all.min, b.min);
     all.max = all.empty ? b.max : glm::max(all.max, b.max);
@@ -238,6 +241,7 @@ bool EffectInstance::done() const {
 void EffectInstance::destroy() {
   for (Group* g : groups_) context_->destroyGroup(*g);
   groups_.clear();
+  std::fill(std::begin(impls_), std::end(impls_), nullptr);
 }
 
 }  // namespace flurry
