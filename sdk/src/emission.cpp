@@ -566,7 +566,7 @@ void emitFromDeaths(GroupImpl& g, std::size_t k, const GroupImpl& source, std::u
 
 std::size_t storedLanes(GroupImpl& g, StoredLanes& stored) {
   std::size_t lanes = 0;
-  forEachLane(g.laneCache, [&](std::uint32_t* lane) { stored[lanes++] = lane; });
+  forEachSlot(g.laneCache, g.laneSlots, [&](std::uint32_t* lane) { stored[lanes++] = lane; });
   for (auto& lane : g.trailLanes) stored[lanes++] = lane.u();
   if (g.trailCount) stored[lanes++] = g.trailCount.u();
   return lanes;

@@ -127,6 +127,7 @@ void GroupImpl::cacheLanes() {
   l.charge = f(Attribute::Charge, 0);
   l.visible = lanes[std::size_t(Attribute::Visible)][0].u();
   l.user = f(Attribute::UserData, 0);
+  laneSlots = l.storedSlots();
 }
 
 void writeParticle(const Lanes& l, std::size_t i, const Particle& q) {
@@ -511,8 +512,9 @@ void detail::GroupImpl::prefetchSelf() const {
 void detail::GroupImpl::prefetchData(int part, int parts) const {
   const std::size_t bytes = size * sizeof(float) + 64;
   int k = 0;
-  forEachLane(laneCache, [&](const std::uint32_t* lane) {
-    if (k++ % parts == part) prefetchBytes(lane, bytes);
+  forEachSlot(laneCache, laneSlots, [&](const std::uint32_t* lane) {
+    if (k == part) prefetchBytes(lane, bytes);
+    if (++k == parts) k = 0;
   });
   if (part != 0) return;
   prefetchVector(actions.actions());

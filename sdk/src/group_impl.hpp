@@ -2,11 +2,14 @@
 #pragma once
 
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "../../kernels/params.h"
@@ -68,7 +71,32 @@ struct Lanes {
   /// The lanes from particle b on (a small group's one block starts at 0: no call).
   Lanes offset(std::size_t b) const { return b == 0 ? *this : offsetBy(b); }
   Lanes offsetBy(std::size_t b) const;
+
+  /// The members are nothing but lane pointers, of 32-bit elements: slot k is the k-th in
+  /// memory order. Loops that need not know which lane is which (moving, prefetching) read
+  /// them as slots, not member by member.
+  static constexpr int kSlots = 38;
+  /// Slot k (null where not stored).
+  std::uint32_t* slot(int k) const {
+    std::uint32_t* lane;
+    std::memcpy(&lane, reinterpret_cast<const char*>(this) + k * sizeof(lane), sizeof(lane));
+    return lane;
+  }
+  /// Bit k set where slot k is stored.
+  std::uint64_t storedSlots() const {
+    std::uint64_t mask = 0;
+    for (int k = 0; k < kSlots; ++k) mask |= std::uint64_t(slot(k) != nullptr) << k;
+    return mask;
+  }
 };
+static_assert(sizeof(Lanes) == Lanes::kSlots * sizeof(float*) &&
+              std::is_trivially_copyable_v<Lanes>);
+
+/// Calls f(lane) for each slot of `mask` (Lanes::storedSlots) in slot order.
+template <class F>
+void forEachSlot(const Lanes& l, std::uint64_t mask, F&& f) {
+  for (; mask != 0; mask &= mask - 1) f(l.slot(std::countr_zero(mask)));
+}
 
 /// Calls f(pointer) with a reference to each of `l`'s lane pointers, null or not, in a fixed
 /// order: the one list of a Lanes' members (Lanes::offset, forEachLane).
@@ -303,6 +331,7 @@ struct GroupImpl {
   /// The stored lanes' pointers (lanePointers()), taken again whenever `lanes` changes
   /// (ensureStorage): a step reads these 6 cache lines, not the 18 of the table.
   Lanes laneCache;
+  std::uint64_t laneSlots = 0;  ///< laneCache.storedSlots()
   AttributeSet required{Attribute::Position, Attribute::Id};
   AttributeSet stored;  ///< what the lanes hold now
   ActionList actions;   ///< replace through Group::setActions, which bumps actionsVersion
