@@ -99,7 +99,8 @@ void forEachSlot(const Lanes& l, std::uint64_t mask, F&& f) {
 }
 
 /// Calls f(pointer) with a reference to each of `l`'s lane pointers, null or not, in a fixed
-/// order: the one list of a Lanes' members (Lanes::offset, forEachLane).
+/// order: the one list of a Lanes' members by name (Lanes::offset; loops that need not know
+/// which lane is which walk them as slots, Lanes::slot).
 template <class L, class F>
 void forEachLanePointer(L& l, F&& f) {
   for (int c = 0; c < 3; ++c) {
@@ -124,14 +125,6 @@ void forEachLanePointer(L& l, F&& f) {
   f(l.charge);
   f(l.visible);
   f(l.user);
-}
-
-/// Calls f(lane) for every stored lane of `l` (as 32-bit words), in a fixed order.
-template <class F>
-void forEachLane(const Lanes& l, F&& f) {
-  forEachLanePointer(l, [&](auto* const& lane) {
-    if (lane) f(reinterpret_cast<std::uint32_t*>(lane));
-  });
 }
 
 /// Gathers / scatters one particle's stored attributes (others read as Particle's defaults).
