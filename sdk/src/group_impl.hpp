@@ -303,28 +303,29 @@ struct GroupImpl {
   static void* operator new(std::size_t bytes);
   static void operator delete(void* group, std::size_t bytes) noexcept;
 
-  std::string name;
+  // The first cache line: what every step and a game's every frame read (a reader of the
+  // box reads this line alone); the lane pointers fill the next five.
+  std::size_t capacity = 0;
+  std::size_t size = 0;
+  std::uint64_t seed = 0;
   std::uint32_t index = 0;  ///< creation order in the context: keeps groups' random streams apart
+  std::uint32_t stream = 0;
+  /// Group::bounds() was asked: from then on the CPU pass takes the live particles' box
+  /// every step, each block while it is in cache (no pass of its own).
+  Bounds stepBounds;  ///< of the last step's pass, when boundsValid
   /// Group::setSeed: the seed and stream its draws take instead of the context's seed and
   /// `index`.
   bool ownSeed = false;
-  std::uint64_t seed = 0;
-  std::uint32_t stream = 0;
+  bool boundsWanted = false;
+  bool boundsValid = false;  ///< stepBounds is the live particles' box now
   /// What keeps its random streams apart from other groups': `index`, or Group::setSeed's.
   std::uint32_t streamKey() const { return ownSeed ? stream : index; }
 
-  std::size_t capacity = 0;
-  std::size_t size = 0;
-  /// Group::bounds() was asked: from then on the CPU pass takes the live particles' box
-  /// every step, each block while it is in cache (no pass of its own). Beside `size`: a game
-  /// asks every instance's box each frame, and then reads this one cache line of the group.
-  bool boundsWanted = false;
-  bool boundsValid = false;  ///< stepBounds is the live particles' box now
-  Bounds stepBounds;         ///< of the last step's pass, when boundsValid
   /// The stored lanes' pointers (lanePointers()), taken again whenever `lanes` changes
-  /// (ensureStorage): a step reads these 6 cache lines, not the 18 of the table.
+  /// (ensureStorage): a step reads these 5 cache lines, not the 18 of the table.
   Lanes laneCache;
   std::uint64_t laneSlots = 0;  ///< laneCache.storedSlots()
+  std::string name;
   AttributeSet required{Attribute::Position, Attribute::Id};
   AttributeSet stored;  ///< what the lanes hold now
   ActionList actions;   ///< replace through Group::setActions, which bumps actionsVersion
