@@ -307,15 +307,15 @@ struct GroupImpl {
   // box reads this line alone); the lane pointers fill the next five.
   std::size_t capacity = 0;
   std::size_t size = 0;
+  /// Group::setSeed: the seed and stream its draws take (ownSeed) instead of the context's
+  /// seed and `index`.
   std::uint64_t seed = 0;
   std::uint32_t index = 0;  ///< creation order in the context: keeps groups' random streams apart
   std::uint32_t stream = 0;
+  Bounds stepBounds;  ///< of the last step's pass, when boundsValid
+  bool ownSeed = false;
   /// Group::bounds() was asked: from then on the CPU pass takes the live particles' box
   /// every step, each block while it is in cache (no pass of its own).
-  Bounds stepBounds;  ///< of the last step's pass, when boundsValid
-  /// Group::setSeed: the seed and stream its draws take instead of the context's seed and
-  /// `index`.
-  bool ownSeed = false;
   bool boundsWanted = false;
   bool boundsValid = false;  ///< stepBounds is the live particles' box now
   /// What keeps its random streams apart from other groups': `index`, or Group::setSeed's.
