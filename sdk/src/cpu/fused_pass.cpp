@@ -145,15 +145,25 @@ void guard(const Bounce& b, const Lanes& L, const float* const* start, std::size
   }
 }
 
-// 16 floats (or words) as one value of GCC's and Clang's vector extension: one AVX-512
-// register, two AVX2 ones, four SSE2 ones. The reductions over a block (its swept bounds, its
-// live bounds) keep 16 independent lanes in these: they vectorise without -ffast-math, and
-// no lane waits on a store of the last iteration (lanes kept in stack arrays did: 14 % of a
-// 1M-particle step with bounds).
+// The reductions over a block (its swept bounds, its live bounds) keep 16 independent lanes
+// in values of GCC's and Clang's vector extension: they vectorise without -ffast-math, and no
+// lane waits on a store of the last iteration (lanes kept in stack arrays did: 14 % of a
+// 1M-particle step with bounds). The 16 lanes are held as vectors of the build's own width
+// (one AVX-512 register, two AVX2 ones, four SSE2 ones): GCC lowers a ?: on a vector wider
+// than the target's registers element by element, which made the AVX2 build's swept bounds
+// ~40 % of a classic fountain's instructions.
 constexpr std::size_t kLanes16 = 16;
-using Floats16 = float __attribute__((vector_size(4 * kLanes16)));
-using Words16 = std::uint32_t __attribute__((vector_size(4 * kLanes16)));
-using Ints16 = std::int32_t __attribute__((vector_size(4 * kLanes16)));
+#if defined(__AVX512F__)
+constexpr std::size_t kNativeFloats = 16;
+#elif defined(__AVX__)
+constexpr std::size_t kNativeFloats = 8;
+#else
+constexpr std::size_t kNativeFloats = 4;
+#endif
+constexpr std::size_t kParts = kLanes16 / kNativeFloats;
+using Floats = float __attribute__((vector_size(4 * kNativeFloats)));
+using Words = std::uint32_t __attribute__((vector_size(4 * kNativeFloats)));
+using Ints = std::int32_t __attribute__((vector_size(4 * kNativeFloats)));
 
 // Spatial culling of one block over one sub-step: the block's swept bounds, taken when an
 // action with a finite reach is reached and kept until an action that moves particles runs.
@@ -166,30 +176,39 @@ struct Culler {
 
   // The box the block's straight paths p .. p + v·dt lie in.
   void gather(const Lanes& L, std::size_t n, float dt) {
-    constexpr std::size_t W = kLanes16;
-    using F = Floats16;
-    using U = Words16;
+    constexpr std::size_t W = kLanes16, N = kNativeFloats;
+    using F = Floats;
+    using U = Words;
     float check = 0.0f;
     scale = 0.0f;
     for (int c = 0; c < 3; ++c) {
       const float* __restrict p = L.p[c];
       const float* __restrict v = L.v[c];
-      F mn = F{} + kInfinity, mx = F{} - kInfinity, sp = F{}, ck = F{};
+      F mn[kParts], mx[kParts], sp[kParts], ck[kParts];
+      for (std::size_t q = 0; q < kParts; ++q) {
+        mn[q] = F{} + kInfinity;
+        mx[q] = F{} - kInfinity;
+        sp[q] = F{};
+        ck[q] = F{};
+      }
       std::size_t i = 0;
       for (; i + W <= n; i += W) {
-        F x, s;
-        std::memcpy(&x, p + i, sizeof x);
-        std::memcpy(&s, v + i, sizeof s);
-        s = (F)((U)s & 0x7fffffffu);  // |v|
-        mn = x < mn ? x : mn;
-        mx = x > mx ? x : mx;
-        sp = s > sp ? s : sp;
-        ck += (x - x) + (s - s);  // NaN if x or s is NaN or infinite
+        for (std::size_t q = 0; q < kParts; ++q) {
+          F x, s;
+          std::memcpy(&x, p + i + q * N, sizeof x);
+          std::memcpy(&s, v + i + q * N, sizeof s);
+          s = (F)((U)s & 0x7fffffffu);  // |v|
+          mn[q] = x < mn[q] ? x : mn[q];
+          mx[q] = x > mx[q] ? x : mx[q];
+          sp[q] = s > sp[q] ? s : sp[q];
+          ck[q] += (x - x) + (s - s);  // NaN if x or s is NaN or infinite
+        }
       }
       float a = kInfinity, b = -kInfinity, s = 0.0f;
       for (std::size_t j = 0; j < W; ++j, ++i) {
         // The remainder into the lanes it would have had, then the lanes together.
-        float lmn = mn[j], lmx = mx[j], lsp = sp[j], lck = ck[j];
+        float lmn = mn[j / N][j % N], lmx = mx[j / N][j % N], lsp = sp[j / N][j % N],
+              lck = ck[j / N][j % N];
         if (i < n) {
           const float x = p[i], sv = std::abs(v[i]);
           lmn = x < lmn ? x : lmn;
@@ -417,29 +436,35 @@ void guardFinite(const Lanes& L, std::size_t n, std::uint32_t* __restrict dead, 
 // max xyz, taken while the block is in cache, for Group::bounds. Every live position is
 // finite (guardFinite killed the others); a block of dead only gives an empty box.
 void liveBounds(const Lanes& L, std::size_t n, const std::uint32_t* __restrict dead, float* out) {
-  constexpr std::size_t W = kLanes16;  // (in vector registers: Floats16)
-  using F = Floats16;
-  using U = Words16;
-  using I = Ints16;
+  constexpr std::size_t W = kLanes16, N = kNativeFloats;
+  using F = Floats;
+  using U = Words;
+  using I = Ints;
   const F inf = F{} + kInfinity, ninf = F{} - kInfinity;
   for (int c = 0; c < 3; ++c) {
     const float* __restrict p = L.p[c];
-    F mn = inf, mx = ninf;
+    F mn[kParts], mx[kParts];
+    for (std::size_t q = 0; q < kParts; ++q) {
+      mn[q] = inf;
+      mx[q] = ninf;
+    }
     std::size_t i = 0;
     for (; i + W <= n; i += W) {
-      F x;
-      U d;
-      std::memcpy(&x, p + i, sizeof x);
-      std::memcpy(&d, dead + i, sizeof d);
-      const I live = d == 0u;
-      const F lo = live ? x : inf, hi = live ? x : ninf;
-      mn = lo < mn ? lo : mn;
-      mx = hi > mx ? hi : mx;
+      for (std::size_t q = 0; q < kParts; ++q) {
+        F x;
+        U d;
+        std::memcpy(&x, p + i + q * N, sizeof x);
+        std::memcpy(&d, dead + i + q * N, sizeof d);
+        const I live = d == 0u;
+        const F lo = live ? x : inf, hi = live ? x : ninf;
+        mn[q] = lo < mn[q] ? lo : mn[q];
+        mx[q] = hi > mx[q] ? hi : mx[q];
+      }
     }
     float lo = kInfinity, hi = -kInfinity;
     for (std::size_t j = 0; j < W; ++j, ++i) {
       // The remainder into the lanes it would have had, then the lanes together.
-      float a = mn[j], b = mx[j];
+      float a = mn[j / N][j % N], b = mx[j / N][j % N];
       if (i < n && dead[i] == 0u) {
         a = p[i] < a ? p[i] : a;
         b = p[i] > b ? p[i] : b;
