@@ -172,6 +172,35 @@ TEST(Emitter, LoopingPathWrapsToTheFirstKey) {
   }
 }
 
+// A step's births along a path are placed a segment at a time (newborns.cpp placeOnPath):
+// with many keys a step, births before the first key, after the last and around a loop,
+// every newborn sits exactly where Emitter::positionAt puts the emitter at its birth time.
+TEST(Emitter, PathBirthsManyKeysAStepSitWhereTheEmitterWas) {
+  for (bool loop : {false, true}) {
+    Emitter e;
+    Random rng(5, 0, 0, 0);
+    double t = 0.3;  // births from 1/rate on: the first ones before the first key
+    for (int k = 0; k < 200; ++k) {
+      t += 0.002 + 0.05 * rng.uniform();
+      e.path.push_back({t, Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * 10.0f});
+    }
+    e.pathLoop = loop;
+    e.rate = 997.0;  // ~33 births a step over several keys each step
+    ContextOptions o;
+    o.dt = 1.0 / 30.0;
+    Context ctx(o);
+    Group& g = ctx.createGroup("g", 20000);
+    g.addEmitter(e);
+    ctx.run(int(2.0 * t * 30.0));  // past the last key: held there, or looping
+    ASSERT_GT(g.size(), 1000u);
+    for (std::size_t i = 0; i < g.size(); ++i) {
+      const Particle p = g.particle(i);
+      const double born = double(p.id + 1) / e.rate;
+      ASSERT_EQ(p.position, e.positionAt(born)) << "born at " << born << " loop " << loop;
+    }
+  }
+}
+
 TEST(Emitter, CapacityOverflowIsCountedNotACrash) {
   Context ctx;
   Group& g = ctx.createGroup("g", 100);

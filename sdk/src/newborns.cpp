@@ -102,6 +102,34 @@ kernel::FlNewbornDraws newbornDraws(const Lanes& L, const Emitter& em, const Par
       n(L.charge, type.charge), n(L.up[0], type.up), n(L.rot[0], type.rotVelocity));
 }
 
+// Adds where a path emitter was at each birth time t[0..m) (nondecreasing) to p: one search
+// for each key's segment the births fall in, then the segment's births in one loop (the same
+// kernels/path.h interpolation pathPositionAt takes, so bitwise the same place). Births at or
+// before the first key, at or after the last, or wrapping around a loop go one by one.
+void placeOnPath(const Emitter& em, const double* t, std::size_t m, float* px, float* py,
+                 float* pz) {
+  const std::vector<Keyframe>& path = em.path;
+  std::size_t key = 0;  // the path's key the last birth found
+  for (std::size_t k = 0; k < m;) {
+    const Vec3 e = pathPositionAt(em, t[k], key);
+    px[k] += e.x;
+    py[k] += e.y;
+    pz[k] += e.z;
+    ++k;
+    if (key == 0 || key >= path.size()) continue;
+    const double ta = path[key - 1].time, tz = path[key].time, first = path.front().time;
+    const Vec3 a = path[key - 1].position, b = path[key].position;
+    std::size_t end = k;
+    while (end < m && t[end] >= ta && t[end] < tz && t[end] > first) ++end;
+    for (; k < end; ++k) {
+      const Vec3 q = kernel::fl_path_between(t[k], ta, a, tz, b);
+      px[k] += q.x;
+      py[k] += q.y;
+      pz[k] += q.z;
+    }
+  }
+}
+
 // Emitters with one particle type: every draw of a batch at once (see sampling.hpp).
 void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em, std::uint64_t q0,
                std::size_t i0, std::size_t m) {
@@ -114,7 +142,8 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
     float rows[kMaxDraws][kBatch];
     float attr[16][kBatch];
     float up[3][kBatch], rot[3][kBatch];
-    float age[kBatch];  // zeros
+    float age[kBatch];    // zeros
+    double time[kBatch];  // birth times
   };
   thread_local std::unique_ptr<Scratch> scratch;
   if (!scratch) scratch = std::make_unique<Scratch>();  // once per thread
@@ -171,16 +200,21 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
   float* const px = attr[3];
   float* const py = attr[4];
   float* const pz = attr[5];
-  std::size_t key = 0;  // the path's key the last birth found
+  double* const tb = sc.time;
+  for (std::size_t k = 0; k < m; ++k) tb[k] = birthTime(run, em, q0 + k);
   for (std::size_t k = 0; k < m; ++k) {
-    const double tb = birthTime(run, em, q0 + k);
-    nc.remaining[i0 + k] = nc.left(tb);
-    const Vec3 e = em.path.empty() ? em.position + em.velocity * float(tb - em.start)
-                                   : pathPositionAt(em, tb, key);
-    px[k] += e.x;
-    py[k] += e.y;
-    pz[k] += e.z;
+    nc.remaining[i0 + k] = nc.left(tb[k]);
     age[k] = 0.0f;
+  }
+  if (em.path.empty()) {
+    for (std::size_t k = 0; k < m; ++k) {
+      const float s = float(tb[k] - em.start);
+      px[k] += em.position.x + em.velocity.x * s;
+      py[k] += em.position.y + em.velocity.y * s;
+      pz[k] += em.position.z + em.velocity.z * s;
+    }
+  } else {
+    placeOnPath(em, tb, m, px, py, pz);
   }
   // Into the batch's slots (consecutive), one lane at a time.
   const std::size_t first = nc.slot(i0);
