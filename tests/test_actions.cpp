@@ -4,13 +4,37 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdlib>
 #include <random>
+#include <string>
 
 #include "culling_scene.hpp"
 #include "flurry/flurry.hpp"
 
 using namespace flurry;
 using flurry::test::cullingScene;
+
+// The CPU backend runs the widest build the CPU has (run natively, and under qemu as a CPU
+// without AVX and one without AVX-512: tests/isa); FLURRY_ISA may pick a narrower one.
+TEST(Dispatch, PicksTheWidestInstructionSetTheCpuHas) {
+  const std::string isa = cpuInstructionSet();
+#if defined(__x86_64__) && defined(__GNUC__)
+  __builtin_cpu_init();
+  const bool has512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+                      __builtin_cpu_supports("avx512vl");
+  const bool has2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  if (std::getenv("FLURRY_ISA") == nullptr) {
+    EXPECT_EQ(isa, has512 ? "avx512" : has2 ? "avx2" : "baseline");
+  }
+  if (isa == "avx512") {
+    EXPECT_TRUE(has512);
+  }
+  if (isa == "avx2") {
+    EXPECT_TRUE(has2);
+  }
+#endif
+  EXPECT_TRUE(isa == "avx512" || isa == "avx2" || isa == "baseline") << isa;
+}
 
 namespace {
 ContextOptions opts(double dt = 0.01, unsigned threads = 1) {

@@ -286,7 +286,8 @@ class ClassicReporter : public benchmark::ConsoleReporter {
     std::printf(
         "\nSummary (medians; M particle-steps/s of the whole step, %% of the read-modify-write\n"
         "bandwidth on as many threads, and the step's split emit/act/compact in %% of its "
-        "time):\n");
+        "time), CPU backend's %s build:\n",
+        cpuInstructionSet());
     for (const auto& [rmwKey, bps] : rmw_)
       std::printf("  read-modify-write, lanes/threads %s: %.1f GB/s\n", rmwKey.c_str(), bps / 1e9);
     for (const auto& [fn, byKey] : rows_) {

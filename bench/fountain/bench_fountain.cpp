@@ -275,8 +275,9 @@ class RatioReporter : public benchmark::ConsoleReporter {
   void Finalize() override {
     ConsoleReporter::Finalize();
     std::printf(
-        "\nSummary (%u threads; GB/s count the bytes of the attributes read and written):\n",
-        threads());
+        "\nSummary (%u threads, CPU backend's %s build; GB/s count the bytes of the attributes "
+        "read and written):\n",
+        threads(), cpuInstructionSet());
     for (const char* n : {"1048576", "4194304"}) {
       const std::string N = n;
       const double rmw = bytes_["ReadModifyWrite/" + N];

@@ -334,9 +334,9 @@ class SummaryReporter : public benchmark::ConsoleReporter {
   void Finalize() override {
     ConsoleReporter::Finalize();
     std::printf(
-        "\nSummary (%u threads; OpenCL = PoCL on this CPU; GB/s count the bytes of the "
-        "attributes read and written):\n",
-        threads());
+        "\nSummary (%u threads, CPU backend's %s build; OpenCL = PoCL on this CPU; GB/s count "
+        "the bytes of the attributes read and written):\n",
+        threads(), cpuInstructionSet());
     for (const char* n : {"1048576", "4194304"}) {
       const std::string N = n;
       const double rmw = bytes_["ReadModifyWrite/" + N];

@@ -280,7 +280,7 @@ class RatioReporter : public benchmark::ConsoleReporter {
   }
   void Finalize() override {
     ConsoleReporter::Finalize();
-    std::printf("\nSummary (medians of this run):\n");
+    std::printf("\nSummary (medians of this run, CPU backend's %s build):\n", cpuInstructionSet());
     for (const auto& [name, ms] : ms_) {
       if (name.rfind("Instances/", 0) != 0) continue;
       const std::string args = name.substr(10);

@@ -24,6 +24,10 @@ const char* versionString() {
   return "0.1.0";
 }
 
+const char* cpuInstructionSet() {
+  return detail::fusedPassIsa();
+}
+
 struct Context::Impl {
   ContextOptions options;
   detail::PassOptions pass;

@@ -41,10 +41,15 @@ Impl pick() {
   (void)want;
   return baseline::actFusedImpl;
 }
+// Picked once per process: what fusedPassIsa() says is what runs.
+Impl chosen() {
+  static const Impl impl = pick();
+  return impl;
+}
 }  // namespace
 
 const char* fusedPassIsa() {
-  const Impl impl = pick();
+  const Impl impl = chosen();
 #ifdef FLURRY_HAS_ISA_VARIANTS
   if (impl == avx512::actFusedImpl) return "avx512";
   if (impl == avx2::actFusedImpl) return "avx2";
@@ -54,7 +59,7 @@ const char* fusedPassIsa() {
 }
 
 void actFused(GroupImpl& g, const StepParams& sp) {
-  static const Impl impl = pick();
+  static const Impl impl = chosen();
   impl(g, sp);
 }
 
@@ -63,7 +68,7 @@ void writeNewborns(GroupImpl& g, const StepParams& sp, const BirthRun* runs,
   using Write = decltype(&baseline::writeNewborns);
   // The same instruction set as the fused pass.
   static const Write write = [] {
-    const Impl impl = pick();
+    const Impl impl = chosen();
 #ifdef FLURRY_HAS_ISA_VARIANTS
     if (impl == avx512::actFusedImpl) return &avx512::writeNewborns;
     if (impl == avx2::actFusedImpl) return &avx2::writeNewborns;
