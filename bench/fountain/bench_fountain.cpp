@@ -9,8 +9,8 @@
 //
 // Deflectors culled (1M particles on a floor in 32 pieces against 2):
 //
-//   build/release/bench/bench_fountain --benchmark_filter='Deflectors|ReadModifyWrite6' \
-//       --benchmark_repetitions=5
+//   build/release/bench/bench_fountain --benchmark_filter='Deflectors|ReadModifyWrite6'
+//       --benchmark_repetitions=5   (one command)
 //
 // Idle groups (100 groups of which 10 are alive, against the 10 alone):
 //
