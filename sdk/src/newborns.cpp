@@ -102,10 +102,11 @@ kernel::FlNewbornDraws newbornDraws(const Lanes& L, const Emitter& em, const Par
       n(L.charge, type.charge), n(L.up[0], type.up), n(L.rot[0], type.rotVelocity));
 }
 
-// Adds where a path emitter was at each birth time t[0..m) (nondecreasing) to p: one search
-// for each key's segment the births fall in, then the segment's births in one loop (the same
-// kernels/path.h interpolation pathPositionAt takes, so bitwise the same place). Births at or
-// before the first key, at or after the last, or wrapping around a loop go one by one.
+// Adds where a path emitter was at each birth time t[0..m) to p: a search for the key's
+// segment of a birth, then the births after it inside that segment in one loop (the same
+// kernels/path.h interpolation pathPositionAt takes, so bitwise the same place). A step's
+// births come in increasing time, so a segment's are consecutive; births at or before the
+// first key, at or after the last, or wrapping around a loop go one by one.
 void placeOnPath(const Emitter& em, const double* t, std::size_t m, float* px, float* py,
                  float* pz) {
   const std::vector<Keyframe>& path = em.path;
@@ -208,10 +209,10 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
   }
   if (em.path.empty()) {
     for (std::size_t k = 0; k < m; ++k) {
-      const float s = float(tb[k] - em.start);
-      px[k] += em.position.x + em.velocity.x * s;
-      py[k] += em.position.y + em.velocity.y * s;
-      pz[k] += em.position.z + em.velocity.z * s;
+      const Vec3 e = kernel::fl_path_linear(em.position, em.velocity, em.start, tb[k]);
+      px[k] += e.x;
+      py[k] += e.y;
+      pz[k] += e.z;
     }
   } else {
     placeOnPath(em, tb, m, px, py, pz);
