@@ -87,6 +87,7 @@ for _ in range(n):
 view = time.perf_counter() - t
 overhead = max(loop - one, 0.0) / n + view / n
 
+print(f"CPU backend      the {flurry.cpu_instruction_set()} build")
 print(f"particles        {len(group)} (capacity {group.capacity}), lowest y {lowest:.4f}")
 print(f"runs             C++ {[round(t, 3) for t in cpp_runs]}, Python {[round(t, 3) for t in py_runs]}")
 print(f"C++    {args.frames} steps in {cpp:.3f} s  ({cpp / args.frames * 1e3:.2f} ms/step)")

@@ -30,6 +30,7 @@ from ._flurry import (  # noqa: F401
     RenderError,
     __version__,
     builtin_effects,
+    cpu_instruction_set,
     load,
     has_render,
     has_vdb,
@@ -38,7 +39,8 @@ from . import _flurry
 
 __all__ = [
     "Context", "Effect", "EffectError", "EffectInstance", "Error", "Group", "GroupStats", "InvalidArgument",
-    "IoError", "RenderError", "action", "actions", "builtin_effects", "domain", "domains",
+    "IoError", "RenderError", "action", "actions", "builtin_effects", "cpu_instruction_set",
+    "domain", "domains",
     "effect", "emitter", "gather", "group", "load", "simulate",
 ]
 if has_vdb:

@@ -735,6 +735,10 @@ NB_MODULE(_flurry, m) {
         return out;
       },
       "Names of the built-in effects.");
+  m.def(
+      "cpu_instruction_set", [] { return std::string(flurry::cpuInstructionSet()); },
+      "The build the CPU backend runs here: 'avx512', 'avx2' or 'baseline' (SSE2), the widest "
+      "the CPU has (FLURRY_ISA picks a narrower one).");
 
 #ifdef FLURRY_PY_VDB
   m.attr("has_vdb") = true;

@@ -17,6 +17,10 @@ def fountain(**kw) -> flurry.Context:
     return flurry.simulate(flurry.load("fountain"), threads=1, **kw)
 
 
+def test_cpu_instruction_set_names_a_build():
+    assert flurry.cpu_instruction_set() in ("avx512", "avx2", "baseline")
+
+
 # --- zero copy -------------------------------------------------------------------------------
 
 def test_views_are_the_group_storage_and_see_the_next_step():
