@@ -24,7 +24,7 @@ FL_INLINE float fl_falloff_weight(FlFalloffParams f, float px, float py, float p
 
 /* The fraction of the way an exponential approach at `rate` covers in dt: never above 1. */
 FL_INLINE float fl_approach(float rate, float dt) {
-  return 1.0f - exp(-rate * dt);
+  return 1.0f - fl_expf(-rate * dt);
 }
 
 /* MatchVelocity and MatchRotVelocity: the mean of a field (fx, fy, fz) over the particles of
@@ -160,7 +160,7 @@ FL_INLINE void fl_explosion_step(float cx, float cy, float cz, float magnitude, 
   const float r = sqrt(dx * dx + dy * dy + dz * dz);
   if (!(r > 0.0f)) return;
   const float delta = r - front;
-  const float mag = magnitude * exp(-delta * delta * inv2s2) / (r * r + eps);
+  const float mag = magnitude * fl_expf(-delta * delta * inv2s2) / (r * r + eps);
   fl_add_scaled(dx, dy, dz, mag / r * dt, vx, vy, vz);
 }
 
@@ -172,7 +172,7 @@ FL_INLINE void fl_explosion_accel(float cx, float cy, float cz, float magnitude,
   const float r = sqrt(dx * dx + dy * dy + dz * dz);
   if (!(r > 0.0f)) return;
   const float delta = r - front;
-  const float s = magnitude * exp(-delta * delta / twoS2) / (r * r + eps) / r;
+  const float s = magnitude * fl_expf(-delta * delta / twoS2) / (r * r + eps) / r;
   *ax += dx * s;
   *ay += dy * s;
   *az += dz * s;
@@ -183,9 +183,9 @@ FL_INLINE void fl_explosion_accel(float cx, float cy, float cz, float magnitude,
 /* Damping with a falloff weight w: each component decays at its rate for dt. */
 FL_INLINE void fl_damping_step(float rx, float ry, float rz, float dt, float w, float* vx,
                                float* vy, float* vz) {
-  *vx = *vx * exp(-rx * dt * w);
-  *vy = *vy * exp(-ry * dt * w);
-  *vz = *vz * exp(-rz * dt * w);
+  *vx = *vx * fl_expf(-rx * dt * w);
+  *vy = *vy * fl_expf(-ry * dt * w);
+  *vz = *vz * fl_expf(-rz * dt * w);
 }
 
 FL_INLINE void fl_damping_accel(float rx, float ry, float rz, float w, float vx, float vy, float vz,
@@ -385,16 +385,19 @@ FL_INLINE void fl_curve_lookup(const FL_GLOBAL float* keys, uint count, uint str
 
 /* ---- Each force from its record (params.h), as both backends call it ---------------------- */
 
-/* exp(-rate dt): the maker's value (std::exp) for the step length it made the record for, so
+/* exp(-rate dt): the maker's value (fl_expf) for the step length it made the record for, so
  * that both backends use the same bits; computed for any other length (a newborn's rest of its
- * step, a sub-step on the device). */
+ * step, a sub-step on the device). Computed before the choice, which then is a select: a loop
+ * over newborns vectorises (GCC kept a branch where the exp was conditional). */
 FL_INLINE float fl_force_decay(float rate, float dt, float madeDt, float made) {
-  return dt == madeDt ? made : exp(-rate * dt);
+  const float e = fl_expf(-rate * dt);
+  return dt == madeDt ? made : e;
 }
 
 /* fl_approach, with the maker's exp for the step length it made the record for. */
 FL_INLINE float fl_force_approach(float rate, float dt, float madeDt, float made) {
-  return dt == madeDt ? 1.0f - made : fl_approach(rate, dt);
+  const float k = fl_approach(rate, dt); /* (before the choice, as in fl_force_decay) */
+  return dt == madeDt ? 1.0f - made : k;
 }
 
 /* Gravity: v + a dt; with a falloff v + a (dt w). */
@@ -654,7 +657,7 @@ FL_INLINE void fl_pull(FlPullParams q, float dx, float dy, float dz, float* ox, 
 /* MatchVelocity and MatchRotVelocity: how far towards the neighbours' mean over dt (the
  * maker's approach for the step length it made the record for). */
 FL_INLINE float fl_match_k(FlMatchParams m, float dt) {
-  return dt == m.dt ? m.approach : 1.0f - exp(-m.rate * dt);
+  return dt == m.dt ? m.approach : 1.0f - fl_expf(-m.rate * dt);
 }
 
 /* Avoid: the change of speed away from an obstacle at distance dist over dt. */

@@ -41,7 +41,7 @@ FL_INLINE void fl_rk4_finish(float sp, float sv, float dt, float* p, float* v) {
 FL_INLINE void fl_exact_step(float g, float k, float h, float* p, float* v) {
   const float v0 = *v;
   if (k > 0.0f) {
-    const float e = exp(-k * h), term = g / k;
+    const float e = fl_expf(-k * h), term = g / k;
     *p += term * h + (v0 - term) * (1.0f - e) / k;
     *v = term + (v0 - term) * e;
   } else {

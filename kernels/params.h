@@ -100,7 +100,7 @@ typedef struct FlBirthRun {
 /* ---- Each action's constants, by name --------------------------------------------------
  * Made on the host by one maker for both backends (actionParams, sdk/src/action_params.hpp)
  * and read by the action's kernel function (forces.h, deflect.h, ...), which the CPU's pass
- * and the device's act kernel both call. A `decay` is exp(-rate * dt) made with std::exp for
+ * and the device's act kernel both call. A `decay` is exp(-rate * dt) made with fl_expf for
  * the record's `dt`, so both backends multiply by the same bits; a step of another length (a
  * newborn's rest of its step, a sub-step on the device) makes its own. */
 

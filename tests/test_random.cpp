@@ -112,6 +112,33 @@ TEST(Random, BoxMullersCosIsWithin3e7OnEveryUniform) {
   EXPECT_LT(worst, 3e-7);  // as kernels/domain.h says
 }
 
+// The kernels' exp (kernels/math.h: decays of a newborn's own step, falloffs, a blast front)
+// against double precision on every 61st float whose exp is a normal float, and at the ends.
+TEST(Random, KernelsExpIsWithinAnUlp) {
+  namespace k = flurry::detail::kernel;
+  double worst = 0.0;
+  for (std::uint32_t b = 0; b < 0xffffffc0u; b += 61) {
+    const float x = std::bit_cast<float>(b);
+    if (!(x >= -87.3f && x <= 88.7f)) continue;  // e^x a normal float
+    const double u = ulps(k::fl_expf(x), std::exp(double(x)));
+    if (u > worst) worst = u;
+    ASSERT_LT(u, 1.0) << x;
+  }
+  EXPECT_GT(worst, 0.5);              // (the loop saw floats rounded: it ran)
+  EXPECT_EQ(k::fl_expf(0.0f), 1.0f);  // a rate of 0 keeps a velocity exactly
+  EXPECT_EQ(k::fl_expf(-0.0f), 1.0f);
+  // Below the normal range: within a step of the subnormals' spacing, then 0.
+  for (float x = -87.4f; x > -103.9f; x -= 0.37f)
+    EXPECT_NEAR(double(k::fl_expf(x)), std::exp(double(x)), 1.5e-45) << x;
+  EXPECT_EQ(k::fl_expf(-104.0f), 0.0f);
+  EXPECT_EQ(k::fl_expf(-1e30f), 0.0f);
+  EXPECT_EQ(k::fl_expf(-INFINITY), 0.0f);
+  EXPECT_EQ(k::fl_expf(89.0f), INFINITY);
+  EXPECT_EQ(k::fl_expf(INFINITY), INFINITY);
+  EXPECT_TRUE(std::isnan(k::fl_expf(NAN)));
+  EXPECT_LT(ulps(k::fl_expf(88.72f), std::exp(double(88.72f))), 1.0);  // (n = 128: two factors)
+}
+
 TEST(Random, NormalIsTheKernelsBoxMuller) {
   flurry::Random a(9, 1, 2, 3), b(9, 1, 2, 3);
   for (int i = 0; i < 1000; ++i) {

@@ -10,6 +10,7 @@
 #include "flurry/actions.hpp"
 #include "flurry/error.hpp"
 #include "flurry/field.hpp"
+#include "kernel_compat.hpp"
 
 namespace flurry {
 
@@ -217,8 +218,9 @@ cl::FlActionParams actionParams(const Action& act, float dt) {
   const auto xyz = [](Vec3 v) { return cl::FlXyz{v.x, v.y, v.z}; };
   cl::FlActionParams p{};
   auto& own = p.own;
-  // exp(-rate·dt) for the step length the record is made for (fl_force_decay).
-  auto decay = [&](float rate) { return std::exp(-rate * dt); };
+  // exp(-rate·dt) for the step length the record is made for (fl_force_decay): the kernels'
+  // own exp, so that a step of another length (a newborn's) is the same function of its dt.
+  auto decay = [&](float rate) { return kernel::fl_expf(-rate * dt); };
   auto falloff = [&](const Falloff& f) {
     p.falloff = {f.center.x, f.center.y, f.center.z, f.radius, f.power};
   };

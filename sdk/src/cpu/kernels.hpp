@@ -213,10 +213,30 @@ inline void apply(const Gravity&, const Lanes& L, std::size_t n, const BlockCont
 inline void dampLanes(const cl::FlDampingParams& d, float* const* lane, std::size_t n,
                       const BlockContext& c) {
   if (c.ownDt) {
-    float* __restrict x = lane[0];
-    float* __restrict y = lane[1];
-    float* __restrict z = lane[2];
-    for (std::size_t i = 0; i < n; ++i) kernel::fl_damping(d, c.ownDt[i], &x[i], &y[i], &z[i]);
+    // fl_damping per newborn, in loops the vectoriser takes (its exp is float arithmetic;
+    // the record's fields are read before the loops, which would otherwise keep a branch).
+    const float* __restrict own = c.ownDt;
+    if (d.rate.y == d.rate.x && d.rate.z == d.rate.x) {  // (fl_damping_factors' one exp)
+      float* __restrict x = lane[0];
+      float* __restrict y = lane[1];
+      float* __restrict z = lane[2];
+      const float rate = d.rate.x, madeDt = d.dt, made = d.decay.x;
+      for (std::size_t i = 0; i < n; ++i) {
+        const float f = kernel::fl_force_decay(rate, own[i], madeDt, made);
+        x[i] *= f;
+        y[i] *= f;
+        z[i] *= f;
+      }
+      return;
+    }
+    const float rate[3] = {d.rate.x, d.rate.y, d.rate.z};
+    const float made[3] = {d.decay.x, d.decay.y, d.decay.z};
+    const float madeDt = d.dt;
+    for (int k = 0; k < 3; ++k) {
+      float* __restrict v = lane[k];
+      const float r = rate[k], m = made[k];
+      for (std::size_t i = 0; i < n; ++i) v[i] *= kernel::fl_force_decay(r, own[i], madeDt, m);
+    }
     return;
   }
   float fx, fy, fz;

@@ -4,8 +4,8 @@
 //
 // Products with dt are made on the device (dt there is the sub-step's): a host-made product
 // would be wrong under sub-steps. Exponentials of -rate·dt are the exception: the host packs
-// std::exp's value together with the dt it was made for, and the device uses it when its dt
-// is that one (bit for bit the CPU's) and its own exp otherwise.
+// fl_expf's value (kernels/math.h) together with the dt it was made for, and the device uses
+// it when its dt is that one and computes the same function otherwise (bit for bit the CPU's).
 #include <cmath>
 #include <string>
 
