@@ -48,7 +48,7 @@ FL_INLINE float3 fl_sample_u(__global const float* v, uint kind, const float* u)
                                 u[1], u[2]);
       return fl_cone_surface_at(a, fl_v3(v + 3), fl_v3(v + 6), fl_v3(v + 9), v[12], u[0], u[2]);
     case FL_DOMAIN_BLOB:
-      return fl_blob_at(a, v[3], u[0], u[1], u[2], u[3], u[4], u[5]);
+      return fl_blob_at(a, v[3], u[0], u[1], u[2], u[3]);
     default: /* point, plane: the point itself */
       return a;
   }

@@ -115,12 +115,21 @@ FL_INLINE float fl_cbrt_nonneg(float x) {
   return x > 0.0f ? y : 0.0f;
 }
 
-/* A standard normal from two uniforms in [0, 1) by Box-Muller (Random::normal() calls it):
- * its log and cos are the ones above, so both backends give the same bits. */
-FL_INLINE float fl_normal_from(float ua, float ub) {
+/* Two independent standard normals from two uniforms in [0, 1) by Box-Muller, r cos and
+ * r sin: its log and cos are the ones above, so both backends give the same bits. */
+FL_INLINE void fl_normal_pair(float ua, float ub, float* n0, float* n1) {
   float s, c;
   fl_sincos_2pi(ub, &s, &c);
-  return sqrt(-2.0f * fl_logf(1.0f - ua)) * c;
+  const float r = sqrt(-2.0f * fl_logf(1.0f - ua));
+  *n0 = r * c;
+  *n1 = r * s;
+}
+
+/* One standard normal from two uniforms (Random::normal() calls it): the pair's first. */
+FL_INLINE float fl_normal_from(float ua, float ub) {
+  float n0, n1;
+  fl_normal_pair(ua, ub, &n0, &n1);
+  return n0;
 }
 
 /* A fuzzy value (flurry::Fuzzy) from its draws: uniform in center +- spread from one uniform,
@@ -149,7 +158,7 @@ FL_INLINE uint fl_draw_count(uint kind) {
     case FL_DOMAIN_MESH:
       return 3;
     case FL_DOMAIN_BLOB:
-      return 6;
+      return 4;
     default: /* point, plane (the point itself), union */
       return 0;
   }
@@ -230,10 +239,12 @@ FL_INLINE float3 fl_cone_surface_at(float3 apex, float3 axis, float3 e1, float3 
   return fl_cone_point(apex, axis, e1, e2, t, t * ro, u2);
 }
 
-FL_INLINE float3 fl_blob_at(float3 c, float sd, float u0, float u1, float u2, float u3, float u4,
-                            float u5) {
-  return make_float3(c.x + sd * fl_normal_from(u0, u1), c.y + sd * fl_normal_from(u2, u3),
-                     c.z + sd * fl_normal_from(u4, u5));
+/* A blob's point: three normals from four uniforms (both of one Box-Muller pair, the first of
+ * another), each an independent standard normal. */
+FL_INLINE float3 fl_blob_at(float3 c, float sd, float u0, float u1, float u2, float u3) {
+  float nx, ny;
+  fl_normal_pair(u0, u1, &nx, &ny);
+  return make_float3(c.x + sd * nx, c.y + sd * ny, c.z + sd * fl_normal_from(u2, u3));
 }
 
 /* ---- Crossing a planar piece's plane (Sink's Hit, Avoid) ----------------------------------- */

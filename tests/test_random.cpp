@@ -165,8 +165,7 @@ TEST(Random, NormalBatchesAreTheScalarBoxMullerBitForBit) {
   const flurry::Fuzzy f(2.0f, 0.25f, flurry::Fuzzy::Distribution::Normal);
   flurry::detail::sampleBatch(f, rows, n, g.data());
   for (std::size_t i = 0; i < n; ++i) {
-    const flurry::Vec3 p =
-        k::fl_blob_at(c, 0.5f, u[0][i], u[1][i], u[2][i], u[3][i], u[4][i], u[5][i]);
+    const flurry::Vec3 p = k::fl_blob_at(c, 0.5f, u[0][i], u[1][i], u[2][i], u[3][i]);
     ASSERT_EQ(std::bit_cast<std::uint32_t>(x[i]), std::bit_cast<std::uint32_t>(p.x)) << i;
     ASSERT_EQ(std::bit_cast<std::uint32_t>(y[i]), std::bit_cast<std::uint32_t>(p.y)) << i;
     ASSERT_EQ(std::bit_cast<std::uint32_t>(z[i]), std::bit_cast<std::uint32_t>(p.z)) << i;

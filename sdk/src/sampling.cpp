@@ -83,10 +83,9 @@ FL_LOOP void cone(C u0, C u1, C u2, F x, F y, F z, std::size_t n, Vec3 apex, Vec
 }
 
 // Box-Muller in float arithmetic alone (kernels/math.h): no libm call, so this vectorises.
-FL_LOOP void blob(C u0, C u1, C u2, C u3, C u4, C u5, F x, F y, F z, std::size_t n, Vec3 c,
-                  float sd) {
+FL_LOOP void blob(C u0, C u1, C u2, C u3, F x, F y, F z, std::size_t n, Vec3 c, float sd) {
   for (std::size_t i = 0; i < n; ++i)
-    store(x, y, z, i, k::fl_blob_at(c, sd, u0[i], u1[i], u2[i], u3[i], u4[i], u5[i]));
+    store(x, y, z, i, k::fl_blob_at(c, sd, u0[i], u1[i], u2[i], u3[i]));
 }
 
 FL_LOOP void normal(C u0, C u1, F out, std::size_t n, float center, float spread) {
@@ -184,7 +183,7 @@ void sampleBatch(const Domain& d, const float* const* u, std::size_t n, float* x
             sampleBatch(un.parts[k], rest, 1, x + i, y + i, z + i);
           }
         } else if constexpr (std::is_same_v<S, BlobDomain>) {
-          blob(u[0], u[1], u[2], u[3], u[4], u[5], x, y, z, n, s.center, s.stddev);
+          blob(u[0], u[1], u[2], u[3], x, y, z, n, s.center, s.stddev);
         }
       },
       d.shape());
