@@ -1,10 +1,14 @@
 // Force fields and the other per-particle actions against their expected behaviour.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <vector>
 
 #include "flurry/flurry.hpp"
+#include "forces_kernel.hpp"  // fl_curve_lookup: the device's walk, on the CPU
 #include "noise.hpp"
 
 using namespace flurry;
@@ -305,6 +309,75 @@ TEST(OverLife, CurvesMultiplyTheBirthColorAndSizeByDefault) {
   EXPECT_NEAR(h.particle(0).color.g, 0.5f, 1e-6f);
   EXPECT_NEAR(h.particle(0).color.r, 0.0f, 1e-6f);
   EXPECT_NEAR(h.particle(0).size, 1.0f, 1e-6f);
+}
+
+// The CPU evaluates a curve of a few keys a segment at a time over many particles; the device
+// walks the keys per particle (kernels/forces.h fl_curve_lookup). Both give the same bits: at
+// the keys, between them, before the first and past the last, on two keys at one time, for a
+// particle without a lifetime, with one key, and for a curve long enough to be walked.
+TEST(OverLife, CurvesGiveTheKernelsValuesBitForBit) {
+  using ColorKeys = std::vector<ColorOverLife::Key>;
+  using SizeKeys = std::vector<SizeOverLife::Key>;
+  std::vector<std::pair<ColorKeys, SizeKeys>> curves = {
+      {{{0.1f, Vec4(1, 0, 0, 1)},
+        {0.3f, Vec4(0, 1, 0, 0.5f)},
+        {0.3f, Vec4(0, 0, 1, 0.25f)},  // a jump: two keys at one time
+        {0.65f, Vec4(0.2f, 0.7f, 0.1f, 0.9f)},
+        {0.9f, Vec4(0.5f, 0.5f, 0.5f, 0.0f)}},
+       {{0.1f, 1.0f}, {0.3f, 3.0f}, {0.3f, 0.5f}, {0.9f, 2.0f}}},
+      {{{0.4f, Vec4(0.3f, 0.6f, 0.9f, 1.0f)}}, {{0.4f, 7.0f}}},  // one key
+  };
+  {
+    ColorKeys longColor;  // past kMostSegmentedKeys: walked per particle
+    SizeKeys longSize;
+    for (int k = 0; k < 12; ++k) {
+      const float t = float(k) / 11.0f, w = float(k % 3) / 2.0f;
+      longColor.push_back({t, Vec4(w, 1.0f - w, t, 1.0f - t)});
+      longSize.push_back({t, 1.0f + w});
+    }
+    curves.push_back({longColor, longSize});
+  }
+  for (const OverLifeMode mode : {OverLifeMode::Replace, OverLifeMode::Multiply}) {
+    for (const auto& [colorKeys, sizeKeys] : curves) {
+      Context ctx = makeContext(0.25);
+      Group& g = ctx.createGroup("g", 2000);
+      g.setActions({ColorOverLife{colorKeys, mode}, SizeOverLife{sizeKeys, mode}});
+      // Ages that land on every key, between them, outside them; some without a lifetime.
+      std::vector<Particle> added;
+      for (int i = 0; i < 1500; ++i) {
+        Particle p = at(Vec3(0));
+        p.lifetime = i % 97 == 0 ? 0.0f : 2.0f;
+        p.age =
+            i < 1200 ? 2.0f * float(i) / 1100.0f - 0.1f : 2.0f * colorKeys[i % colorKeys.size()].t;
+        p.color = Vec4(0.5f + 0.001f * float(i % 200), 0.25f, 1.0f, 0.75f);
+        p.size = 1.0f + 0.01f * float(i % 50);
+        g.add(p);
+        added.push_back(p);
+      }
+      ctx.step();  // (no Move: the ages stay as added)
+      ASSERT_EQ(g.size(), added.size());
+      for (std::size_t i = 0; i < added.size(); ++i) {
+        const Particle& p = added[i];
+        const Particle q = g.particle(i);
+        ASSERT_EQ(q.age, p.age);
+        const float t = detail::kernel::fl_life_fraction(p.age, p.lifetime);
+        float col[4], size[1];
+        detail::kernel::fl_curve_lookup(reinterpret_cast<const float*>(colorKeys.data()),
+                                        unsigned(colorKeys.size()), 5u, t, col);
+        detail::kernel::fl_curve_lookup(reinterpret_cast<const float*>(sizeKeys.data()),
+                                        unsigned(sizeKeys.size()), 2u, t, size);
+        const bool multiply = mode == OverLifeMode::Multiply;
+        for (int d = 0; d < 4; ++d) {
+          const float want = multiply ? p.color[d] * col[d] : col[d];
+          ASSERT_EQ(std::bit_cast<std::uint32_t>(q.color[d]), std::bit_cast<std::uint32_t>(want))
+              << "particle " << i << " channel " << d << " t " << t << " keys " << colorKeys.size();
+        }
+        const float want = multiply ? p.size * size[0] : size[0];
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(q.size), std::bit_cast<std::uint32_t>(want))
+            << "particle " << i << " t " << t << " keys " << sizeKeys.size();
+      }
+    }
+  }
 }
 
 TEST(RandomActions, DrawFromTheirDomainsReproducibly) {

@@ -460,22 +460,90 @@ inline const float* keyFloats(const std::vector<Key>& keys) {
 inline float lifeFraction(const Lanes& L, std::size_t i) {
   return kernel::fl_life_fraction(L.age[i], L.lifetime[i]);
 }
+
+// Curves of up to this many keys are evaluated a segment at a time over a chunk of particles
+// (curveLanes); longer ones walk their keys per particle (fl_curve_lookup).
+constexpr std::uint32_t kMostSegmentedKeys = 8;
+
+// A curve of `count` keys (its t, then C values) at each of n particles' life fractions,
+// into out[0..C): fl_curve_lookup's values bit for bit, in loops the vectoriser takes. Its walk
+// over the keys per particle is a branch per key; here each particle's segment is found by one
+// compare per key, and each segment's values are then taken for all and kept where they
+// belong (a select). Curves have a few keys: that is a few passes over a chunk in cache.
+template <int C>
+inline void curveLanes(const float* keys, std::uint32_t count, const float* __restrict age,
+                       const float* __restrict life, std::size_t n, float* const* out) {
+  constexpr std::uint32_t stride = C + 1;
+  constexpr std::size_t kChunk = 256;
+  alignas(64) float t[kChunk];
+  alignas(64) std::uint32_t seg[kChunk];  // fl_curve_lookup's hi: 0 before, count past the last
+  const float first = keys[0];
+  for (std::size_t c0 = 0; c0 < n; c0 += kChunk) {
+    const std::size_t m = std::min(kChunk, n - c0);
+    for (std::size_t i = 0; i < m; ++i) t[i] = kernel::fl_life_fraction(age[c0 + i], life[c0 + i]);
+    for (std::size_t i = 0; i < m; ++i) seg[i] = t[i] <= first ? 0u : count;
+    for (std::uint32_t k = count - 1; k >= 1; --k) {  // downwards: the first key at or past t
+      const float tk = keys[k * stride];
+      for (std::size_t i = 0; i < m; ++i) seg[i] = seg[i] != 0u && t[i] <= tk ? k : seg[i];
+    }
+    for (int c = 0; c < C; ++c) {
+      float* __restrict o = out[c] + c0;
+      const float before = keys[1 + c], after = keys[(count - 1) * stride + 1 + c];
+      for (std::size_t i = 0; i < m; ++i) o[i] = seg[i] == 0u ? before : after;
+    }
+    for (std::uint32_t k = 1; k < count; ++k) {
+      const float* k0 = keys + (k - 1) * stride;
+      const float* k1 = keys + k * stride;
+      float v0[C], d[C];
+      for (int c = 0; c < C; ++c) v0[c] = k0[1 + c], d[c] = k1[1 + c] - k0[1 + c];
+      const float t0 = k0[0], t1 = k1[0];
+      for (int c = 0; c < C; ++c) {
+        float* __restrict o = out[c] + c0;
+        for (std::size_t i = 0; i < m; ++i) {
+          const float v = v0[c] + d[c] * kernel::fl_key_weight(t0, t1, t[i]);
+          o[i] = seg[i] == k ? v : o[i];
+        }
+      }
+    }
+  }
+}
+
 // Multiply scales the birth value (stored by emission), Replace sets the curve's value.
 inline void apply(const ColorOverLife& a, const Lanes& L, std::size_t n, const BlockContext&) {
   const bool multiply = a.mode == OverLifeMode::Multiply;
+  const auto count = kernel::uint(a.keys.size());
+  if (count <= kMostSegmentedKeys) {
+    curveLanes<4>(keyFloats(a.keys), count, L.age, L.lifetime, n, L.color);
+    if (multiply)
+      for (int d = 0; d < 4; ++d) {
+        float* __restrict col = L.color[d];
+        const float* __restrict birth = L.birthColor[d];
+        for (std::size_t i = 0; i < n; ++i) col[i] = birth[i] * col[i];
+      }
+    return;
+  }
   for (std::size_t i = 0; i < n; ++i) {
     float col[4];
-    kernel::fl_curve_lookup(keyFloats(a.keys), kernel::uint(a.keys.size()), 5u, lifeFraction(L, i),
-                            col);
+    kernel::fl_curve_lookup(keyFloats(a.keys), count, 5u, lifeFraction(L, i), col);
     for (int d = 0; d < 4; ++d) L.color[d][i] = multiply ? L.birthColor[d][i] * col[d] : col[d];
   }
 }
 inline void apply(const SizeOverLife& a, const Lanes& L, std::size_t n, const BlockContext&) {
   const bool multiply = a.mode == OverLifeMode::Multiply;
+  const auto count = kernel::uint(a.keys.size());
+  if (count <= kMostSegmentedKeys) {
+    float* const out[1] = {L.size};
+    curveLanes<1>(keyFloats(a.keys), count, L.age, L.lifetime, n, out);
+    if (multiply) {
+      float* __restrict size = L.size;
+      const float* __restrict birth = L.birthSize;
+      for (std::size_t i = 0; i < n; ++i) size[i] = birth[i] * size[i];
+    }
+    return;
+  }
   for (std::size_t i = 0; i < n; ++i) {
     float s[1];
-    kernel::fl_curve_lookup(keyFloats(a.keys), kernel::uint(a.keys.size()), 2u, lifeFraction(L, i),
-                            s);
+    kernel::fl_curve_lookup(keyFloats(a.keys), count, 2u, lifeFraction(L, i), s);
     L.size[i] = multiply ? L.birthSize[i] * s[0] : s[0];
   }
 }
