@@ -181,15 +181,14 @@ void Deflectors(benchmark::State& state) {
       double(g.stats().blockActionsCulled - culled) / double(state.iterations());
 }
 
-// The galaxy sample (samples/effects/galaxy.json: arms, a softened orbit, a vortex) with a
-// million stars: every emitter's rate and bursts scaled so that about `stars` live at once
-// (a rate times its mean lifetime), the renderer's attributes stored. One whole
+// A built-in sample with its emitters' rates scaled so that about `stars` particles live at
+// once (a rate times its mean lifetime), the renderer's attributes stored. One whole
 // Context::step() of the effect's dt, on all threads: the frame a game has for it.
-void GalaxyStars(benchmark::State& state) {
+void scaledSample(benchmark::State& state, const char* name) {
   const double stars = double(state.range(0));
-  const samples::Sample* sample = samples::findSample("galaxy");
+  const samples::Sample* sample = samples::findSample(name);
   if (!sample || !sample->effect) {
-    state.SkipWithError("the galaxy sample did not load");
+    state.SkipWithError((std::string("the sample ") + name + " did not load").c_str());
     return;
   }
   const Effect& base = *sample->effect;
@@ -227,6 +226,18 @@ void GalaxyStars(benchmark::State& state) {
   state.counters["live"] = live;
   state.counters["dt_ms"] = base.dt * 1e3;
   state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(live));
+}
+
+// The galaxy sample (samples/effects/galaxy.json: arms, a softened orbit, a vortex) with a
+// million stars.
+void GalaxyStars(benchmark::State& state) {
+  scaledSample(state, "galaxy");
+}
+
+// The campfire sample (flames, smoke and sparks: Turbulence, ColorOverLife and SizeOverLife in
+// each group) with a million particles: what curves over life and curl noise cost.
+void CampfireMillion(benchmark::State& state) {
+  scaledSample(state, "campfire");
 }
 
 // The ceiling for it: the six lanes it reads and writes.
@@ -379,6 +390,7 @@ BENCHMARK(Deflectors)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(GalaxyStars)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(CampfireMillion)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(IdleGroups)
     ->ArgNames({"groups", "alive"})
     ->Args({10, 10})

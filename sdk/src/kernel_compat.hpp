@@ -20,7 +20,13 @@
 #define FL_GLOBAL  // the device's __global: one address space here
 #endif
 #ifndef FL_UNROLL
-#define FL_UNROLL  // the device's unroll pragma (GCC is left to decide)
+// The device's unroll pragma: a short loop of constant count unrolled whole (the noise's eight
+// corners: a loop over particles around it then vectorises).
+#if defined(__clang__)
+#define FL_UNROLL _Pragma("unroll")
+#else
+#define FL_UNROLL _Pragma("GCC unroll 16")
+#endif
 #endif
 
 namespace flurry::detail {
