@@ -13,7 +13,7 @@ FL_INLINE float fl_clampf(float v, float lo, float hi) { /* std::clamp's rule */
   return v < lo ? lo : hi < v ? hi : v;
 }
 
-/* e^x in float arithmetic alone, within 2 ulp (tests/test_random.cpp checks it against double
+/* e^x in float arithmetic alone, within an ulp (tests/test_random.cpp checks it against double
  * precision): the decays and approaches of a newborn's own step length, a falloff's, a blast
  * front's. libm's expf is a call per particle the vectoriser cannot take, and the device's exp
  * rounds its last bit its own way; this is a handful of multiplies and adds on either, with
