@@ -9,6 +9,7 @@
 /* Every helper is forced inline: PoCL made a kernel ~11x slower when Philox was left as a
  * call. */
 #define FL_INLINE inline __attribute__((always_inline))
+#define FL_MATH_INLINE FL_INLINE
 #define make_float3(x, y, z) ((float3)((x), (y), (z)))
 /* A pointer into a buffer the host wrote (a group's lanes, its start-of-step snapshot). */
 #define FL_GLOBAL __global

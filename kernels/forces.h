@@ -14,12 +14,15 @@
 #define FLURRY_KERNELS_FORCES_H
 
 /* A force's falloff (its record's FlFalloffParams): (1 - r/radius)^power inside the radius
- * around (cx, cy, cz), 0 outside, 1 everywhere for an infinite radius. */
+ * around (cx, cy, cz), 0 outside, 1 everywhere for an infinite radius. Every term is taken
+ * before the choices (a loop over particles vectorises; the CPU's loops fold the unit power
+ * and the infinite radius away, cpu/kernels.hpp withFalloff). */
 FL_INLINE float fl_falloff_weight(FlFalloffParams f, float px, float py, float pz) {
-  if (!(f.radius < INFINITY)) return 1.0f;
   const float dx = px - f.cx, dy = py - f.cy, dz = pz - f.cz;
   const float t = fl_maxf(0.0f, 1.0f - sqrt(dx * dx + dy * dy + dz * dz) / f.radius);
-  return f.power == 1.0f ? t : pow(t, f.power);
+  const float faded = fl_powf(t, f.power);
+  const float w = f.power == 1.0f ? t : faded;
+  return f.radius < INFINITY ? w : 1.0f;
 }
 
 /* The fraction of the way an exponential approach at `rate` covers in dt: never above 1. */
@@ -110,10 +113,14 @@ FL_INLINE int fl_vortex_field(FlVortex v, float px, float py, float pz, float* u
   const float d = wx * v.kx + wy * v.ky + wz * v.kz;
   const float rx = wx - v.kx * d, ry = wy - v.ky * d, rz = wz - v.kz * d;
   const float r = sqrt(rx * rx + ry * ry + rz * rz);
-  /* On the axis there is no radial direction: no swirl, no inflow (finite, not NaN). */
-  const float hx = r > 0.0f ? rx / r : 0.0f, hy = r > 0.0f ? ry / r : 0.0f,
-              hz = r > 0.0f ? rz / r : 0.0f;
-  const float around = r < v.core ? v.around * r / v.core : v.around * pow(v.core / r, v.tightness);
+  /* On the axis there is no radial direction: no swirl, no inflow (finite, not NaN; the
+   * offset there is below 1e-22, its square lost). One choice, of the divisor: GCC vectorises
+   * the loop only with few choices of r (three on the unit vector were one too many). */
+  const float safe = r > 0.0f ? r : 1.0f;
+  const float hx = rx / safe, hy = ry / safe, hz = rz / safe;
+  /* (Both sides taken before the choice: a loop over particles vectorises.) */
+  const float outside = v.around * fl_powf(v.core / r, v.tightness);
+  const float around = r < v.core ? v.around * r / v.core : outside;
   *ux = (v.ky * hz - hy * v.kz) * around - hx * v.in + v.kx * v.up;
   *uy = (v.kz * hx - hz * v.kx) * around - hy * v.in + v.ky * v.up;
   *uz = (v.kx * hy - hx * v.ky) * around - hz * v.in + v.kz * v.up;

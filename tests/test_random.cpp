@@ -139,6 +139,48 @@ TEST(Random, KernelsExpIsWithinAnUlp) {
   EXPECT_LT(ulps(k::fl_expf(88.72f), std::exp(double(88.72f))), 1.0);  // (n = 128: two factors)
 }
 
+// fl_powf (kernels/math.h): a falloff's fade and a vortex's swirl, on both backends.
+TEST(Random, KernelsPowIsWithinTwoUlps) {
+  namespace k = flurry::detail::kernel;
+  const float powers[] = {0.001f, 0.25f, 0.5f, 0.8f, 1.0f, 1.5f, 2.0f,
+                          2.5f,   3.0f,  4.0f, 7.3f, 10.f, 31.7f};
+  double worst = 0.0;
+  std::size_t checked = 0;
+  for (const float y : powers) {
+    // Every 997th float in (0, 1] (a falloff's and a vortex's bases), every 9973rd above.
+    for (std::uint32_t b = 1; b < 0x7f000000u; b += b < 0x3f800000u ? 997 : 9973) {
+      const float x = std::bit_cast<float>(b);
+      const double exact = std::pow(double(x), double(y));
+      if (!(exact >= 1.17549435e-38 && exact < 3.4e38)) continue;  // a normal float
+      const double u = ulps(k::fl_powf(x, y), exact);
+      worst = std::max(worst, u);
+      ++checked;
+      ASSERT_LT(u, 2.0) << x << "^" << y;
+    }
+  }
+  EXPECT_GT(checked, std::size_t(8'000'000));
+  EXPECT_GT(worst, 0.5);  // (the loop saw results rounded: it ran)
+  // A large exponent keeps y·log2 x's fraction (log2 x in two floats): a few ulp at 100.
+  for (float x = 0.05f; x < 1.0f; x += 0.0137f)
+    EXPECT_LT(ulps(k::fl_powf(x, 100.0f), std::pow(double(x), 100.0)), 3.0) << x;
+  // Below the normal range: within a step of the subnormals' spacing, then 0.
+  for (float x = 1e-3f; x > 1e-6f; x *= 0.83f)
+    EXPECT_NEAR(double(k::fl_powf(x, 13.5f)), std::pow(double(x), 13.5), 1.5e-45) << x;
+  EXPECT_EQ(k::fl_powf(0.5f, 1e20f), 0.0f);
+  EXPECT_EQ(k::fl_powf(2.0f, 1e20f), INFINITY);
+  // C's pow at the special values.
+  EXPECT_EQ(k::fl_powf(0.0f, 0.0f), 1.0f);
+  EXPECT_EQ(k::fl_powf(0.0f, 2.0f), 0.0f);
+  EXPECT_EQ(k::fl_powf(1.0f, 7.0f), 1.0f);
+  EXPECT_EQ(k::fl_powf(1.0f, 1e20f), 1.0f);
+  EXPECT_EQ(k::fl_powf(INFINITY, 2.0f), INFINITY);
+  EXPECT_EQ(k::fl_powf(NAN, 0.0f), 1.0f);
+  EXPECT_TRUE(std::isnan(k::fl_powf(NAN, 2.0f)));
+  EXPECT_EQ(k::fl_powf(1e-45f, 0.0f), 1.0f);
+  EXPECT_EQ(k::fl_powf(0.25f, 0.5f), 0.5f);  // exact where the result is a float
+  EXPECT_EQ(k::fl_powf(0.5f, 3.0f), 0.125f);
+}
+
 TEST(Random, NormalIsTheKernelsBoxMuller) {
   flurry::Random a(9, 1, 2, 3), b(9, 1, 2, 3);
   for (int i = 0; i < 1000; ++i) {

@@ -16,6 +16,12 @@
 #ifndef FL_INLINE
 #define FL_INLINE inline
 #endif
+#ifndef FL_MATH_INLINE
+// The elementary functions (fl_expf, fl_powf) always inline, as on the device: GCC left
+// fl_powf out of line where a loop called several kernel functions, a call per particle that
+// kept the loop scalar. (Every kernel function forced inline lost more loops than it won.)
+#define FL_MATH_INLINE inline __attribute__((always_inline))
+#endif
 #ifndef FL_GLOBAL
 #define FL_GLOBAL  // the device's __global: one address space here
 #endif
