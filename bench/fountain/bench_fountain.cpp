@@ -240,6 +240,92 @@ void CampfireMillion(benchmark::State& state) {
   scaledSample(state, "campfire");
 }
 
+// One force alone (then Move) over 1M immortal particles spread through a box 8 m wide: what
+// each costs a particle-step against the read-modify-write of the position and velocity it
+// reads and writes (ReadModifyWrite6, the summary's "of RMW"). Where an action ran a scalar
+// loop, this is where it shows.
+ActionList forceAlone(const std::string& name) {
+  Falloff fade;
+  fade.center = Vec3(0.0f, 4.0f, 0.0f);
+  fade.radius = 5.0f;
+  fade.power = name.find("Power2.5") != std::string::npos ? 2.5f : 1.0f;
+  if (name.rfind("Gravity", 0) == 0) {
+    Gravity g{Vec3(0.0f, -9.81f, 0.0f)};
+    if (name != "Gravity") g.falloff = fade;
+    return {g, Move{}};
+  }
+  if (name.rfind("Damping", 0) == 0) {
+    Damping d{Vec3(0.3f)};
+    d.falloff = fade;
+    return {d, Move{}};
+  }
+  if (name == "Vortex") {
+    Vortex v;
+    v.center = Vec3(0.0f, 4.0f, 0.0f);
+    v.aroundSpeed = 3.0f;
+    v.coreRadius = 1.0f;
+    v.tightness = 0.8f;
+    v.inSpeed = 0.5f;
+    return {v, Move{}};
+  }
+  if (name == "Explosion") {
+    Explosion e;
+    e.center = Vec3(0.0f, 4.0f, 0.0f);
+    e.speed = 0.01f;  // (its front stays among the particles)
+    return {e, Move{}};
+  }
+  if (name == "Turbulence") return {Turbulence{}, Move{}};
+  if (name == "ElectricField") {
+    ElectricField e;
+    e.field = Vec3(0.0f, 1.0f, 0.5f);
+    e.falloff = fade;
+    return {e, Move{}};
+  }
+  if (name == "OrbitPoint") return {OrbitPoint{}, Move{}};
+  if (name == "Jet") {
+    Jet j;
+    j.center = Vec3(0.0f, 4.0f, 0.0f);
+    j.radius = 3.0f;
+    return {j, Move{}};
+  }
+  if (name == "Avoid") {
+    Avoid a;
+    a.obstacle = Domain::sphere(Vec3(0.0f, 4.0f, 0.0f), 2.0f);
+    return {a, Move{}};
+  }
+  return {};
+}
+
+void Forces(benchmark::State& state, const char* name) {
+  const auto n = std::size_t(state.range(0));
+  ContextOptions o;
+  o.threads = threads();
+  o.dt = 1.0 / 60.0;
+  Context ctx(o);
+  Group& g = ctx.createGroup("particles", n);
+  Emitter e;
+  e.shape = Domain::box(Vec3(-4.0f, 0.0f, -4.0f), Vec3(4.0f, 8.0f, 4.0f));
+  ParticleType t;
+  t.velocity = Domain::sphere(Vec3(0.0f), 0.5f);
+  t.lifetime = 1e30f;
+  t.charge = Fuzzy(1.0f, 0.5f);
+  e.types = {t};
+  e.bursts = {{0.0, std::uint32_t(n), 0.0, 1}};
+  g.addEmitter(e);
+  const ActionList actions = forceAlone(name);
+  if (actions.actions().empty()) {
+    state.SkipWithError((std::string("no force named ") + name).c_str());
+    return;
+  }
+  g.setActions(actions);
+  ctx.step();  // emits all n
+  for (auto _ : state) ctx.step();
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(n));
+  // Position and velocity read and written (the charge and mass an electric field reads too).
+  const double bytes = std::string(name) == "ElectricField" ? 56.0 : 48.0;
+  state.SetBytesProcessed(std::int64_t(double(state.iterations()) * double(n) * bytes));
+}
+
 // The ceiling for it: the six lanes it reads and writes.
 void ReadModifyWrite6(benchmark::State& state) {
   flurry::bench::readModifyWrite(state, 6, threads());
@@ -333,6 +419,20 @@ class RatioReporter : public benchmark::ConsoleReporter {
             rmw / 1e9, bytes_["Deflectors/deflectors:32/cull:1"] / 1e9,
             bytes_["Deflectors/deflectors:2/cull:1"] / 1e9);
     }
+    const double rmw6 = bytes_["ReadModifyWrite6/1048576"];
+    bool forcesTitle = false;
+    for (const auto& [name, rate] : bytes_) {
+      if (name.rfind("Forces/", 0) != 0 || rmw6 <= 0) continue;
+      if (!forcesTitle)
+        std::printf(
+            "  one force and Move over 1M particles, against the read-modify-write of "
+            "their 6 lanes (%.1f GB/s):\n",
+            rmw6 / 1e9);
+      forcesTitle = true;
+      std::printf("    %-32s %6.1f M particle-steps/s = %3.0f %% of it\n",
+                  name.substr(7, name.find('/', 7) - 7).c_str(), items_[name] / 1e6,
+                  100 * rate / rmw6);
+    }
     const double galaxy = ms_["GalaxyStars/1000000"];
     if (galaxy > 0 && galaxyDt_ > 0)
       std::printf(
@@ -389,6 +489,19 @@ BENCHMARK(Deflectors)
     ->Args({32, 0})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+#define FLURRY_FORCE(F) \
+  BENCHMARK_CAPTURE(Forces, F, #F)->Arg(1 << 20)->Unit(benchmark::kMillisecond)->UseRealTime();
+FLURRY_FORCE(Gravity)
+FLURRY_FORCE(GravityFalloff)
+FLURRY_FORCE(GravityFalloffPower2 .5)
+FLURRY_FORCE(DampingFalloffPower2 .5)
+FLURRY_FORCE(Vortex)
+FLURRY_FORCE(Explosion)
+FLURRY_FORCE(Turbulence)
+FLURRY_FORCE(ElectricField)
+FLURRY_FORCE(OrbitPoint)
+FLURRY_FORCE(Jet)
+FLURRY_FORCE(Avoid)
 BENCHMARK(GalaxyStars)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(CampfireMillion)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(IdleGroups)

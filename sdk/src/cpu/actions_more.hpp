@@ -212,18 +212,52 @@ inline void apply(const Gravitate&, const Lanes& L, std::size_t n, const BlockCo
   }
 }
 
+// fl_vortex, bit for bit, with its approach factor apart from the field: once for a block's
+// step, each newborn's in a loop of its own. (Taken inside the loop over the field, the
+// factor's exp, even of the same step for all, kept that loop scalar.)
 inline void apply(const Vortex&, const Lanes& L, std::size_t n, const BlockContext& c) {
   const cl::FlVortexParams v = c.record().own.vortex;
-  for (std::size_t i = 0; i < n; ++i)
-    onLocals(L.v, i, [&](float* x, float* y, float* z) {
-      kernel::fl_vortex(v, c.dtAt(i), L.p[0][i], L.p[1][i], L.p[2][i], x, y, z);
-    });
+  const kernel::FlVortex field = kernel::fl_vortex_of(v);
+  auto run = [&](std::size_t first, std::size_t m, auto factor) {
+    velocityLoop(L.p[0] + first, L.p[1] + first, L.p[2] + first, L.v[0] + first, L.v[1] + first,
+                 L.v[2] + first, m, UniformDt{0.0f},
+                 [field, factor](std::size_t i, float px, float py, float pz, float, float* x,
+                                 float* y, float* z) {
+                   kernel::fl_vortex_step(field, factor[i], px, py, pz, x, y, z);
+                 });
+  };
+  if (!c.ownDt) {
+    run(0, n, UniformDt{kernel::fl_force_approach(v.responsiveness, c.dt, v.dt, v.decay)});
+    return;
+  }
+  constexpr std::size_t kChunk = 256;
+  alignas(64) float factor[kChunk];
+  const float rate = v.responsiveness, madeDt = v.dt, made = v.decay;
+  for (std::size_t first = 0; first < n; first += kChunk) {
+    const std::size_t m = std::min(kChunk, n - first);
+    const float* __restrict own = c.ownDt + first;
+    for (std::size_t i = 0; i < m; ++i)
+      factor[i] = kernel::fl_force_approach(rate, own[i], madeDt, made);
+    run(first, m, OwnDt{factor});
+  }
 }
 
 inline void apply(const Jet& a, const Lanes& L, std::size_t n, const BlockContext& c) {
   const cl::FlJetParams jet = c.record().own.jet;
   const bool constant = std::holds_alternative<PointDomain>(a.acceleration.shape());
   const Vec3 fixed = constant ? std::get<PointDomain>(a.acceleration.shape()).p : Vec3(0.0f);
+  if (constant) {  // the same sums, kept by a choice: a vector loop
+    velocityLoop(
+        L, n, c,
+        [jet, fixed](float px, float py, float pz, float dt, float* x, float* y, float* z) {
+          const int in = kernel::fl_jet_reaches(jet, px, py, pz);
+          const float nx = *x + fixed.x * dt, ny = *y + fixed.y * dt, nz = *z + fixed.z * dt;
+          *x = in ? nx : *x;
+          *y = in ? ny : *y;
+          *z = in ? nz : *z;
+        });
+    return;
+  }
   for (std::size_t i = 0; i < n; ++i) {
     if (!kernel::fl_jet_reaches(jet, L.p[0][i], L.p[1][i], L.p[2][i])) continue;
     Vec3 acc = fixed;
@@ -238,10 +272,14 @@ inline void apply(const Jet& a, const Lanes& L, std::size_t n, const BlockContex
 inline void apply(const Explosion&, const Lanes& L, std::size_t n, const BlockContext& c) {
   const cl::FlExplosionParams e = c.record().own.explosion;
   if (c.time + 0.5 * c.dt < e.time) return;  // (fl_explosion's test, once for the block)
-  for (std::size_t i = 0; i < n; ++i)
-    onLocals(L.v, i, [&](float* x, float* y, float* z) {
-      kernel::fl_explosion(e, c.dt, c.time, L.p[0][i], L.p[1][i], L.p[2][i], x, y, z);
-    });
+  // The blast over the whole (sub-)step for every particle, a newborn too: its front is at
+  // mid-step (as the device's).
+  const float dt = c.dt;
+  const double time = c.time;
+  velocityLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, UniformDt{dt},
+               [e, dt, time](float px, float py, float pz, float, float* x, float* y, float* z) {
+                 kernel::fl_explosion(e, dt, time, px, py, pz, x, y, z);
+               });
 }
 
 // The accelerations are drawn for a batch of particles at once (Philox vectorised, the
@@ -252,15 +290,17 @@ inline void apply(const RandomAccel& a, const Lanes& L, std::size_t n, const Blo
   sampleFromActionStreams(a.acceleration, L, n, c,
                           [&](std::size_t first, std::size_t m, float* ax, float* ay, float* az) {
                             if (weighted) {  // v + a·(dt·w), as without a falloff (w = 1)
-                              for (std::size_t k = 0; k < m; ++k) {
-                                const std::size_t i = first + k;
-                                const float s =
-                                    c.dtAt(i) * kernel::fl_falloff_weight(falloff, L.p[0][i],
-                                                                          L.p[1][i], L.p[2][i]);
-                                ax[k] *= s;
-                                ay[k] *= s;
-                                az[k] *= s;
-                              }
+                              withFalloff(falloff, [&](auto fall) {
+                                for (std::size_t k = 0; k < m; ++k) {
+                                  const std::size_t i = first + k;
+                                  const float s =
+                                      c.dtAt(i) * kernel::fl_falloff_weight(fall(), L.p[0][i],
+                                                                            L.p[1][i], L.p[2][i]);
+                                  ax[k] *= s;
+                                  ay[k] *= s;
+                                  az[k] *= s;
+                                }
+                              });
                               addVaryingLoop(L.v[0] + first, L.v[1] + first, L.v[2] + first, ax, ay,
                                              az, m, UniformDt{1.0f});
                               return;
@@ -328,24 +368,33 @@ inline void apply(const Turbulence&, const Lanes& L, std::size_t n, const BlockC
       scale *= 0.5f;
       freq *= 2.0f;
     }
-    for (std::size_t i = 0; i < m; ++i)
-      onLocals(L.v, c0 + i, [&](float* x, float* y, float* z) {
-        const float w = kernel::fl_falloff_weight(f, px[i], py[i], pz[i]);
-        kernel::fl_add_scaled(curl[0][i] * t.amplitude, curl[1][i] * t.amplitude,
-                              curl[2][i] * t.amplitude, c.dtAt(c0 + i) * w, x, y, z);
+    withFalloff(f, [&](auto fall) {
+      withDt(c, [&](auto dt) {
+        velocityLoop(px, py, pz, L.v[0] + c0, L.v[1] + c0, L.v[2] + c0, m,
+                     OffsetDt<decltype(dt)>{dt, c0},
+                     [&](std::size_t i, float x0, float y0, float z0, float dti, float* x, float* y,
+                         float* z) {
+                       const float w = kernel::fl_falloff_weight(fall(), x0, y0, z0);
+                       kernel::fl_add_scaled(curl[0][i] * t.amplitude, curl[1][i] * t.amplitude,
+                                             curl[2][i] * t.amplitude, dti * w, x, y, z);
+                     });
       });
+    });
   }
 }
 
 inline void apply(const ElectricField&, const Lanes& L, std::size_t n, const BlockContext& c) {
   const cl::FlActionParams& r = c.record();
   const cl::FlElectricParams e = r.own.electric;
-  const cl::FlFalloffParams f = r.falloff;
-  for (std::size_t i = 0; i < n; ++i)
-    onLocals(L.v, i, [&](float* x, float* y, float* z) {
-      kernel::fl_electric(e, f, c.dtAt(i), L.p[0][i], L.p[1][i], L.p[2][i], x, y, z, L.charge[i],
-                          L.mass[i]);
-    });
+  const float* __restrict charge = L.charge;
+  const float* __restrict mass = L.mass;
+  withFalloff(r.falloff, [&](auto fall) {
+    velocityLoop(L, n, c,
+                 [e, fall, charge, mass](std::size_t i, float px, float py, float pz, float dt,
+                                         float* x, float* y, float* z) {
+                   kernel::fl_electric(e, fall(), dt, px, py, pz, x, y, z, charge[i], mass[i]);
+                 });
+  });
 }
 
 inline void apply(const MagneticField&, const Lanes& L, std::size_t n, const BlockContext& c) {

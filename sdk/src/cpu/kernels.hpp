@@ -170,14 +170,20 @@ inline void sinkLoop(const Shape& shape, const float* __restrict px, const float
 
 // A force's update of each particle's velocity from its position, f(px, py, pz, dt, &vx, &vy,
 // &vz) (a shared kernel function with the force's record bound): through locals and
-// __restrict parameters, so that a branch-free f vectorises.
+// __restrict parameters, so that a branch-free f vectorises; flattened, so that GCC's
+// inlining budget, spent on the pass around it, leaves no kernel function a call in the loop.
 template <class Dt, class F>
-inline void velocityLoop(const float* __restrict px, const float* __restrict py,
-                         const float* __restrict pz, float* __restrict vx, float* __restrict vy,
-                         float* __restrict vz, std::size_t n, Dt dt, F f) {
+[[gnu::flatten]] inline void velocityLoop(const float* __restrict px, const float* __restrict py,
+                                          const float* __restrict pz, float* __restrict vx,
+                                          float* __restrict vy, float* __restrict vz, std::size_t n,
+                                          Dt dt, F f) {
   for (std::size_t i = 0; i < n; ++i) {
     float x = vx[i], y = vy[i], z = vz[i];
-    f(px[i], py[i], pz[i], dt[i], &x, &y, &z);
+    if constexpr (std::is_invocable_v<F, std::size_t, float, float, float, float, float*, float*,
+                                      float*>)
+      f(i, px[i], py[i], pz[i], dt[i], &x, &y, &z);  // (one that reads other lanes at i)
+    else
+      f(px[i], py[i], pz[i], dt[i], &x, &y, &z);
     vx[i] = x, vy[i] = y, vz[i] = z;
   }
 }
@@ -187,15 +193,39 @@ inline void velocityLoop(const Lanes& L, std::size_t n, const BlockContext& c, F
          [&](auto dt) { velocityLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, dt, f); });
 }
 
+// Calls body(fall), fall() giving the falloff record f as a loop over particles reads it. Where
+// its radius is infinite or its power 1 (the usual cases), those fields are constants there,
+// so that fl_falloff_weight's choices fold and the loop takes no fl_powf (for an infinite
+// radius, no distance) only to throw it away: the same weights.
+template <class Body>
+inline void withFalloff(const cl::FlFalloffParams& f, Body body) {
+  if (!(f.radius < kInfinity)) {
+    body([f] {
+      cl::FlFalloffParams u = f;
+      u.radius = kInfinity;
+      return u;
+    });
+  } else if (f.power == 1.0f) {
+    body([f] {
+      cl::FlFalloffParams u = f;
+      u.power = 1.0f;
+      return u;
+    });
+  } else {
+    body([f] { return f; });
+  }
+}
+
 inline void apply(const Gravity&, const Lanes& L, std::size_t n, const BlockContext& c) {
   const cl::FlActionParams& r = c.record();
   const cl::FlGravityParams g = r.own.gravity;
   if (r.falloff.radius < kInfinity) {
-    const cl::FlFalloffParams f = r.falloff;
-    velocityLoop(L, n, c,
-                 [g, f](float px, float py, float pz, float dt, float* x, float* y, float* z) {
-                   kernel::fl_gravity_falloff(g, f, dt, px, py, pz, x, y, z);
-                 });
+    withFalloff(r.falloff, [&](auto fall) {
+      velocityLoop(L, n, c,
+                   [g, fall](float px, float py, float pz, float dt, float* x, float* y, float* z) {
+                     kernel::fl_gravity_falloff(g, fall(), dt, px, py, pz, x, y, z);
+                   });
+    });
     return;
   }
   if (!c.ownDt) {  // fl_gravity with a·dt made once for the block
@@ -248,12 +278,12 @@ inline void apply(const Damping&, const Lanes& L, std::size_t n, const BlockCont
   const cl::FlActionParams& r = c.record();
   const cl::FlDampingParams d = r.own.damping;
   if (r.falloff.radius < kInfinity) {
-    const cl::FlFalloffParams f = r.falloff;
-    for (std::size_t i = 0; i < n; ++i) {
-      float x = L.v[0][i], y = L.v[1][i], z = L.v[2][i];
-      kernel::fl_damping_falloff(d, f, c.dtAt(i), L.p[0][i], L.p[1][i], L.p[2][i], &x, &y, &z);
-      L.v[0][i] = x, L.v[1][i] = y, L.v[2][i] = z;
-    }
+    withFalloff(r.falloff, [&](auto fall) {
+      velocityLoop(L, n, c,
+                   [d, fall](float px, float py, float pz, float dt, float* x, float* y, float* z) {
+                     kernel::fl_damping_falloff(d, fall(), dt, px, py, pz, x, y, z);
+                   });
+    });
     return;
   }
   dampLanes(d, L.v, n, c);
