@@ -108,6 +108,20 @@ inline void addVaryingLoop(float* __restrict vx, float* __restrict vy, float* __
 
 // ---- Absorbers, blockers -----------------------------------------------------------------
 
+// Avoid's threat: outside the shape now, inside at the look-ahead point p + v·look.
+template <class Shape>
+inline void threatLoop(const Shape& shape, const float* __restrict px, const float* __restrict py,
+                       const float* __restrict pz, const float* __restrict vx,
+                       const float* __restrict vy, const float* __restrict vz,
+                       std::uint8_t* __restrict threat, std::size_t n, float look) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const int now = detail::inside(shape, Vec3(px[i], py[i], pz[i]));
+    const int next = detail::inside(
+        shape, Vec3(px[i] + vx[i] * look, py[i] + vy[i] * look, pz[i] + vz[i] * look));
+    threat[i] = std::uint8_t((now == 0) & (next != 0));
+  }
+}
+
 template <class Shape, class Dt>
 inline void sinkMotionLoop(const Shape& shape, const float* __restrict px,
                            const float* __restrict py, const float* __restrict pz,
@@ -425,22 +439,15 @@ inline void apply(const SampledField& a, const Lanes& L, std::size_t n, const Bl
   }
 }
 
+// A closed obstacle threatens a particle outside it whose look-ahead point lies inside: that
+// test (the same containment as Domain::contains) runs over a chunk of particles in vectors,
+// and only the few it finds take the push, one by one. A planar obstacle tests each particle's
+// crossing one by one.
 inline void apply(const Avoid& a, const Lanes& L, std::size_t n, const BlockContext& c) {
   const cl::FlAvoidParams avoid = c.record().own.avoid;
   const bool planar = a.obstacle.isPlanar();
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 p = at(L.p, i), v = at(L.v, i);
-    const Vec3 ahead = p + v * avoid.lookAhead;
-    bool threat;
-    if (planar) {
-      Vec3 h;
-      threat =
-          kernel::fl_path_crosses(p, ahead, a.obstacle.closestPoint(p), a.obstacle.normal(p), &h) &&
-          a.obstacle.distance(h) < 1e-4f * (1.0f + glm::length(p));
-    } else {
-      threat = !a.obstacle.contains(p) && a.obstacle.contains(ahead);
-    }
-    if (!threat) continue;
+  auto push = [&](std::size_t i) {
+    const Vec3 p = at(L.p, i);
     const float dist = a.obstacle.distance(p);
     Vec3 away = a.obstacle.normal(p);
     if (planar && glm::dot(p - a.obstacle.closestPoint(p), away) < 0.0f) away = -away;
@@ -448,7 +455,33 @@ inline void apply(const Avoid& a, const Lanes& L, std::size_t n, const BlockCont
       kernel::fl_add_scaled(away.x, away.y, away.z, kernel::fl_avoid_step(avoid, dist, c.dtAt(i)),
                             x, y, z);
     });
+  };
+  if (planar) {
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3 p = at(L.p, i), v = at(L.v, i);
+      const Vec3 ahead = p + v * avoid.lookAhead;
+      Vec3 h;
+      if (kernel::fl_path_crosses(p, ahead, a.obstacle.closestPoint(p), a.obstacle.normal(p), &h) &&
+          a.obstacle.distance(h) < 1e-4f * (1.0f + glm::length(p)))
+        push(i);
+    }
+    return;
   }
+  std::visit(
+      [&](const auto& shape) {
+        constexpr std::size_t kChunk = 256;
+        alignas(64) std::uint8_t threat[kChunk];
+        const float look = avoid.lookAhead;
+        for (std::size_t first = 0; first < n; first += kChunk) {
+          const std::size_t m = std::min(kChunk, n - first);
+          threatLoop(shape, L.p[0] + first, L.p[1] + first, L.p[2] + first, L.v[0] + first,
+                     L.v[1] + first, L.v[2] + first, threat, m, look);
+          for (std::size_t i = 0; i < m; ++i)
+            if (threat[i]) [[unlikely]]
+              push(first + i);
+        }
+      },
+      a.obstacle.shape());
 }
 
 inline void apply(const Follow&, const Lanes& L, std::size_t n, const BlockContext& c) {
