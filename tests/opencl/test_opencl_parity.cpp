@@ -375,6 +375,14 @@ TEST(OpenCLParity, WhichActionsAreBitwise) {
     faded.falloff.radius = 3.0f;
     faded.falloff.power = 2.5f;
     check("Gravity, falloff power 2.5", ActionList{faded, Move{}, KillOld{}});
+    // A drawn jet in reach of every particle (the CPU draws a block's in batches) and of few
+    // (one by one).
+    for (const float radius : {100.0f, 0.4f}) {
+      Jet jet = bitwiseCase<Jet>();
+      jet.radius = radius;
+      check(radius > 1.0f ? "Jet, every particle in reach" : "Jet, few in reach",
+            ActionList{jet, Move{}, KillOld{}});
+    }
   }
   desc::forEachAction([&](auto tag) {
     using A = typename decltype(tag)::type;

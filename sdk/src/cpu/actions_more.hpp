@@ -272,6 +272,38 @@ inline void apply(const Jet& a, const Lanes& L, std::size_t n, const BlockContex
         });
     return;
   }
+  // A drawn acceleration: where many of the block's particles are in reach, every particle's
+  // is drawn in batches (the same numbers as one Random each) and kept by a choice; where few
+  // are, theirs are drawn one by one.
+  std::size_t reached = 0;
+  {
+    const float* __restrict px = L.p[0];
+    const float* __restrict py = L.p[1];
+    const float* __restrict pz = L.p[2];
+    for (std::size_t i = 0; i < n; ++i)
+      reached += std::size_t(kernel::fl_jet_reaches(jet, px[i], py[i], pz[i]));
+  }
+  if (reached == 0) return;
+  if (reached * 8 >= n) {
+    sampleFromActionStreams(
+        a.acceleration, L, n, c,
+        [&](std::size_t first, std::size_t m, float* ax, float* ay, float* az) {
+          withDt(c, [&](auto dt) {
+            velocityLoop(L.p[0] + first, L.p[1] + first, L.p[2] + first, L.v[0] + first,
+                         L.v[1] + first, L.v[2] + first, m, OffsetDt<decltype(dt)>{dt, first},
+                         [jet, ax, ay, az](std::size_t k, float px, float py, float pz, float h,
+                                           float* x, float* y, float* z) {
+                           const int in = kernel::fl_jet_reaches(jet, px, py, pz);
+                           const float nx = *x + ax[k] * h, ny = *y + ay[k] * h,
+                                       nz = *z + az[k] * h;
+                           *x = in ? nx : *x;
+                           *y = in ? ny : *y;
+                           *z = in ? nz : *z;
+                         });
+          });
+        });
+    return;
+  }
   for (std::size_t i = 0; i < n; ++i) {
     if (!kernel::fl_jet_reaches(jet, L.p[0][i], L.p[1][i], L.p[2][i])) continue;
     Vec3 acc = fixed;
