@@ -286,10 +286,14 @@ ActionList forceAlone(const std::string& name) {
     return {e, Move{}};
   }
   if (name == "OrbitPoint") return {OrbitPoint{}, Move{}};
-  if (name == "Jet") {
+  if (name.rfind("Jet", 0) == 0) {
     Jet j;
     j.center = Vec3(0.0f, 4.0f, 0.0f);
     j.radius = 3.0f;
+    if (name == "JetDrawn") {  // random kicks over most of the box, which stays full
+      j.radius = 6.0f;
+      j.acceleration = Domain::box(Vec3(-6.0f), Vec3(6.0f));
+    }
     return {j, Move{}};
   }
   if (name == "Avoid") {
@@ -505,6 +509,7 @@ FLURRY_FORCE(Turbulence)
 FLURRY_FORCE(ElectricField)
 FLURRY_FORCE(OrbitPoint)
 FLURRY_FORCE(Jet)
+FLURRY_FORCE(JetDrawn)
 FLURRY_FORCE(Avoid)
 BENCHMARK(GalaxyStars)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(CampfireMillion)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
