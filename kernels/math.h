@@ -13,6 +13,15 @@ FL_INLINE float fl_clampf(float v, float lo, float hi) { /* std::clamp's rule */
   return v < lo ? lo : hi < v ? hi : v;
 }
 
+/* e^r for |r| <= ln2/2 (a little beyond is fine): Cephes' degree-5 polynomial, fl_expf's and
+ * fl_powf's after their reduction. */
+FL_MATH_INLINE float fl_exp_reduced(float r) {
+  const float p =
+      ((((1.9875691500e-4f * r + 1.3981999507e-3f) * r + 8.3334519073e-3f) * r +
+        4.1665795894e-2f) * r + 1.6666665459e-1f) * r + 5.0000001201e-1f;
+  return p * (r * r) + r + 1.0f;
+}
+
 /* e·2^n for n in [-200, 200], in two factors so that a result below the normal range rounds
  * once: fl_expf's and fl_powf's end. */
 FL_MATH_INLINE float fl_exp_scaled(float e, int n) {
@@ -37,10 +46,7 @@ FL_MATH_INLINE float fl_expf(float x) {
   const int n = (int)(as_uint(t) & 0x007fffffu) - 0x400000;
   const float nf = t - 12582912.0f;
   const float r = (x - nf * 0.693359375f) - nf * -2.12194440e-4f;
-  const float p =
-      ((((1.9875691500e-4f * r + 1.3981999507e-3f) * r + 8.3334519073e-3f) * r +
-        4.1665795894e-2f) * r + 1.6666665459e-1f) * r + 5.0000001201e-1f;
-  return fl_exp_scaled(p * (r * r) + r + 1.0f, n);
+  return fl_exp_scaled(fl_exp_reduced(r), n);
 }
 
 /* Veltkamp's split of a (|a| < 2^100) into two halves of 12 bits whose products are exact. */
@@ -110,10 +116,7 @@ FL_MATH_INLINE float fl_powf(float x, float y) {
   const float t = ph + 12582912.0f;
   const int n = (int)(as_uint(t) & 0x007fffffu) - 0x400000;
   const float r = ((ph - (t - 12582912.0f)) + pl) * 0.693147181f;
-  const float p =
-      ((((1.9875691500e-4f * r + 1.3981999507e-3f) * r + 8.3334519073e-3f) * r +
-        4.1665795894e-2f) * r + 1.6666665459e-1f) * r + 5.0000001201e-1f;
-  float v = fl_exp_scaled(p * (r * r) + r + 1.0f, n);
+  float v = fl_exp_scaled(fl_exp_reduced(r), n);
   v = x == 0.0f ? 0.0f : v;
   v = x == 1.0f ? 1.0f : v;
   v = x > 3.40282347e38f ? x : v;
