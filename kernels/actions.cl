@@ -16,21 +16,7 @@ FL_INLINE void fl_move(float dt, float* px, float* py, float* pz, float vx, floa
   *pz += vz * dt;
 }
 
-/* Move turns the up vector with the angular velocity, exactly: about w by |w|*dt (Rodrigues;
- * kernels.hpp apply(Move)). cos and sin are the device's: an ulp from glibc's. */
-FL_INLINE void fl_turn_up(float dt, float* ux, float* uy, float* uz, float wx, float wy,
-                          float wz) {
-  const float speed = sqrt(wx * wx + wy * wy + wz * wz);
-  if (!(speed > 0.0f)) return;
-  const float kx = wx / speed, ky = wy / speed, kz = wz / speed;
-  const float x = *ux, y = *uy, z = *uz;
-  const float ct = cos(speed * dt), st = sin(speed * dt);
-  const float cx = ky * z - y * kz, cy = kz * x - z * kx, cz = kx * y - x * ky;
-  const float d = (kx * x + ky * y + kz * z) * (1.0f - ct);
-  *ux = x * ct + cx * st + kx * d;
-  *uy = y * ct + cy * st + ky * d;
-  *uz = z * ct + cz * st + kz * d;
-}
+/* (Move's turn of the up vector, fl_turn_up, is in forces.h: the CPU runs it too.) */
 
 /* ---- Spatial culling per work-group (fused_pass.cpp Culler) ------------------------------ */
 

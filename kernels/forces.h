@@ -202,11 +202,61 @@ FL_INLINE void fl_damping_accel(float rx, float ry, float rz, float w, float vx,
   *az += -rz * vz * w;
 }
 
-/* MagneticField: v turns about the unit field direction k by theta = -(q/m)|B| dt w, exactly
- * (Rodrigues), in double where the device has it, so that the speed does not drift. */
-FL_INLINE void fl_magnetic_turn(float kx, float ky, float kz, fl_real theta, float* vx, float* vy,
-                                float* vz) {
-  const fl_real ct = cos(theta), st = sin(theta);
+/* sin and cos of x in fl_real (double where the device has it) by arithmetic alone: the
+ * backends' libm and builtin round their last bits apart, and a libm call per particle keeps
+ * the CPU's loop scalar. fdlibm's reduction and kernels: x = k pi/2 + r, |r| <= pi/4, with
+ * k = round(x 2/pi) by adding 1.5·2^52 (its spacing is 1; no conversion to an integer, so
+ * no undefined behaviour for any x), pi/2 in three parts of 33 bits (k·part exact for
+ * |k| < 2^20), then degree-13 and -14 polynomials in r. tests/test_random.cpp checks both
+ * against libm's. |x| beyond 2^40 (an angle whose double has no fraction left to turn by)
+ * turns by nothing; infinite or NaN x gives NaN. Without doubles the same steps in float
+ * (1.5·2^23, |x| up to 2^22), less exact. */
+#ifdef FL_FP64
+#define FL_REAL_ROUNDER ((fl_real)6755399441055744.0) /* 1.5·2^52 */
+#define FL_REAL_TURN_LIMIT ((fl_real)1099511627776.0) /* 2^40 */
+#else
+#define FL_REAL_ROUNDER ((fl_real)12582912.0) /* 1.5·2^23 */
+#define FL_REAL_TURN_LIMIT ((fl_real)4194304.0) /* 2^22 */
+#endif
+FL_MATH_INLINE void fl_sincos_real(fl_real x, fl_real* sn, fl_real* cs) {
+  x = fabs(x) <= FL_REAL_TURN_LIMIT ? x : x - x; /* inf - inf: NaN */
+  const fl_real k = (x * (fl_real)6.36619772367581382433e-01 + FL_REAL_ROUNDER) - FL_REAL_ROUNDER;
+  const fl_real r = ((x - k * (fl_real)1.57079632673412561417e+00) -
+                     k * (fl_real)6.07710050630396597660e-11) -
+                    k * (fl_real)2.02226624871116645580e-21;
+  const fl_real z = r * r;
+  const fl_real s =
+      r + r * z *
+              ((fl_real)-1.66666666666666324348e-01 +
+               z * ((fl_real)8.33333333332248946124e-03 +
+                    z * ((fl_real)-1.98412698298579493134e-04 +
+                         z * ((fl_real)2.75573137070700676789e-06 +
+                              z * ((fl_real)-2.50507602534068634195e-08 +
+                                   z * (fl_real)1.58969099521155010221e-10)))));
+  const fl_real c =
+      ((fl_real)1.0 - (fl_real)0.5 * z) +
+      z * z *
+          ((fl_real)4.16666666666666019037e-02 +
+           z * ((fl_real)-1.38888888888741095749e-03 +
+                z * ((fl_real)2.48015872894767294178e-05 +
+                     z * ((fl_real)-2.75573143513906633035e-07 +
+                          z * ((fl_real)2.08757232129817482790e-09 +
+                               z * (fl_real)-1.13596475577881948265e-11)))));
+  /* The quadrant, k mod 4, as m = k - 4 round(k/4) in {-2, ..., 2}. */
+  const fl_real m = k - (fl_real)4.0 * ((k * (fl_real)0.25 + FL_REAL_ROUNDER) - FL_REAL_ROUNDER);
+  const fl_real am = fabs(m);
+  const fl_real sr = am == (fl_real)1.0 ? c : s, cr = am == (fl_real)1.0 ? s : c;
+  *sn = (am == (fl_real)2.0 || m == (fl_real)-1.0) ? -sr : sr;
+  *cs = (am == (fl_real)2.0 || m == (fl_real)1.0) ? -cr : cr;
+}
+
+/* v turns about the unit vector k by theta, exactly (Rodrigues), in double where the device
+ * has it, so that the length does not drift: a MagneticField's turn of the velocity, Move's
+ * of the up vector. */
+FL_INLINE void fl_turn_about(float kx, float ky, float kz, fl_real theta, float* vx, float* vy,
+                             float* vz) {
+  fl_real st, ct;
+  fl_sincos_real(theta, &st, &ct);
   const fl_real x = *vx, y = *vy, z = *vz;
   const fl_real dx = kx, dy = ky, dz = kz;
   const fl_real d = (dx * x + dy * y + dz * z) * ((fl_real)1.0 - ct);
@@ -216,6 +266,14 @@ FL_INLINE void fl_magnetic_turn(float kx, float ky, float kz, fl_real theta, flo
 }
 
 /* The Lorentz acceleration (v x B) q w; q is charge over mass. */
+/* Move turns the up vector with the angular velocity w: about w by |w| dt. */
+FL_INLINE void fl_turn_up(float dt, float* ux, float* uy, float* uz, float wx, float wy,
+                          float wz) {
+  const float speed = sqrt(wx * wx + wy * wy + wz * wz);
+  if (!(speed > 0.0f)) return;
+  fl_turn_about(wx / speed, wy / speed, wz / speed, (fl_real)(speed * dt), ux, uy, uz);
+}
+
 FL_INLINE void fl_magnetic_accel(float Bx, float By, float Bz, float q, float w, float vx, float vy,
                                  float vz, float* ax, float* ay, float* az) {
   *ax += (vy * Bz - By * vz) * q * w;
@@ -572,13 +630,20 @@ FL_INLINE void fl_electric_acc(FlElectricParams e, FlFalloffParams f, float px, 
   *az += e.field.z * q * w;
 }
 
-/* MagneticField: v turns about B by -(q/m)|B| dt w, exactly (fl_magnetic_turn). */
-FL_INLINE void fl_magnetic(FlMagneticParams m, FlFalloffParams f, float dt, float px, float py,
-                           float pz, float* vx, float* vy, float* vz, float charge, float mass) {
-  if (!(m.strength > 0.0f)) return;
+/* MagneticField: v turns about B by -(q/m)|B| dt w, exactly (fl_turn_about), for a field
+ * of strength > 0 (fl_magnetic tests it; the CPU's loop tests it once, before: GCC left the
+ * loop scalar with the test inside). */
+FL_INLINE void fl_magnetic_field_on(FlMagneticParams m, FlFalloffParams f, float dt, float px,
+                                    float py, float pz, float* vx, float* vy, float* vz,
+                                    float charge, float mass) {
   const fl_real theta = -(fl_real)fl_charge_per_mass(charge, mass) * (fl_real)m.strength *
                         (fl_real)dt * (fl_real)fl_falloff_weight(f, px, py, pz);
-  fl_magnetic_turn(m.direction.x, m.direction.y, m.direction.z, theta, vx, vy, vz);
+  fl_turn_about(m.direction.x, m.direction.y, m.direction.z, theta, vx, vy, vz);
+}
+
+FL_INLINE void fl_magnetic(FlMagneticParams m, FlFalloffParams f, float dt, float px, float py,
+                           float pz, float* vx, float* vy, float* vz, float charge, float mass) {
+  if (m.strength > 0.0f) fl_magnetic_field_on(m, f, dt, px, py, pz, vx, vy, vz, charge, mass);
 }
 
 FL_INLINE void fl_magnetic_acc(FlMagneticParams m, FlFalloffParams f, float px, float py, float pz,

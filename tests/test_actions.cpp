@@ -66,6 +66,33 @@ TEST(Gravity, ProjectileMatchesTheDiscreteAndAnalyticSolutions) {
   EXPECT_NEAR(q.position.y, 2 + 10 * T + 0.5 * gy * T * T, std::abs(gy) * T * dt);
 }
 
+// Move turns the up vector with the angular velocity, exactly (kernels/forces.h fl_turn_up): a
+// spin of w about z for T seconds turns it by w T, whatever the steps, and keeps it unit.
+TEST(Move, TurnsTheUpVectorByTheAngularVelocityExactly) {
+  const float w = 2.5f;
+  for (const double dt : {0.001, 0.05, 0.7}) {
+    Context ctx(opts(dt));
+    Group& g = ctx.createGroup("p", 2);
+    g.require({Attribute::Up, Attribute::RotVelocity});
+    g.setActions({Move{}});
+    Particle spun, still;
+    spun.up = Vec3(1.0f, 0.0f, 0.0f);
+    spun.rotVelocity = Vec3(0.0f, 0.0f, w);
+    still.up = Vec3(0.6f, 0.8f, 0.0f);  // no angular velocity: left as it is, to the bit
+    g.add(spun);
+    g.add(still);
+    const int N = int(std::lround(7.0 / dt));
+    ctx.run(N);
+    const double angle = double(w) * dt * N;
+    const Vec3 up = g.particle(0).up;
+    EXPECT_NEAR(up.x, std::cos(angle), 1e-4) << dt;
+    EXPECT_NEAR(up.y, std::sin(angle), 1e-4) << dt;
+    EXPECT_EQ(up.z, 0.0f);
+    EXPECT_NEAR(glm::length(up), 1.0f, 1e-5f) << dt;
+    EXPECT_EQ(g.particle(1).up, still.up);
+  }
+}
+
 TEST(Damping, DecaysExponentiallyAtAnyStepSize) {
   for (double dt : {0.1, 1.0}) {
     Context ctx(opts(dt));

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "flurry/random.hpp"
+#include "forces_kernel.hpp"  // kernels/forces.h: fl_sincos_real
 #include "sampling.hpp"
 #include "shape_math.hpp"  // kernels/math.h and domain.h on the CPU
 
@@ -179,6 +180,48 @@ TEST(Random, KernelsPowIsWithinTwoUlps) {
   EXPECT_EQ(k::fl_powf(1e-45f, 0.0f), 1.0f);
   EXPECT_EQ(k::fl_powf(0.25f, 0.5f), 0.5f);  // exact where the result is a float
   EXPECT_EQ(k::fl_powf(0.5f, 3.0f), 0.125f);
+}
+
+// fl_sincos_real (kernels/forces.h): a MagneticField's turn, on both backends, in double
+// (whose result rounds to float: two of double's ulps are 2^-29 of float's).
+TEST(Random, KernelsSinCosAreWithinTwoUlpsOfDouble) {
+  namespace k = flurry::detail::kernel;
+  // In double's ulps at the result (sin and cos near their zeros are compared at 1e-300's
+  // scale by a floor on the spacing: what matters there is the absolute error, ~1e-17).
+  auto ulpsD = [](double got, double want) {
+    const double spacing = std::max(std::abs(std::nextafter(want, INFINITY) - want), 1e-17);
+    return std::abs(got - want) / spacing;
+  };
+  double worst = 0.0;
+  std::size_t checked = 0;
+  auto check = [&](double x) {
+    double s, c;
+    k::fl_sincos_real(x, &s, &c);
+    const double u = std::max(ulpsD(s, std::sin(x)), ulpsD(c, std::cos(x)));
+    worst = std::max(worst, u);
+    ++checked;
+    ASSERT_LE(u, 2.0) << x;
+  };
+  // Angles a step turns by (to a few turns), densely; then out to 2^20 radians, and the
+  // quadrants' edges where k changes.
+  for (double x = -20.0; x <= 20.0; x += 0.000731) check(x);
+  for (double x = 1e-12; x < 1048576.0; x *= 1.0007) check(x), check(-x);
+  for (int q = -4000; q <= 4000; ++q)
+    for (const double d : {-1e-9, 0.0, 1e-9}) check(q * 1.5707963267948966 / 2 + d);
+  EXPECT_GT(checked, std::size_t(100'000));
+  EXPECT_GT(worst, 0.25);  // (the loop saw rounded results: it ran)
+  double s, c;
+  k::fl_sincos_real(0.0, &s, &c);
+  EXPECT_EQ(s, 0.0);
+  EXPECT_EQ(c, 1.0);
+  // Past 2^40 radians no turn; infinity and NaN give NaN.
+  k::fl_sincos_real(1e15, &s, &c);
+  EXPECT_EQ(s, 0.0);
+  EXPECT_EQ(c, 1.0);
+  for (const double bad : {double(INFINITY), -double(INFINITY), double(NAN)}) {
+    k::fl_sincos_real(bad, &s, &c);
+    EXPECT_TRUE(std::isnan(s) && std::isnan(c)) << bad;
+  }
 }
 
 TEST(Random, NormalIsTheKernelsBoxMuller) {

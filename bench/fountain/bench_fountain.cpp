@@ -285,6 +285,12 @@ ActionList forceAlone(const std::string& name) {
     e.falloff = fade;
     return {e, Move{}};
   }
+  if (name == "MagneticField") {
+    MagneticField m{Vec3(0.0f, 2.0f, 1.0f)};
+    m.falloff = fade;
+    return {m, Move{}};
+  }
+  if (name == "Spin") return {Move{}};  // Move turning the up vector (Forces stores it)
   if (name == "OrbitPoint") return {OrbitPoint{}, Move{}};
   if (name.rfind("Jet", 0) == 0) {
     Jet j;
@@ -317,9 +323,12 @@ void Forces(benchmark::State& state, const char* name) {
   t.velocity = Domain::sphere(Vec3(0.0f), 0.5f);
   t.lifetime = 1e30f;
   t.charge = Fuzzy(1.0f, 0.5f);
+  t.rotVelocity = Domain::sphere(Vec3(0.0f), 3.0f);
   e.types = {t};
   e.bursts = {{0.0, std::uint32_t(n), 0.0, 1}};
   g.addEmitter(e);
+  const bool spin = std::string(name) == "Spin";
+  if (spin) g.require({Attribute::Up, Attribute::RotVelocity});
   const ActionList actions = forceAlone(name);
   if (actions.actions().empty()) {
     state.SkipWithError((std::string("no force named ") + name).c_str());
@@ -329,8 +338,10 @@ void Forces(benchmark::State& state, const char* name) {
   ctx.step();  // emits all n
   for (auto _ : state) ctx.step();
   state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(n));
-  // Position and velocity read and written (the charge and mass an electric field reads too).
-  const double bytes = std::string(name) == "ElectricField" ? 56.0 : 48.0;
+  // Position and velocity read and written (the charge and mass an electric or magnetic field
+  // reads too; a spin: the up vector too, and the angular velocity read).
+  const std::string f = name;
+  const double bytes = f == "ElectricField" || f == "MagneticField" ? 56.0 : spin ? 84.0 : 48.0;
   state.SetBytesProcessed(std::int64_t(double(state.iterations()) * double(n) * bytes));
 }
 
@@ -507,6 +518,8 @@ FLURRY_FORCE(Vortex)
 FLURRY_FORCE(Explosion)
 FLURRY_FORCE(Turbulence)
 FLURRY_FORCE(ElectricField)
+FLURRY_FORCE(MagneticField)
+FLURRY_FORCE(Spin)
 FLURRY_FORCE(OrbitPoint)
 FLURRY_FORCE(Jet)
 FLURRY_FORCE(JetDrawn)

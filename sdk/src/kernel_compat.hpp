@@ -22,6 +22,9 @@
 // kept the loop scalar. (Every kernel function forced inline lost more loops than it won.)
 #define FL_MATH_INLINE inline __attribute__((always_inline))
 #endif
+#ifndef FL_FP64
+#define FL_FP64 1  // fl_real is double here, as on a device with cl_khr_fp64
+#endif
 #ifndef FL_GLOBAL
 #define FL_GLOBAL  // the device's __global: one address space here
 #endif

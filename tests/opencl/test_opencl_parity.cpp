@@ -318,15 +318,15 @@ std::pair<bool, float> bitwiseCompare(const RunResult& x, const RunResult& y) {
 // sides run one source (kernels/*.h) in float with no contraction into FMAs and correctly
 // rounded division and square root: what is left to differ is where a libm function (log,
 // sin, cos, atan2) stands in the path, the device's builtin and the CPU's libm rounding
-// their last bit apart (exp and pow are the kernels' own, kernels/math.h fl_expf and fl_powf:
-// a vortex's swirl, a falloff's fade of any power). The actions that may
-// differ are listed with that function (on PoCL none does); every other must be bitwise, and
-// those listed must still be within the parity tolerance.
+// their last bit apart; no action has one now (exp and pow are the kernels' own,
+// kernels/math.h fl_expf and fl_powf: a vortex's swirl, a falloff's fade of any power; sin
+// and cos too, kernels/forces.h fl_sincos_real: a magnetic field's turn, the up vector's).
+// An action that may differ would be listed with that function, and must still be within the
+// parity tolerance; every other must be bitwise.
 TEST(OpenCLParity, WhichActionsAreBitwise) {
   FLURRY_REQUIRE_OPENCL();
-  // Each action not bitwise, and the libm function on its path.
-  const std::map<std::string, std::string> expectedNot = {
-      {"MagneticField", "cos, sin (double where the device has it)"}};
+  // Each action not bitwise, and the libm function on its path: none.
+  const std::map<std::string, std::string> expectedNot = {};
   int bitwise = 0, differ = 0;
   std::string table;
   std::optional<RunResult> alone;  // the CPU's run without the action

@@ -337,7 +337,7 @@ inline void apply(const RandomAccel& a, const Lanes& L, std::size_t n, const Blo
   sampleFromActionStreams(a.acceleration, L, n, c,
                           [&](std::size_t first, std::size_t m, float* ax, float* ay, float* az) {
                             if (weighted) {  // v + a·(dt·w), as without a falloff (w = 1)
-                              withFalloff(falloff, [&](auto fall) {
+                              withFalloff<true>(falloff, [&](auto fall) {
                                 for (std::size_t k = 0; k < m; ++k) {
                                   const std::size_t i = first + k;
                                   const float s =
@@ -447,13 +447,17 @@ inline void apply(const ElectricField&, const Lanes& L, std::size_t n, const Blo
 inline void apply(const MagneticField&, const Lanes& L, std::size_t n, const BlockContext& c) {
   const cl::FlActionParams& r = c.record();
   const cl::FlMagneticParams m = r.own.magnetic;
-  const cl::FlFalloffParams f = r.falloff;
   if (!(m.strength > 0.0f)) return;
-  for (std::size_t i = 0; i < n; ++i)
-    onLocals(L.v, i, [&](float* x, float* y, float* z) {
-      kernel::fl_magnetic(m, f, c.dtAt(i), L.p[0][i], L.p[1][i], L.p[2][i], x, y, z, L.charge[i],
-                          L.mass[i]);
-    });
+  const float* __restrict charge = L.charge;
+  const float* __restrict mass = L.mass;
+  withFalloff(r.falloff, [&](auto fall) {
+    velocityLoop(L, n, c,
+                 [m, fall, charge, mass](std::size_t i, float px, float py, float pz, float dt,
+                                         float* x, float* y, float* z) {
+                   kernel::fl_magnetic_field_on(m, fall(), dt, px, py, pz, x, y, z, charge[i],
+                                                mass[i]);
+                 });
+  });
 }
 
 // The grid is the CPU's own copy (VectorField), sampled as the device samples its buffer.

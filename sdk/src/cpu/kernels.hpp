@@ -196,10 +196,11 @@ inline void velocityLoop(const Lanes& L, std::size_t n, const BlockContext& c, F
 // Calls body(fall), fall() giving the falloff record f as a loop over particles reads it. Where
 // its radius is infinite or its power 1 (the usual cases), those fields are constants there,
 // so that fl_falloff_weight's choices fold and the loop takes no fl_powf (for an infinite
-// radius, no distance) only to throw it away: the same weights.
-template <class Body>
+// radius, no distance) only to throw it away: the same weights. kFinite: the caller took an
+// infinite radius apart (no loop made for it).
+template <bool kFinite = false, class Body>
 inline void withFalloff(const cl::FlFalloffParams& f, Body body) {
-  if (!(f.radius < kInfinity)) {
+  if (!kFinite && !(f.radius < kInfinity)) {
     body([f] {
       cl::FlFalloffParams u = f;
       u.radius = kInfinity;
@@ -220,7 +221,7 @@ inline void apply(const Gravity&, const Lanes& L, std::size_t n, const BlockCont
   const cl::FlActionParams& r = c.record();
   const cl::FlGravityParams g = r.own.gravity;
   if (r.falloff.radius < kInfinity) {
-    withFalloff(r.falloff, [&](auto fall) {
+    withFalloff<true>(r.falloff, [&](auto fall) {
       velocityLoop(L, n, c,
                    [g, fall](float px, float py, float pz, float dt, float* x, float* y, float* z) {
                      kernel::fl_gravity_falloff(g, fall(), dt, px, py, pz, x, y, z);
@@ -278,7 +279,7 @@ inline void apply(const Damping&, const Lanes& L, std::size_t n, const BlockCont
   const cl::FlActionParams& r = c.record();
   const cl::FlDampingParams d = r.own.damping;
   if (r.falloff.radius < kInfinity) {
-    withFalloff(r.falloff, [&](auto fall) {
+    withFalloff<true>(r.falloff, [&](auto fall) {
       velocityLoop(L, n, c,
                    [d, fall](float px, float py, float pz, float dt, float* x, float* y, float* z) {
                      kernel::fl_damping_falloff(d, fall(), dt, px, py, pz, x, y, z);
@@ -289,26 +290,28 @@ inline void apply(const Damping&, const Lanes& L, std::size_t n, const BlockCont
   dampLanes(d, L.v, n, c);
 }
 
+template <class Dt>
+[[gnu::flatten]] inline void turnUpLoop(float* __restrict ux, float* __restrict uy,
+                                        float* __restrict uz, const float* __restrict wx,
+                                        const float* __restrict wy, const float* __restrict wz,
+                                        std::size_t n, Dt dt) {
+  for (std::size_t i = 0; i < n; ++i) {
+    float x = ux[i], y = uy[i], z = uz[i];
+    kernel::fl_turn_up(dt[i], &x, &y, &z, wx[i], wy[i], wz[i]);
+    ux[i] = x, uy[i] = y, uz[i] = z;
+  }
+}
+
 inline void apply(const Move&, const Lanes& L, std::size_t n, const BlockContext& c) {
   if (L.prev[0]) copyLoop(L.prev[0], L.prev[1], L.prev[2], L.p[0], L.p[1], L.p[2], n);
   withDt(c, [&](auto dt) {
     moveLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, dt);
     if (L.age) ageLoop(L.age, n, dt);
   });
-  if (L.up[0] && L.rot[0]) {
-    // The up vector turns with the angular velocity: exactly, about ω by |ω|·dt.
-    for (std::size_t i = 0; i < n; ++i) {
-      const Vec3 w(L.rot[0][i], L.rot[1][i], L.rot[2][i]);
-      const float speed = glm::length(w);
-      if (!(speed > 0.0f)) continue;
-      const Vec3 k = w / speed, u(L.up[0][i], L.up[1][i], L.up[2][i]);
-      const float ct = std::cos(speed * c.dtAt(i)), st = std::sin(speed * c.dtAt(i));
-      const Vec3 r = u * ct + glm::cross(k, u) * st + k * (glm::dot(k, u) * (1.0f - ct));
-      L.up[0][i] = r.x;
-      L.up[1][i] = r.y;
-      L.up[2][i] = r.z;
-    }
-  }
+  if (L.up[0] && L.rot[0])  // the up vector turns with the angular velocity (fl_turn_up)
+    withDt(c, [&](auto dt) {
+      turnUpLoop(L.up[0], L.up[1], L.up[2], L.rot[0], L.rot[1], L.rot[2], n, dt);
+    });
 }
 
 inline void apply(const KillOld&, const Lanes& L, std::size_t n, const BlockContext& c) {
