@@ -307,6 +307,15 @@ ActionList forceAlone(const std::string& name) {
     a.obstacle = Domain::sphere(Vec3(0.0f, 4.0f, 0.0f), 2.0f);
     return {a, Move{}};
   }
+  if (name == "AvoidPlane") {
+    Avoid a;
+    a.obstacle = Domain::plane(Vec3(0.0f, 4.0f, 0.0f), Vec3(0.0f, 1.0f, 0.0f));
+    return {a, Move{}};
+  }
+  if (name == "SinkHit") {  // a disc above the box: every path tested, none absorbed
+    const Domain disc = Domain::disc(Vec3(0.0f, 9.0f, 0.0f), Vec3(0.0f, 1.0f, 0.0f), 3.0f);
+    return {Sink{disc, 0.0f, Sink::Mode::Hit}, Move{}};
+  }
   return {};
 }
 
@@ -524,6 +533,8 @@ FLURRY_FORCE(OrbitPoint)
 FLURRY_FORCE(Jet)
 FLURRY_FORCE(JetDrawn)
 FLURRY_FORCE(Avoid)
+FLURRY_FORCE(AvoidPlane)
+FLURRY_FORCE(SinkHit)
 BENCHMARK(GalaxyStars)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(CampfireMillion)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(IdleGroups)

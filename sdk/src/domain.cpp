@@ -89,18 +89,9 @@ Vec3 closestShape(const PointDomain& d, Vec3) {
 Vec3 closestShape(const LineDomain& d, Vec3 p) {
   return kern::fl_closest_segment(d.p0, d.p1, p);
 }
-Vec3 closestShape(const TriangleDomain& d, Vec3 p) {
-  return kern::fl_closest_triangle(d.p0, d.p1, d.p2, p);
-}
-Vec3 closestShape(const PlaneDomain& d, Vec3 p) {
-  return kern::fl_closest_plane(d.point, d.normal, p);
-}
-Vec3 closestShape(const RectangleDomain& d, Vec3 p) {
-  return kern::fl_closest_rectangle(d.origin, d.u, d.v, p);
-}
-Vec3 closestShape(const DiscDomain& d, Vec3 p) {
-  return kern::fl_closest_disc(d.center, d.normal, kern::fl_any_perpendicular(d.normal),
-                               d.outerRadius, d.innerRadius, p);
+template <class Planar>
+requires detail::kPlanarShape<Planar> Vec3 closestShape(const Planar& d, Vec3 p) {
+  return detail::closest(d, p);  // (shape_math.hpp: the CPU's planar loops share it)
 }
 Vec3 closestShape(const BoxDomain& d, Vec3 p) {
   return kern::fl_closest_box(d.min, d.max, p);

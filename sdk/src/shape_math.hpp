@@ -3,6 +3,8 @@
 // over whole particle arrays vectorise. Domain::contains() and the CPU kernels share these.
 #pragma once
 
+#include <type_traits>
+
 #include "../../kernels/params.h"  // FL_DOMAIN_*: the kinds, in Domain::Shape's order
 #include "flurry/domain.hpp"
 #include "isa_namespace.hpp"
@@ -48,6 +50,25 @@ inline bool inside(const ConeDomain& d, Vec3 p) {
 inline bool inside(const BlobDomain& d, Vec3 p) {
   return kernel::fl_inside_blob(d.center, d.stddev, p);
 }
+
+// The nearest point of a planar piece (Domain::closestPoint); its normal is the shape's.
+inline Vec3 closest(const PlaneDomain& d, Vec3 p) {
+  return kernel::fl_closest_plane(d.point, d.normal, p);
+}
+inline Vec3 closest(const RectangleDomain& d, Vec3 p) {
+  return kernel::fl_closest_rectangle(d.origin, d.u, d.v, p);
+}
+inline Vec3 closest(const TriangleDomain& d, Vec3 p) {
+  return kernel::fl_closest_triangle(d.p0, d.p1, d.p2, p);
+}
+inline Vec3 closest(const DiscDomain& d, Vec3 p) {
+  return kernel::fl_closest_disc(d.center, d.normal, kernel::fl_any_perpendicular(d.normal),
+                                 d.outerRadius, d.innerRadius, p);
+}
+template <class Shape>
+constexpr bool kPlanarShape =
+    std::is_same_v<Shape, PlaneDomain> || std::is_same_v<Shape, RectangleDomain> ||
+    std::is_same_v<Shape, TriangleDomain> || std::is_same_v<Shape, DiscDomain>;
 
 }  // namespace FLURRY_ISA_NAMESPACE
 

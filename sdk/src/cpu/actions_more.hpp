@@ -122,6 +122,48 @@ inline void threatLoop(const Shape& shape, const float* __restrict px, const flo
   }
 }
 
+// Where each straight path p -> p + v·len crosses a planar piece's plane (fl_path_crosses
+// from the piece's nearest point, as Domain gives it), *h, and how far that lies from the
+// piece (Domain::distance), into gap; infinite where it does not cross. Sink's Hit and a
+// planar obstacle's Avoid test a chunk of particles so, in vectors where the piece's nearest
+// point is branch-free (plane, disc).
+template <class Shape, class Len>
+[[gnu::flatten]] inline void planarCrossingLoop(
+    const Shape& s, const float* __restrict px, const float* __restrict py,
+    const float* __restrict pz, const float* __restrict vx, const float* __restrict vy,
+    const float* __restrict vz, Len len, std::size_t n, float* __restrict gap, float* __restrict hx,
+    float* __restrict hy, float* __restrict hz) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 p(px[i], py[i], pz[i]);
+    const Vec3 q = p + Vec3(vx[i], vy[i], vz[i]) * len[i];
+    Vec3 h = p;
+    const int crosses = kernel::fl_path_crosses(p, q, detail::closest(s, p), s.normal, &h);
+    const float d = glm::length(h - detail::closest(s, h));
+    gap[i] = crosses ? d : kInfinity;
+    hx[i] = h.x, hy[i] = h.y, hz[i] = h.z;
+  }
+}
+
+// planarCrossingLoop over chunks of the block: f(first, m, gap, h) for each.
+template <class Len, class F>
+inline void planarCrossings(const Domain& piece, const Lanes& L, std::size_t n, Len len, F f) {
+  constexpr std::size_t kChunk = 256;
+  alignas(64) float gap[kChunk], h[3][kChunk];
+  std::visit(
+      [&]<class Shape>(const Shape& s) {
+        if constexpr (kPlanarShape<Shape>) {
+          for (std::size_t first = 0; first < n; first += kChunk) {
+            const std::size_t m = std::min(kChunk, n - first);
+            planarCrossingLoop(s, L.p[0] + first, L.p[1] + first, L.p[2] + first, L.v[0] + first,
+                               L.v[1] + first, L.v[2] + first, OffsetDt<Len>{len, first}, m, gap,
+                               h[0], h[1], h[2]);
+            f(first, m, static_cast<const float*>(gap), h);
+          }
+        }
+      },
+      piece.shape());
+}
+
 template <class Shape, class Dt>
 inline void sinkMotionLoop(const Shape& shape, const float* __restrict px,
                            const float* __restrict py, const float* __restrict pz,
@@ -154,15 +196,17 @@ inline void apply(const Sink& a, const Lanes& L, std::size_t n, const BlockConte
           },
           a.region.shape());
     });
-  } else {  // Hit: the coming Move crosses the plane piece
-    for (std::size_t i = 0; i < n; ++i) {
-      const Vec3 p = at(L.p, i), v = at(L.v, i);
-      Vec3 h;
-      if (!kernel::fl_path_crosses(p, p + v * c.dtAt(i), a.region.closestPoint(p),
-                                   a.region.normal(p), &h))
-        continue;
-      c.dead[i] = kernel::fl_dead_sink_hit(a.region.distance(h), h, c.action + 1, c.dead[i]);
-    }
+  } else {  // Hit: the coming Move crosses the plane piece (an infinite gap: it does not)
+    withDt(c, [&](auto dt) {
+      planarCrossings(
+          a.region, L, n, dt,
+          [&](std::size_t first, std::size_t m, const float* gap, const float(*h)[256]) {
+            std::uint32_t* __restrict dead = c.dead + first;
+            for (std::size_t k = 0; k < m; ++k)
+              dead[k] =
+                  kernel::fl_dead_sink_hit(gap[k], Vec3(h[0][k], h[1][k], h[2][k]), code, dead[k]);
+          });
+    });
   }
   passThrough(c, L, n, c.record().own.sink.passThrough);
 }
@@ -493,15 +537,14 @@ inline void apply(const Avoid& a, const Lanes& L, std::size_t n, const BlockCont
                             x, y, z);
     });
   };
-  if (planar) {
-    for (std::size_t i = 0; i < n; ++i) {
-      const Vec3 p = at(L.p, i), v = at(L.v, i);
-      const Vec3 ahead = p + v * avoid.lookAhead;
-      Vec3 h;
-      if (kernel::fl_path_crosses(p, ahead, a.obstacle.closestPoint(p), a.obstacle.normal(p), &h) &&
-          a.obstacle.distance(h) < 1e-4f * (1.0f + glm::length(p)))
-        push(i);
-    }
+  if (planar) {  // the look-ahead path crosses the piece
+    planarCrossings(a.obstacle, L, n, UniformDt{avoid.lookAhead},
+                    [&](std::size_t first, std::size_t m, const float* gap, const float(*)[256]) {
+                      for (std::size_t k = 0; k < m; ++k)
+                        if (gap[k] < kInfinity &&  // (most do not cross: no length taken)
+                            gap[k] < 1e-4f * (1.0f + glm::length(at(L.p, first + k)))) [[unlikely]]
+                          push(first + k);
+                    });
     return;
   }
   std::visit(
