@@ -311,24 +311,37 @@ FL_INLINE float fl_field_blend(float c000, float c100, float c010, float c110, f
 
 /* The field's value at p: a grid of nx x ny x nz vectors of three floats each, x fastest, at
  * `g`, from (ox, oy, oz) in steps of vs. Both backends read the same floats: the CPU its
- * VectorField's, the device its copy in the act kernel's `extra`. */
-FL_INLINE float3 fl_grid_sample(const FL_GLOBAL float* g, int nx, int ny, int nz, float ox,
-                                float oy, float oz, float vs, float px, float py, float pz) {
-  int x0, x1, y0, y1, z0, z1;
-  const float tx = fl_field_axis((px - ox) / vs, nx, &x0, &x1);
-  const float ty = fl_field_axis((py - oy) / vs, ny, &y0, &y1);
-  const float tz = fl_field_axis((pz - oz) / vs, nz, &z0, &z1);
-  /* The corner (x, y, z)'s component k (64-bit: a grid may pass 2^32 floats). */
-#define FL_CORNER(x, y, z, k) \
-  g[((ulong)(x) + (ulong)nx * ((ulong)(y) + (ulong)ny * (ulong)(z))) * 3u + (k)]
-#define FL_BLEND(k)                                                                         \
-  fl_field_blend(FL_CORNER(x0, y0, z0, k), FL_CORNER(x1, y0, z0, k), FL_CORNER(x0, y1, z0, k), \
-                 FL_CORNER(x1, y1, z0, k), FL_CORNER(x0, y0, z1, k), FL_CORNER(x1, y0, z1, k), \
-                 FL_CORNER(x0, y1, z1, k), FL_CORNER(x1, y1, z1, k), tx, ty, tz)
-  return make_float3(FL_BLEND(0), FL_BLEND(1), FL_BLEND(2));
-#undef FL_BLEND
-#undef FL_CORNER
-}
+ * VectorField's, the device its copy in the act kernel's `extra`. The corners' offsets are
+ * taken in `index_t`: ulong (fl_grid_sample) for any grid (one may pass 2^32 floats); int
+ * (fl_grid_sample_int) for a grid of fewer than 2^31 floats, whose lookups the CPU's loop
+ * gathers in vectors (GCC vectorises a gather of 32-bit offsets, not of 64-bit ones). The same
+ * values either way. */
+#define FL_GRID_SAMPLE(name, index_t)                                                          \
+  FL_INLINE float3 name(const FL_GLOBAL float* g, int nx, int ny, int nz, float ox, float oy,  \
+                        float oz, float vs, float px, float py, float pz) {                    \
+    int x0, x1, y0, y1, z0, z1;                                                                \
+    const float tx = fl_field_axis((px - ox) / vs, nx, &x0, &x1);                              \
+    const float ty = fl_field_axis((py - oy) / vs, ny, &y0, &y1);                              \
+    const float tz = fl_field_axis((pz - oz) / vs, nz, &z0, &z1);                              \
+    const index_t rx = (index_t)nx, rxy = (index_t)nx * (index_t)ny;                           \
+    const index_t c000 = ((index_t)x0 + rx * (index_t)y0 + rxy * (index_t)z0) * 3;            \
+    const index_t c100 = ((index_t)x1 + rx * (index_t)y0 + rxy * (index_t)z0) * 3;            \
+    const index_t c010 = ((index_t)x0 + rx * (index_t)y1 + rxy * (index_t)z0) * 3;            \
+    const index_t c110 = ((index_t)x1 + rx * (index_t)y1 + rxy * (index_t)z0) * 3;            \
+    const index_t c001 = ((index_t)x0 + rx * (index_t)y0 + rxy * (index_t)z1) * 3;            \
+    const index_t c101 = ((index_t)x1 + rx * (index_t)y0 + rxy * (index_t)z1) * 3;            \
+    const index_t c011 = ((index_t)x0 + rx * (index_t)y1 + rxy * (index_t)z1) * 3;            \
+    const index_t c111 = ((index_t)x1 + rx * (index_t)y1 + rxy * (index_t)z1) * 3;            \
+    return make_float3(FL_GRID_BLEND(0), FL_GRID_BLEND(1), FL_GRID_BLEND(2));                  \
+  }
+/* Component k of the eight corners, blended. */
+#define FL_GRID_BLEND(k)                                                                       \
+  fl_field_blend(g[c000 + (k)], g[c100 + (k)], g[c010 + (k)], g[c110 + (k)], g[c001 + (k)],    \
+                 g[c101 + (k)], g[c011 + (k)], g[c111 + (k)], tx, ty, tz)
+FL_GRID_SAMPLE(fl_grid_sample, ulong)
+FL_GRID_SAMPLE(fl_grid_sample_int, int)
+#undef FL_GRID_BLEND
+#undef FL_GRID_SAMPLE
 
 /* ---- Targets, speed limits ---------------------------------------------------------------- */
 

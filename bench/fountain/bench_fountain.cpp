@@ -290,6 +290,20 @@ ActionList forceAlone(const std::string& name) {
     m.falloff = fade;
     return {m, Move{}};
   }
+  if (name.rfind("SampledField", 0) == 0) {  // a swirl on a 32^3 grid over the box
+    auto field = std::make_shared<VectorField>();
+    field->origin = Vec3(-4.0f, 0.0f, -4.0f);
+    field->voxelSize = 8.0f / 31.0f;
+    field->dims = glm::ivec3(32);
+    for (int z = 0; z < 32; ++z)
+      for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 32; ++x)
+          field->data.push_back(Vec3(float(z - 16), 0.1f * float(y), float(16 - x)) * 0.1f);
+    SampledField f;
+    f.field = field;
+    if (name == "SampledFieldCarry") f.mode = SampledField::Mode::Velocity;
+    return {f, Move{}};
+  }
   if (name == "Spin") return {Move{}};  // Move turning the up vector (Forces stores it)
   if (name == "OrbitPoint") return {OrbitPoint{}, Move{}};
   if (name.rfind("Jet", 0) == 0) {
@@ -529,6 +543,8 @@ FLURRY_FORCE(Turbulence)
 FLURRY_FORCE(ElectricField)
 FLURRY_FORCE(MagneticField)
 FLURRY_FORCE(Spin)
+FLURRY_FORCE(SampledField)
+FLURRY_FORCE(SampledFieldCarry)
 FLURRY_FORCE(OrbitPoint)
 FLURRY_FORCE(Jet)
 FLURRY_FORCE(JetDrawn)

@@ -510,6 +510,22 @@ inline void apply(const SampledField& a, const Lanes& L, std::size_t n, const Bl
   const cl::FlSampledFieldParams s = r.own.sampledField;
   const cl::FlFalloffParams f = r.falloff;
   const VectorField& field = *a.field;
+  if (field.data.size() * 3 < (std::size_t(1) << 31)) {  // offsets in int: gathered in vectors
+    const float* grid = reinterpret_cast<const float*>(field.data.data());
+    const int nx = field.dims.x, ny = field.dims.y, nz = field.dims.z;
+    const Vec3 o = field.origin;
+    const float vs = field.voxelSize;
+    withFalloff(f, [&](auto fall) {
+      velocityLoop(
+          L, n, c, [=](float px, float py, float pz, float dt, float* x, float* y, float* z) {
+            const Vec3 u =
+                kernel::fl_grid_sample_int(grid, nx, ny, nz, o.x, o.y, o.z, vs, px, py, pz);
+            kernel::fl_sampled_field(s, dt, kernel::fl_falloff_weight(fall(), px, py, pz), u.x, u.y,
+                                     u.z, x, y, z);
+          });
+    });
+    return;
+  }
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3 p = at(L.p, i);
     const Vec3 u = sampleTrilinear(field, p);
