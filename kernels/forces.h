@@ -34,6 +34,17 @@ FL_INLINE float fl_approach(float rate, float dt) {
  * the step's start (n of them, at sx, sy, sz) within r2max (a squared radius) of p, `self`
  * left out, and the value (vx, vy, vz) carried towards it by k; left as it is with no
  * neighbour. */
+/* The value carried by k towards the mean of `count` neighbours' (their sum); as it was with
+ * none. */
+FL_INLINE void fl_match_finish(float sumx, float sumy, float sumz, int count, float k, float* vx,
+                               float* vy, float* vz) {
+  if (count == 0) return;
+  const float c = (float)count;
+  *vx = *vx + (sumx / c - *vx) * k;
+  *vy = *vy + (sumy / c - *vy) * k;
+  *vz = *vz + (sumz / c - *vz) * k;
+}
+
 FL_INLINE void fl_match_mean(const FL_GLOBAL float* sx, const FL_GLOBAL float* sy,
                              const FL_GLOBAL float* sz, const FL_GLOBAL float* fx,
                              const FL_GLOBAL float* fy, const FL_GLOBAL float* fz, uint n,
@@ -50,11 +61,7 @@ FL_INLINE void fl_match_mean(const FL_GLOBAL float* sx, const FL_GLOBAL float* s
     sumz += fz[j];
     ++count;
   }
-  if (count == 0) return;
-  const float c = (float)count;
-  *vx = *vx + (sumx / c - *vx) * k;
-  *vy = *vy + (sumy / c - *vy) * k;
-  *vz = *vz + (sumz / c - *vz) * k;
+  fl_match_finish(sumx, sumy, sumz, count, k, vx, vy, vz);
 }
 
 /* Charge over mass: a particle of zero (or negative) mass feels no field. */

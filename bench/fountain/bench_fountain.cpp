@@ -368,6 +368,32 @@ void Forces(benchmark::State& state, const char* name) {
   state.SetBytesProcessed(std::int64_t(double(state.iterations()) * double(n) * bytes));
 }
 
+// A flock: MatchVelocity over `n` particles in a 4 m box, each against all the others (the
+// classic API's neighbour actions are O(n^2)): ns per particle pair.
+void Flock(benchmark::State& state) {
+  const auto n = std::size_t(state.range(0));
+  ContextOptions o;
+  o.threads = threads();
+  o.dt = 1.0 / 60.0;
+  Context ctx(o);
+  Group& g = ctx.createGroup("flock", n);
+  Emitter e;
+  e.shape = Domain::box(Vec3(-2.0f), Vec3(2.0f));
+  ParticleType t;
+  t.velocity = Domain::sphere(Vec3(0.0f), 1.0f);
+  t.lifetime = 1e30f;
+  e.types = {t};
+  e.bursts = {{0.0, std::uint32_t(n), 0.0, 1}};
+  g.addEmitter(e);
+  g.setActions({MatchVelocity{}, Move{}});
+  ctx.step();
+  for (auto _ : state) ctx.step();
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(n) * std::int64_t(n));
+  state.counters["ns/pair"] =
+      benchmark::Counter(double(state.iterations()) * double(n) * double(n) * 1e-9,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
 // The ceiling for it: the six lanes it reads and writes.
 void ReadModifyWrite6(benchmark::State& state) {
   flurry::bench::readModifyWrite(state, 6, threads());
@@ -551,6 +577,7 @@ FLURRY_FORCE(JetDrawn)
 FLURRY_FORCE(Avoid)
 FLURRY_FORCE(AvoidPlane)
 FLURRY_FORCE(SinkHit)
+BENCHMARK(Flock)->Arg(4096)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(GalaxyStars)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(CampfireMillion)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(IdleGroups)

@@ -593,16 +593,69 @@ inline void apply(const Follow&, const Lanes& L, std::size_t n, const BlockConte
 
 // Towards the mean of the neighbours' values within maxRadius, at `magnitude` per second
 // (kernels/forces.h, shared with the device).
+// kMatchLanes particles at a time scan the others in lockstep, each summing in its own
+// order (fl_match_mean's: the others by index, a neighbour's value added, anyone else's -0,
+// which leaves every sum as it was), so that the scan runs in vectors with the same sums.
+// GCC's vector types of this build's width, two side by side, not its vectoriser: that one
+// turned "add -0 or u" back into a conditional add, and branched on whether any lane had a
+// neighbour.
+constexpr std::size_t kMatchWidth = FLURRY_ISA_FLOATS, kMatchLanes = 2 * kMatchWidth;
+using MatchFloats = float __attribute__((vector_size(4 * kMatchWidth)));
+using MatchInts = std::int32_t __attribute__((vector_size(4 * kMatchWidth)));
+inline void matchScan(const float* __restrict sx, const float* __restrict sy,
+                      const float* __restrict sz, const float* __restrict fx,
+                      const float* __restrict fy, const float* __restrict fz, std::size_t others,
+                      const float* px0, const float* py0, const float* pz0,
+                      const std::int32_t* own0, float r2max, float* sumx, float* sumy, float* sumz,
+                      std::int32_t* count) {
+  MatchFloats px[2], py[2], pz[2], ax[2], ay[2], az[2];
+  MatchInts own[2], cn[2];
+  std::memcpy(px, px0, sizeof px);
+  std::memcpy(py, py0, sizeof py);
+  std::memcpy(pz, pz0, sizeof pz);
+  std::memcpy(own, own0, sizeof own);
+  const MatchFloats zero = {}, minusZero = -zero;
+  for (int h = 0; h < 2; ++h) ax[h] = ay[h] = az[h] = zero, cn[h] = MatchInts{};
+  for (std::size_t j = 0; j < others; ++j) {
+    // (x - +0 broadcasts x exactly, -0 included: + would turn a -0 into +0)
+    const MatchFloats qx = sx[j] - zero, qy = sy[j] - zero, qz = sz[j] - zero;
+    const MatchFloats ux = fx[j] - zero, uy = fy[j] - zero, uz = fz[j] - zero;
+    for (int h = 0; h < 2; ++h) {
+      const MatchFloats dx = qx - px[h], dy = qy - py[h], dz = qz - pz[h];
+      const MatchInts out = (dx * dx + dy * dy + dz * dz > r2max) | (own[h] == std::int32_t(j));
+      ax[h] += out ? minusZero : ux;
+      ay[h] += out ? minusZero : uy;
+      az[h] += out ? minusZero : uz;
+      cn[h] += out + 1;  // (out is -1 or 0)
+    }
+  }
+  std::memcpy(sumx, ax, sizeof ax);
+  std::memcpy(sumy, ay, sizeof ay);
+  std::memcpy(sumz, az, sizeof az);
+  std::memcpy(count, cn, sizeof cn);
+}
+
 inline void matchMean(const Snapshot& s, const float* const* self, const float* const* field,
                       float* const* out, std::size_t n, const BlockContext& c) {
   const cl::FlMatchParams m = c.record().own.match;
   const float kStep = kernel::fl_match_k(m, c.dt);
-  for (std::size_t i = 0; i < n; ++i) {
-    const float k = c.ownDt ? kernel::fl_match_k(m, c.ownDt[i]) : kStep;
-    kernel::fl_match_mean(s.p[0], s.p[1], s.p[2], field[0], field[1], field[2],
-                          std::uint32_t(s.size), std::uint32_t(c.base + i), m.maxRadius2,
-                          self[0][i], self[1][i], self[2][i], k, &out[0][i], &out[1][i],
-                          &out[2][i]);
+  for (std::size_t i0 = 0; i0 < n; i0 += kMatchLanes) {
+    const std::size_t lanes = std::min(kMatchLanes, n - i0);
+    alignas(64) float px[kMatchLanes] = {}, py[kMatchLanes] = {}, pz[kMatchLanes] = {};
+    alignas(64) float sumx[kMatchLanes], sumy[kMatchLanes], sumz[kMatchLanes];
+    alignas(64) std::int32_t count[kMatchLanes], own[kMatchLanes];
+    for (std::size_t l = 0; l < kMatchLanes; ++l)
+      own[l] = std::int32_t(c.base + i0 + l);  // (lanes past the block: no index to skip)
+    for (std::size_t l = 0; l < lanes; ++l)
+      px[l] = self[0][i0 + l], py[l] = self[1][i0 + l], pz[l] = self[2][i0 + l];
+    matchScan(s.p[0], s.p[1], s.p[2], field[0], field[1], field[2], s.size, px, py, pz, own,
+              m.maxRadius2, sumx, sumy, sumz, count);
+    for (std::size_t l = 0; l < lanes; ++l) {
+      const std::size_t i = i0 + l;
+      const float k = c.ownDt ? kernel::fl_match_k(m, c.ownDt[i]) : kStep;
+      kernel::fl_match_finish(sumx[l], sumy[l], sumz[l], count[l], k, &out[0][i], &out[1][i],
+                              &out[2][i]);
+    }
   }
 }
 inline void apply(const MatchVelocity&, const Lanes& L, std::size_t n, const BlockContext& c) {
