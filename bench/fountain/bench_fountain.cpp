@@ -368,9 +368,9 @@ void Forces(benchmark::State& state, const char* name) {
   state.SetBytesProcessed(std::int64_t(double(state.iterations()) * double(n) * bytes));
 }
 
-// A flock: MatchVelocity over `n` particles in a 4 m box, each against all the others (the
-// classic API's neighbour actions are O(n^2)): ns per particle pair.
-void Flock(benchmark::State& state) {
+// A flock: MatchVelocity (or Gravitate) over `n` particles in a 4 m box, each against all the
+// others (the classic API's neighbour actions are O(n^2)): ns per particle pair.
+void Flock(benchmark::State& state, const char* action) {
   const auto n = std::size_t(state.range(0));
   ContextOptions o;
   o.threads = threads();
@@ -385,7 +385,10 @@ void Flock(benchmark::State& state) {
   e.types = {t};
   e.bursts = {{0.0, std::uint32_t(n), 0.0, 1}};
   g.addEmitter(e);
-  g.setActions({MatchVelocity{}, Move{}});
+  if (std::string(action) == "Gravitate")
+    g.setActions({Gravitate{0.01f, 0.01f}, Move{}});
+  else
+    g.setActions({MatchVelocity{}, Move{}});
   ctx.step();
   for (auto _ : state) ctx.step();
   state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(n) * std::int64_t(n));
@@ -577,7 +580,14 @@ FLURRY_FORCE(JetDrawn)
 FLURRY_FORCE(Avoid)
 FLURRY_FORCE(AvoidPlane)
 FLURRY_FORCE(SinkHit)
-BENCHMARK(Flock)->Arg(4096)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(Flock, MatchVelocity, "MatchVelocity")
+    ->Arg(4096)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(Flock, Gravitate, "Gravitate")
+    ->Arg(4096)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(GalaxyStars)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(CampfireMillion)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(IdleGroups)

@@ -255,18 +255,97 @@ inline void apply(const OrbitLine&, const Lanes& L, std::size_t n, const BlockCo
   });
 }
 
+// kMatchLanes particles at a time scan the others in lockstep, each summing in its own
+// order (fl_match_mean's: the others by index, a neighbour's value added, anyone else's -0,
+// which leaves every sum as it was), so that the scan runs in vectors with the same sums.
+// GCC's vector types of this build's width, two side by side, not its vectoriser: that one
+// turned "add -0 or u" back into a conditional add, and branched on whether any lane had a
+// neighbour.
+constexpr std::size_t kMatchWidth = FLURRY_ISA_FLOATS, kMatchLanes = 2 * kMatchWidth;
+using MatchFloats = float __attribute__((vector_size(4 * kMatchWidth)));
+using MatchInts = std::int32_t __attribute__((vector_size(4 * kMatchWidth)));
+inline void matchScan(const float* __restrict sx, const float* __restrict sy,
+                      const float* __restrict sz, const float* __restrict fx,
+                      const float* __restrict fy, const float* __restrict fz, std::size_t others,
+                      const float* px0, const float* py0, const float* pz0,
+                      const std::int32_t* own0, float r2max, float* sumx, float* sumy, float* sumz,
+                      std::int32_t* count) {
+  MatchFloats px[2], py[2], pz[2], ax[2], ay[2], az[2];
+  MatchInts own[2], cn[2];
+  std::memcpy(px, px0, sizeof px);
+  std::memcpy(py, py0, sizeof py);
+  std::memcpy(pz, pz0, sizeof pz);
+  std::memcpy(own, own0, sizeof own);
+  const MatchFloats zero = {}, minusZero = -zero;
+  for (int h = 0; h < 2; ++h) ax[h] = ay[h] = az[h] = zero, cn[h] = MatchInts{};
+  for (std::size_t j = 0; j < others; ++j) {
+    // (x - +0 broadcasts x exactly, -0 included: + would turn a -0 into +0)
+    const MatchFloats qx = sx[j] - zero, qy = sy[j] - zero, qz = sz[j] - zero;
+    const MatchFloats ux = fx[j] - zero, uy = fy[j] - zero, uz = fz[j] - zero;
+    for (int h = 0; h < 2; ++h) {
+      const MatchFloats dx = qx - px[h], dy = qy - py[h], dz = qz - pz[h];
+      const MatchInts out = (dx * dx + dy * dy + dz * dz > r2max) | (own[h] == std::int32_t(j));
+      ax[h] += out ? minusZero : ux;
+      ay[h] += out ? minusZero : uy;
+      az[h] += out ? minusZero : uz;
+      cn[h] += out + 1;  // (out is -1 or 0)
+    }
+  }
+  std::memcpy(sumx, ax, sizeof ax);
+  std::memcpy(sumy, ay, sizeof ay);
+  std::memcpy(sumz, az, sizeof az);
+  std::memcpy(count, cn, sizeof cn);
+}
+
+// Gravitate: as matchScan, kMatchLanes particles pulled in lockstep, each summing its pulls
+// in the scalar order (itself adding -0). The pulls of a step's lanes go through an array, so
+// that GCC vectorises them (sqrt) and does not fold the sums into conditional adds.
+inline void gravitateScan(const float* __restrict sx, const float* __restrict sy,
+                          const float* __restrict sz, std::size_t others, const float* px,
+                          const float* py, const float* pz, const std::int32_t* own,
+                          const cl::FlPullParams& q, float* sumx, float* sumy, float* sumz) {
+  MatchFloats ax[2] = {}, ay[2] = {}, az[2] = {};
+  alignas(64) float tx[kMatchLanes], ty[kMatchLanes], tz[kMatchLanes];
+  for (std::size_t j = 0; j < others; ++j) {
+    const float qx = sx[j], qy = sy[j], qz = sz[j];
+    for (std::size_t l = 0; l < kMatchLanes; ++l) {
+      float ox, oy, oz;
+      kernel::fl_pull(q, qx - px[l], qy - py[l], qz - pz[l], &ox, &oy, &oz);
+      const bool me = own[l] == std::int32_t(j);
+      tx[l] = me ? -0.0f : ox;
+      ty[l] = me ? -0.0f : oy;
+      tz[l] = me ? -0.0f : oz;
+    }
+    for (int h = 0; h < 2; ++h) {
+      MatchFloats x, y, z;
+      std::memcpy(&x, tx + h * kMatchWidth, sizeof x);
+      std::memcpy(&y, ty + h * kMatchWidth, sizeof y);
+      std::memcpy(&z, tz + h * kMatchWidth, sizeof z);
+      ax[h] += x, ay[h] += y, az[h] += z;
+    }
+  }
+  std::memcpy(sumx, ax, sizeof ax);
+  std::memcpy(sumy, ay, sizeof ay);
+  std::memcpy(sumz, az, sizeof az);
+}
+
 inline void apply(const Gravitate&, const Lanes& L, std::size_t n, const BlockContext& c) {
   const cl::FlPullParams q = c.record().own.pull;
   const Snapshot& s = *c.snapshot;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 p = at(L.p, i);
-    const std::size_t self = c.base + i;
-    Vec3 acc(0.0f);
-    for (std::size_t j = 0; j < s.size; ++j) {
-      if (j == self) continue;
-      acc += softPull(Vec3(s.p[0][j], s.p[1][j], s.p[2][j]) - p, q);
+  for (std::size_t i0 = 0; i0 < n; i0 += kMatchLanes) {
+    const std::size_t lanes = std::min(kMatchLanes, n - i0);
+    alignas(64) float px[kMatchLanes] = {}, py[kMatchLanes] = {}, pz[kMatchLanes] = {};
+    alignas(64) float ax[kMatchLanes], ay[kMatchLanes], az[kMatchLanes];
+    alignas(64) std::int32_t own[kMatchLanes];
+    for (std::size_t l = 0; l < kMatchLanes; ++l)
+      own[l] = std::int32_t(c.base + i0 + l);  // (lanes past the block: no index to skip)
+    for (std::size_t l = 0; l < lanes; ++l)
+      px[l] = L.p[0][i0 + l], py[l] = L.p[1][i0 + l], pz[l] = L.p[2][i0 + l];
+    gravitateScan(s.p[0], s.p[1], s.p[2], s.size, px, py, pz, own, q, ax, ay, az);
+    for (std::size_t l = 0; l < lanes; ++l) {
+      const std::size_t i = i0 + l;
+      put(L.v, i, at(L.v, i) + Vec3(ax[l], ay[l], az[l]) * c.dtAt(i));
     }
-    put(L.v, i, at(L.v, i) + acc * c.dtAt(i));
   }
 }
 
@@ -593,48 +672,6 @@ inline void apply(const Follow&, const Lanes& L, std::size_t n, const BlockConte
 
 // Towards the mean of the neighbours' values within maxRadius, at `magnitude` per second
 // (kernels/forces.h, shared with the device).
-// kMatchLanes particles at a time scan the others in lockstep, each summing in its own
-// order (fl_match_mean's: the others by index, a neighbour's value added, anyone else's -0,
-// which leaves every sum as it was), so that the scan runs in vectors with the same sums.
-// GCC's vector types of this build's width, two side by side, not its vectoriser: that one
-// turned "add -0 or u" back into a conditional add, and branched on whether any lane had a
-// neighbour.
-constexpr std::size_t kMatchWidth = FLURRY_ISA_FLOATS, kMatchLanes = 2 * kMatchWidth;
-using MatchFloats = float __attribute__((vector_size(4 * kMatchWidth)));
-using MatchInts = std::int32_t __attribute__((vector_size(4 * kMatchWidth)));
-inline void matchScan(const float* __restrict sx, const float* __restrict sy,
-                      const float* __restrict sz, const float* __restrict fx,
-                      const float* __restrict fy, const float* __restrict fz, std::size_t others,
-                      const float* px0, const float* py0, const float* pz0,
-                      const std::int32_t* own0, float r2max, float* sumx, float* sumy, float* sumz,
-                      std::int32_t* count) {
-  MatchFloats px[2], py[2], pz[2], ax[2], ay[2], az[2];
-  MatchInts own[2], cn[2];
-  std::memcpy(px, px0, sizeof px);
-  std::memcpy(py, py0, sizeof py);
-  std::memcpy(pz, pz0, sizeof pz);
-  std::memcpy(own, own0, sizeof own);
-  const MatchFloats zero = {}, minusZero = -zero;
-  for (int h = 0; h < 2; ++h) ax[h] = ay[h] = az[h] = zero, cn[h] = MatchInts{};
-  for (std::size_t j = 0; j < others; ++j) {
-    // (x - +0 broadcasts x exactly, -0 included: + would turn a -0 into +0)
-    const MatchFloats qx = sx[j] - zero, qy = sy[j] - zero, qz = sz[j] - zero;
-    const MatchFloats ux = fx[j] - zero, uy = fy[j] - zero, uz = fz[j] - zero;
-    for (int h = 0; h < 2; ++h) {
-      const MatchFloats dx = qx - px[h], dy = qy - py[h], dz = qz - pz[h];
-      const MatchInts out = (dx * dx + dy * dy + dz * dz > r2max) | (own[h] == std::int32_t(j));
-      ax[h] += out ? minusZero : ux;
-      ay[h] += out ? minusZero : uy;
-      az[h] += out ? minusZero : uz;
-      cn[h] += out + 1;  // (out is -1 or 0)
-    }
-  }
-  std::memcpy(sumx, ax, sizeof ax);
-  std::memcpy(sumy, ay, sizeof ay);
-  std::memcpy(sumz, az, sizeof az);
-  std::memcpy(count, cn, sizeof cn);
-}
-
 inline void matchMean(const Snapshot& s, const float* const* self, const float* const* field,
                       float* const* out, std::size_t n, const BlockContext& c) {
   const cl::FlMatchParams m = c.record().own.match;
