@@ -248,7 +248,19 @@ void CampfireMillion(benchmark::State& state) {
 // each costs a particle-step against the read-modify-write of the position and velocity it
 // reads and writes (ReadModifyWrite6, the summary's "of RMW"). Where an action ran a scalar
 // loop, this is where it shows.
+ActionList forceAloneEuler(const std::string& name);
+// A name ending in "RK4": the force integrated by RK4 (each stage's acceleration summed).
 ActionList forceAlone(const std::string& name) {
+  const std::string rk4 = "RK4";
+  if (name.size() > rk4.size() && name.compare(name.size() - rk4.size(), rk4.size(), rk4) == 0) {
+    ActionList list = forceAloneEuler(name.substr(0, name.size() - rk4.size()));
+    list.setIntegrator(Integrator::RK4);
+    return list;
+  }
+  return forceAloneEuler(name);
+}
+
+ActionList forceAloneEuler(const std::string& name) {
   Falloff fade;
   fade.center = Vec3(0.0f, 4.0f, 0.0f);
   fade.radius = 5.0f;
@@ -364,7 +376,8 @@ void Forces(benchmark::State& state, const char* name) {
   // Position and velocity read and written (the charge and mass an electric or magnetic field
   // reads too; a spin: the up vector too, and the angular velocity read).
   const std::string f = name;
-  const double bytes = f == "ElectricField" || f == "MagneticField" ? 56.0 : spin ? 84.0 : 48.0;
+  const bool charged = f.rfind("ElectricField", 0) == 0 || f.rfind("MagneticField", 0) == 0;
+  const double bytes = charged ? 56.0 : spin ? 84.0 : 48.0;
   state.SetBytesProcessed(std::int64_t(double(state.iterations()) * double(n) * bytes));
 }
 
@@ -572,6 +585,8 @@ FLURRY_FORCE(Turbulence)
 FLURRY_FORCE(ElectricField)
 FLURRY_FORCE(MagneticField)
 FLURRY_FORCE(Spin)
+FLURRY_FORCE(VortexRK4)
+FLURRY_FORCE(ElectricFieldRK4)
 FLURRY_FORCE(SampledField)
 FLURRY_FORCE(SampledFieldCarry)
 FLURRY_FORCE(OrbitPoint)

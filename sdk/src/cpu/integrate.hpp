@@ -30,18 +30,36 @@ inline void add(float* const* a, std::size_t i, Vec3 d) {
 }
 }  // namespace
 
+// f(i, p, v, ax, ay, az) for each particle of a stage, its acceleration's sums in locals.
+template <class F>
+[[gnu::flatten]] inline void stageLoop(const float* __restrict px, const float* __restrict py,
+                                       const float* __restrict pz, const float* __restrict vx,
+                                       const float* __restrict vy, const float* __restrict vz,
+                                       float* __restrict ax, float* __restrict ay,
+                                       float* __restrict az, std::size_t n, F f) {
+  for (std::size_t i = 0; i < n; ++i) {
+    float x = ax[i], y = ay[i], z = az[i];
+    f(i, Vec3(px[i], py[i], pz[i]), Vec3(vx[i], vy[i], vz[i]), x, y, z);
+    ax[i] = x, ay[i] = y, az[i] = z;
+  }
+}
+template <class F>
+inline void stageLoop(const Stage& s, std::size_t n, F f) {
+  stageLoop(s.p[0], s.p[1], s.p[2], s.v[0], s.v[1], s.v[2], s.a[0], s.a[1], s.a[2], n, f);
+}
+
 // Adds one force's acceleration at (p, v, t), from its record (c.record()) by the shared
 // kernel functions (kernels/forces.h), which add to the stage's sums as the device's do. `L`
 // gives the per-particle constants (charge, mass, id); `c` the step (its random numbers are the
 // same in every stage of a step).
 inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std::size_t n,
                        const BlockContext& c, double t) {
-  const cl::FlActionParams& r = c.record();
-  const cl::FlFalloffParams f = r.falloff;
+  const cl::FlActionParams& record = c.record();
+  const cl::FlFalloffParams& f = record.falloff;
   // Gravity without a falloff weighs 1 everywhere (fl_falloff_weight): its constant added as a
   // vector loop gives the same sums as the general loop below.
   if (std::holds_alternative<Gravity>(action) && !(f.radius < kInfinity)) {
-    const cl::FlXyz g = r.own.gravity.acceleration;
+    const cl::FlXyz g = record.own.gravity.acceleration;
     const float k[3] = {g.x, g.y, g.z};
     for (int d = 0; d < 3; ++d) {
       float* __restrict a = s.a[d];
@@ -53,64 +71,70 @@ inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std
   std::visit(
       [&](const auto& a) {
         using A = std::decay_t<decltype(a)>;
-        for (std::size_t i = 0; i < n; ++i) {
-          const Vec3 p = get(s.p, i), v = get(s.v, i);
-          float ax = s.a[0][i], ay = s.a[1][i], az = s.a[2][i];
-          Vec3 acc(0.0f);  // drawn from the CPU's own domains, or summed over neighbours
-          if constexpr (std::is_same_v<A, Gravity>) {
-            kernel::fl_gravity_acc(r.own.gravity, f, p.x, p.y, p.z, &ax, &ay, &az);
-          } else if constexpr (std::is_same_v<A, Damping>) {
-            kernel::fl_damping_acc(r.own.damping, f, p.x, p.y, p.z, v.x, v.y, v.z, &ax, &ay, &az);
-          } else if constexpr (std::is_same_v<A, OrbitPoint>) {
-            kernel::fl_orbit_point_acc(r.own.orbitPoint, p.x, p.y, p.z, &ax, &ay, &az);
-          } else if constexpr (std::is_same_v<A, OrbitLine>) {
-            kernel::fl_orbit_line_acc(r.own.orbitLine, p.x, p.y, p.z, &ax, &ay, &az);
-          } else if constexpr (std::is_same_v<A, Gravitate>) {
-            const Snapshot& sn = *c.snapshot;
-            for (std::size_t j = 0; j < sn.size; ++j)
-              if (j != c.base + i)
-                acc += softPull(Vec3(sn.p[0][j], sn.p[1][j], sn.p[2][j]) - p, r.own.pull);
-          } else if constexpr (std::is_same_v<A, Follow>) {
-            const Snapshot& sn = *c.snapshot;
-            const std::size_t next = c.base + i + 1;
-            if (next < sn.size)
-              acc = softPull(Vec3(sn.p[0][next], sn.p[1][next], sn.p[2][next]) - p, r.own.pull);
-          } else if constexpr (std::is_same_v<A, Vortex>) {
-            kernel::fl_vortex_acc(r.own.vortex, p.x, p.y, p.z, v.x, v.y, v.z, &ax, &ay, &az);
-          } else if constexpr (std::is_same_v<A, Jet>) {
-            if (kernel::fl_jet_reaches(r.own.jet, p.x, p.y, p.z)) {
-              Random rng = actionRandom(c, L, i);
-              acc = a.acceleration.sample(rng);
-            }
-          } else if constexpr (std::is_same_v<A, Explosion>) {
-            kernel::fl_explosion_acc(r.own.explosion, t, p.x, p.y, p.z, &ax, &ay, &az);
-          } else if constexpr (std::is_same_v<A, RandomAccel>) {
-            Random rng = actionRandom(c, L, i);
-            acc = a.acceleration.sample(rng) * kernel::fl_falloff_weight(f, p.x, p.y, p.z);
-          } else if constexpr (std::is_same_v<A, Turbulence>) {
-            kernel::fl_turbulence_acc(r.own.turbulence, f, t, p.x, p.y, p.z, &ax, &ay, &az);
-          } else if constexpr (std::is_same_v<A, ElectricField>) {
-            kernel::fl_electric_acc(r.own.electric, f, p.x, p.y, p.z, L.charge[i], L.mass[i], &ax,
-                                    &ay, &az);
-          } else if constexpr (std::is_same_v<A, MagneticField>) {
-            kernel::fl_magnetic_acc(r.own.magnetic, f, p.x, p.y, p.z, v.x, v.y, v.z, L.charge[i],
-                                    L.mass[i], &ax, &ay, &az);
-          } else if constexpr (std::is_same_v<A, SampledField>) {
-            const Vec3 u = sampleTrilinear(*a.field, p);
-            kernel::fl_sampled_field_acc(r.own.sampledField,
-                                         kernel::fl_falloff_weight(f, p.x, p.y, p.z), u.x, u.y, u.z,
-                                         v.x, v.y, v.z, &ax, &ay, &az);
-          }
-          if constexpr (std::is_same_v<A, Gravitate> || std::is_same_v<A, Follow> ||
-                        std::is_same_v<A, Jet> || std::is_same_v<A, RandomAccel>) {
-            ax += acc.x;
-            ay += acc.y;
-            az += acc.z;
-          }
-          s.a[0][i] = ax;
-          s.a[1][i] = ay;
-          s.a[2][i] = az;
-        }
+        // The record by value and the stage's arrays as a function's restricted arguments
+        // (stageLoop): GCC read them again for each particle (the stage's stores might have
+        // changed them), and kept the loop scalar.
+        const cl::FlActionParams r = record;
+        const cl::FlFalloffParams f = r.falloff;
+        const float* __restrict charge = L.charge;
+        const float* __restrict mass = L.mass;
+        stageLoop(
+            s, n,
+            [r, f, t, charge, mass, &a, &c, &L](std::size_t i, Vec3 p, Vec3 v, float& ax, float& ay,
+                                                float& az) {
+              Vec3 acc(0.0f);  // drawn from the CPU's own domains, or summed over neighbours
+              if constexpr (std::is_same_v<A, Gravity>) {
+                kernel::fl_gravity_acc(r.own.gravity, f, p.x, p.y, p.z, &ax, &ay, &az);
+              } else if constexpr (std::is_same_v<A, Damping>) {
+                kernel::fl_damping_acc(r.own.damping, f, p.x, p.y, p.z, v.x, v.y, v.z, &ax, &ay,
+                                       &az);
+              } else if constexpr (std::is_same_v<A, OrbitPoint>) {
+                kernel::fl_orbit_point_acc(r.own.orbitPoint, p.x, p.y, p.z, &ax, &ay, &az);
+              } else if constexpr (std::is_same_v<A, OrbitLine>) {
+                kernel::fl_orbit_line_acc(r.own.orbitLine, p.x, p.y, p.z, &ax, &ay, &az);
+              } else if constexpr (std::is_same_v<A, Gravitate>) {
+                const Snapshot& sn = *c.snapshot;
+                for (std::size_t j = 0; j < sn.size; ++j)
+                  if (j != c.base + i)
+                    acc += softPull(Vec3(sn.p[0][j], sn.p[1][j], sn.p[2][j]) - p, r.own.pull);
+              } else if constexpr (std::is_same_v<A, Follow>) {
+                const Snapshot& sn = *c.snapshot;
+                const std::size_t next = c.base + i + 1;
+                if (next < sn.size)
+                  acc = softPull(Vec3(sn.p[0][next], sn.p[1][next], sn.p[2][next]) - p, r.own.pull);
+              } else if constexpr (std::is_same_v<A, Vortex>) {
+                kernel::fl_vortex_acc(r.own.vortex, p.x, p.y, p.z, v.x, v.y, v.z, &ax, &ay, &az);
+              } else if constexpr (std::is_same_v<A, Jet>) {
+                if (kernel::fl_jet_reaches(r.own.jet, p.x, p.y, p.z)) {
+                  Random rng = actionRandom(c, L, i);
+                  acc = a.acceleration.sample(rng);
+                }
+              } else if constexpr (std::is_same_v<A, Explosion>) {
+                kernel::fl_explosion_acc(r.own.explosion, t, p.x, p.y, p.z, &ax, &ay, &az);
+              } else if constexpr (std::is_same_v<A, RandomAccel>) {
+                Random rng = actionRandom(c, L, i);
+                acc = a.acceleration.sample(rng) * kernel::fl_falloff_weight(f, p.x, p.y, p.z);
+              } else if constexpr (std::is_same_v<A, Turbulence>) {
+                kernel::fl_turbulence_acc(r.own.turbulence, f, t, p.x, p.y, p.z, &ax, &ay, &az);
+              } else if constexpr (std::is_same_v<A, ElectricField>) {
+                kernel::fl_electric_acc(r.own.electric, f, p.x, p.y, p.z, charge[i], mass[i], &ax,
+                                        &ay, &az);
+              } else if constexpr (std::is_same_v<A, MagneticField>) {
+                kernel::fl_magnetic_acc(r.own.magnetic, f, p.x, p.y, p.z, v.x, v.y, v.z, charge[i],
+                                        mass[i], &ax, &ay, &az);
+              } else if constexpr (std::is_same_v<A, SampledField>) {
+                const Vec3 u = sampleTrilinear(*a.field, p);
+                kernel::fl_sampled_field_acc(r.own.sampledField,
+                                             kernel::fl_falloff_weight(f, p.x, p.y, p.z), u.x, u.y,
+                                             u.z, v.x, v.y, v.z, &ax, &ay, &az);
+              }
+              if constexpr (std::is_same_v<A, Gravitate> || std::is_same_v<A, Follow> ||
+                            std::is_same_v<A, Jet> || std::is_same_v<A, RandomAccel>) {
+                ax += acc.x;
+                ay += acc.y;
+                az += acc.z;
+              }
+            });
       },
       action);
 }
