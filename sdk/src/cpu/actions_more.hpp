@@ -553,33 +553,33 @@ inline void apply(const Turbulence&, const Lanes& L, std::size_t n, const BlockC
   }
 }
 
-inline void apply(const ElectricField&, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const cl::FlActionParams& r = c.record();
-  const cl::FlElectricParams e = r.own.electric;
+// A field acting on charge over mass: f(falloff, dt, px, py, pz, x, y, z, charge, mass) on
+// each particle's velocity, in a vector loop (velocityLoop, withFalloff).
+template <class F>
+inline void chargedLoop(const Lanes& L, std::size_t n, const BlockContext& c, F f) {
   const float* __restrict charge = L.charge;
   const float* __restrict mass = L.mass;
-  withFalloff(r.falloff, [&](auto fall) {
+  withFalloff(c.record().falloff, [&](auto fall) {
     velocityLoop(L, n, c,
-                 [e, fall, charge, mass](std::size_t i, float px, float py, float pz, float dt,
+                 [f, fall, charge, mass](std::size_t i, float px, float py, float pz, float dt,
                                          float* x, float* y, float* z) {
-                   kernel::fl_electric(e, fall(), dt, px, py, pz, x, y, z, charge[i], mass[i]);
+                   f(fall(), dt, px, py, pz, x, y, z, charge[i], mass[i]);
                  });
   });
 }
 
+inline void apply(const ElectricField&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const cl::FlElectricParams e = c.record().own.electric;
+  chargedLoop(L, n, c, [e](const cl::FlFalloffParams& f, auto... args) {
+    kernel::fl_electric(e, f, args...);
+  });
+}
+
 inline void apply(const MagneticField&, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const cl::FlActionParams& r = c.record();
-  const cl::FlMagneticParams m = r.own.magnetic;
+  const cl::FlMagneticParams m = c.record().own.magnetic;
   if (!(m.strength > 0.0f)) return;
-  const float* __restrict charge = L.charge;
-  const float* __restrict mass = L.mass;
-  withFalloff(r.falloff, [&](auto fall) {
-    velocityLoop(L, n, c,
-                 [m, fall, charge, mass](std::size_t i, float px, float py, float pz, float dt,
-                                         float* x, float* y, float* z) {
-                   kernel::fl_magnetic_field_on(m, fall(), dt, px, py, pz, x, y, z, charge[i],
-                                                mass[i]);
-                 });
+  chargedLoop(L, n, c, [m](const cl::FlFalloffParams& f, auto... args) {
+    kernel::fl_magnetic_field_on(m, f, args...);
   });
 }
 
