@@ -30,10 +30,6 @@ FL_INLINE float fl_approach(float rate, float dt) {
   return 1.0f - fl_expf(-rate * dt);
 }
 
-/* MatchVelocity and MatchRotVelocity: the mean of a field (fx, fy, fz) over the particles of
- * the step's start (n of them, at sx, sy, sz) within r2max (a squared radius) of p, `self`
- * left out, and the value (vx, vy, vz) carried towards it by k; left as it is with no
- * neighbour. */
 /* The value carried by k towards the mean of `count` neighbours' (their sum); as it was with
  * none. */
 FL_INLINE void fl_match_finish(float sumx, float sumy, float sumz, int count, float k, float* vx,
@@ -45,6 +41,10 @@ FL_INLINE void fl_match_finish(float sumx, float sumy, float sumz, int count, fl
   *vz = *vz + (sumz / c - *vz) * k;
 }
 
+/* MatchVelocity and MatchRotVelocity: the mean of a field (fx, fy, fz) over the particles of
+ * the step's start (n of them, at sx, sy, sz) within r2max (a squared radius) of p, `self`
+ * left out, and the value (vx, vy, vz) carried towards it by k; left as it is with no
+ * neighbour. */
 FL_INLINE void fl_match_mean(const FL_GLOBAL float* sx, const FL_GLOBAL float* sy,
                              const FL_GLOBAL float* sz, const FL_GLOBAL float* fx,
                              const FL_GLOBAL float* fy, const FL_GLOBAL float* fz, uint n,
@@ -215,7 +215,7 @@ FL_INLINE void fl_damping_accel(float rx, float ry, float rz, float w, float vx,
  * k = round(x 2/pi) by adding 1.5·2^52 (its spacing is 1; no conversion to an integer, so
  * no undefined behaviour for any x), pi/2 in three parts of 33 bits (k·part exact for
  * |k| < 2^20), then degree-13 and -14 polynomials in r. tests/test_random.cpp checks both
- * against libm's. |x| beyond 2^40 (an angle whose double has no fraction left to turn by)
+ * against libm's. |x| beyond 2^40 radians (no step's turn: the reduction would lose it)
  * turns by nothing; infinite or NaN x gives NaN. Without doubles the same steps in float
  * (1.5·2^23, |x| up to 2^22), less exact. */
 #ifdef FL_FP64
@@ -272,7 +272,6 @@ FL_INLINE void fl_turn_about(float kx, float ky, float kz, fl_real theta, float*
   *vz = (float)(z * ct + (dx * y - x * dy) * st + dz * d);
 }
 
-/* The Lorentz acceleration (v x B) q w; q is charge over mass. */
 /* Move turns the up vector with the angular velocity w: about w by |w| dt. */
 FL_INLINE void fl_turn_up(float dt, float* ux, float* uy, float* uz, float wx, float wy,
                           float wz) {
@@ -281,6 +280,7 @@ FL_INLINE void fl_turn_up(float dt, float* ux, float* uy, float* uz, float wx, f
   fl_turn_about(wx / speed, wy / speed, wz / speed, (fl_real)(speed * dt), ux, uy, uz);
 }
 
+/* The Lorentz acceleration (v x B) q w; q is charge over mass. */
 FL_INLINE void fl_magnetic_accel(float Bx, float By, float Bz, float q, float w, float vx, float vy,
                                  float vz, float* ax, float* ay, float* az) {
   *ax += (vy * Bz - By * vz) * q * w;

@@ -145,9 +145,11 @@ template <class Shape, class Len>
 }
 
 // planarCrossingLoop over chunks of the block: f(first, m, gap, h) for each.
+constexpr std::size_t kCrossingChunk = 256;
+using CrossingPoints = const float (*)[kCrossingChunk];
 template <class Len, class F>
 inline void planarCrossings(const Domain& piece, const Lanes& L, std::size_t n, Len len, F f) {
-  constexpr std::size_t kChunk = 256;
+  constexpr std::size_t kChunk = kCrossingChunk;
   alignas(64) float gap[kChunk], h[3][kChunk];
   std::visit(
       [&]<class Shape>(const Shape& s) {
@@ -157,7 +159,7 @@ inline void planarCrossings(const Domain& piece, const Lanes& L, std::size_t n, 
             planarCrossingLoop(s, L.p[0] + first, L.p[1] + first, L.p[2] + first, L.v[0] + first,
                                L.v[1] + first, L.v[2] + first, OffsetDt<Len>{len, first}, m, gap,
                                h[0], h[1], h[2]);
-            f(first, m, static_cast<const float*>(gap), h);
+            f(first, m, static_cast<const float*>(gap), CrossingPoints(h));
           }
         }
       },
@@ -198,14 +200,13 @@ inline void apply(const Sink& a, const Lanes& L, std::size_t n, const BlockConte
     });
   } else {  // Hit: the coming Move crosses the plane piece (an infinite gap: it does not)
     withDt(c, [&](auto dt) {
-      planarCrossings(
-          a.region, L, n, dt,
-          [&](std::size_t first, std::size_t m, const float* gap, const float(*h)[256]) {
-            std::uint32_t* __restrict dead = c.dead + first;
-            for (std::size_t k = 0; k < m; ++k)
-              dead[k] =
-                  kernel::fl_dead_sink_hit(gap[k], Vec3(h[0][k], h[1][k], h[2][k]), code, dead[k]);
-          });
+      planarCrossings(a.region, L, n, dt,
+                      [&](std::size_t first, std::size_t m, const float* gap, CrossingPoints h) {
+                        std::uint32_t* __restrict dead = c.dead + first;
+                        for (std::size_t k = 0; k < m; ++k)
+                          dead[k] = kernel::fl_dead_sink_hit(
+                              gap[k], Vec3(h[0][k], h[1][k], h[2][k]), code, dead[k]);
+                      });
     });
   }
   passThrough(c, L, n, c.record().own.sink.passThrough);
@@ -264,6 +265,20 @@ inline void apply(const OrbitLine&, const Lanes& L, std::size_t n, const BlockCo
 constexpr std::size_t kMatchWidth = FLURRY_ISA_FLOATS, kMatchLanes = 2 * kMatchWidth;
 using MatchFloats = float __attribute__((vector_size(4 * kMatchWidth)));
 using MatchInts = std::int32_t __attribute__((vector_size(4 * kMatchWidth)));
+// The positions and indices of the block's particles i0.. (up to kMatchLanes) a scan takes;
+// lanes past the block at the origin, with no index to skip.
+struct ScanLanes {
+  alignas(64) float p[3][kMatchLanes] = {};
+  alignas(64) std::int32_t own[kMatchLanes];
+  std::size_t lanes;
+  ScanLanes(const float* const* pos, std::size_t base, std::size_t i0, std::size_t n)
+      : lanes(std::min(kMatchLanes, n - i0)) {
+    for (std::size_t l = 0; l < kMatchLanes; ++l) own[l] = std::int32_t(base + i0 + l);
+    for (int d = 0; d < 3; ++d)
+      for (std::size_t l = 0; l < lanes; ++l) p[d][l] = pos[d][i0 + l];
+  }
+};
+
 inline void matchScan(const float* __restrict sx, const float* __restrict sy,
                       const float* __restrict sz, const float* __restrict fx,
                       const float* __restrict fy, const float* __restrict fz, std::size_t others,
@@ -333,15 +348,11 @@ inline void apply(const Gravitate&, const Lanes& L, std::size_t n, const BlockCo
   const cl::FlPullParams q = c.record().own.pull;
   const Snapshot& s = *c.snapshot;
   for (std::size_t i0 = 0; i0 < n; i0 += kMatchLanes) {
-    const std::size_t lanes = std::min(kMatchLanes, n - i0);
-    alignas(64) float px[kMatchLanes] = {}, py[kMatchLanes] = {}, pz[kMatchLanes] = {};
+    const ScanLanes at0(L.p, c.base, i0, n);
+    const std::size_t lanes = at0.lanes;
     alignas(64) float ax[kMatchLanes], ay[kMatchLanes], az[kMatchLanes];
-    alignas(64) std::int32_t own[kMatchLanes];
-    for (std::size_t l = 0; l < kMatchLanes; ++l)
-      own[l] = std::int32_t(c.base + i0 + l);  // (lanes past the block: no index to skip)
-    for (std::size_t l = 0; l < lanes; ++l)
-      px[l] = L.p[0][i0 + l], py[l] = L.p[1][i0 + l], pz[l] = L.p[2][i0 + l];
-    gravitateScan(s.p[0], s.p[1], s.p[2], s.size, px, py, pz, own, q, ax, ay, az);
+    gravitateScan(s.p[0], s.p[1], s.p[2], s.size, at0.p[0], at0.p[1], at0.p[2], at0.own, q, ax, ay,
+                  az);
     for (std::size_t l = 0; l < lanes; ++l) {
       const std::size_t i = i0 + l;
       put(L.v, i, at(L.v, i) + Vec3(ax[l], ay[l], az[l]) * c.dtAt(i));
@@ -634,7 +645,7 @@ inline void apply(const Avoid& a, const Lanes& L, std::size_t n, const BlockCont
   };
   if (planar) {  // the look-ahead path crosses the piece
     planarCrossings(a.obstacle, L, n, UniformDt{avoid.lookAhead},
-                    [&](std::size_t first, std::size_t m, const float* gap, const float(*)[256]) {
+                    [&](std::size_t first, std::size_t m, const float* gap, CrossingPoints) {
                       for (std::size_t k = 0; k < m; ++k)
                         if (gap[k] < kInfinity &&  // (most do not cross: no length taken)
                             gap[k] < 1e-4f * (1.0f + glm::length(at(L.p, first + k)))) [[unlikely]]
@@ -677,16 +688,12 @@ inline void matchMean(const Snapshot& s, const float* const* self, const float* 
   const cl::FlMatchParams m = c.record().own.match;
   const float kStep = kernel::fl_match_k(m, c.dt);
   for (std::size_t i0 = 0; i0 < n; i0 += kMatchLanes) {
-    const std::size_t lanes = std::min(kMatchLanes, n - i0);
-    alignas(64) float px[kMatchLanes] = {}, py[kMatchLanes] = {}, pz[kMatchLanes] = {};
+    const ScanLanes at0(self, c.base, i0, n);
+    const std::size_t lanes = at0.lanes;
     alignas(64) float sumx[kMatchLanes], sumy[kMatchLanes], sumz[kMatchLanes];
-    alignas(64) std::int32_t count[kMatchLanes], own[kMatchLanes];
-    for (std::size_t l = 0; l < kMatchLanes; ++l)
-      own[l] = std::int32_t(c.base + i0 + l);  // (lanes past the block: no index to skip)
-    for (std::size_t l = 0; l < lanes; ++l)
-      px[l] = self[0][i0 + l], py[l] = self[1][i0 + l], pz[l] = self[2][i0 + l];
-    matchScan(s.p[0], s.p[1], s.p[2], field[0], field[1], field[2], s.size, px, py, pz, own,
-              m.maxRadius2, sumx, sumy, sumz, count);
+    alignas(64) std::int32_t count[kMatchLanes];
+    matchScan(s.p[0], s.p[1], s.p[2], field[0], field[1], field[2], s.size, at0.p[0], at0.p[1],
+              at0.p[2], at0.own, m.maxRadius2, sumx, sumy, sumz, count);
     for (std::size_t l = 0; l < lanes; ++l) {
       const std::size_t i = i0 + l;
       const float k = c.ownDt ? kernel::fl_match_k(m, c.ownDt[i]) : kStep;
