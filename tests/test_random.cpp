@@ -182,12 +182,13 @@ TEST(Random, KernelsPowIsWithinTwoUlps) {
   EXPECT_EQ(k::fl_powf(0.5f, 3.0f), 0.125f);
 }
 
-// fl_sincos_real (kernels/forces.h): a MagneticField's turn, on both backends, in double
-// (whose result rounds to float: two of double's ulps are 2^-29 of float's).
+// fl_sincos_real (kernels/forces.h): a MagneticField's turn and Move's of the up vector, on
+// both backends, in double (whose result rounds to float: two of double's ulps are 2^-29 of
+// float's).
 TEST(Random, KernelsSinCosAreWithinTwoUlpsOfDouble) {
   namespace k = flurry::detail::kernel;
-  // In double's ulps at the result (sin and cos near their zeros are compared at 1e-300's
-  // scale by a floor on the spacing: what matters there is the absolute error, ~1e-17).
+  // In double's ulps at the result; near sin's and cos's zeros, where that spacing shrinks
+  // without bound, in units of 1e-17 (the absolute error is what a turn feels there).
   auto ulpsD = [](double got, double want) {
     const double spacing = std::max(std::abs(std::nextafter(want, INFINITY) - want), 1e-17);
     return std::abs(got - want) / spacing;
