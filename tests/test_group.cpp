@@ -170,14 +170,13 @@ TEST(Group, CompactionKeepsEverySurvivorOnceWithItsLanes) {
 // compacted alone), every lane and trail point bit for bit, on any number of threads, however
 // the dead fall.
 TEST(Group, AWalkThatFillsHolesLeavesWhatCompactionWould) {
-  // (The last block's holes are the back's on more than one thread: compaction's alone.)
-  const std::tuple<const char*, bool (*)(std::size_t), bool> patterns[] = {
-      {"every third, and the tail", [](std::size_t i) { return i % 3 == 0 || i >= 70000; }, true},
-      {"nine in ten", [](std::size_t i) { return (i * 2654435761u) % 10 != 0; }, true},
-      {"the first half", [](std::size_t i) { return i < 40000; }, true},
-      {"the last block", [](std::size_t i) { return i >= 79000; }, false},
-      {"one in a hundred", [](std::size_t i) { return i % 100 == 7; }, true}};
-  for (const auto& [name, dies, front] : patterns) {
+  const std::pair<const char*, bool (*)(std::size_t)> patterns[] = {
+      {"every third, and the tail", [](std::size_t i) { return i % 3 == 0 || i >= 70000; }},
+      {"nine in ten", [](std::size_t i) { return (i * 2654435761u) % 10 != 0; }},
+      {"the first half", [](std::size_t i) { return i < 40000; }},
+      {"the last block", [](std::size_t i) { return i >= 79000; }},
+      {"one in a hundred", [](std::size_t i) { return i % 100 == 7; }}};
+  for (const auto& [name, dies] : patterns) {
     SCOPED_TRACE(name);
     auto run = [&, dies = dies](unsigned threads, std::uint64_t* filled, bool events = false) {
       Context ctx({.seed = 3, .dt = 0.1, .threads = threads});
@@ -227,7 +226,10 @@ TEST(Group, AWalkThatFillsHolesLeavesWhatCompactionWould) {
       SCOPED_TRACE(threads);
       std::uint64_t walked = 0;
       const auto got = run(threads, &walked);
-      if (threads == 1 || front) {
+      // On one thread the walk fills for certain; on more, the others may take every block
+      // before the front's thread is scheduled (seen on 4 threads of a loaded 2-core
+      // machine), and then compaction alone closes the holes: the bits below are the test.
+      if (threads == 1) {
         EXPECT_GT(walked, 0u) << "the walk filled no hole";
       }
       ASSERT_EQ(got.size(), alone.size());
