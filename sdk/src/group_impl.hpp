@@ -189,6 +189,14 @@ struct ActionPlan {
   // Per action: its result does not depend on the step's length or time (a sink by region,
   // KillOld, colour over life, ...), so it runs over a block of newborns as over any block.
   std::vector<std::uint8_t> timeFree;
+  // Per action: over a batch of newborns it runs with each one's own step length
+  // (BlockContext::ownDt) in one call, as over a block; 0 where it reads the time itself
+  // (it runs per newborn, at the newborn's own time).
+  std::vector<std::uint8_t> ownDt;
+  /// Every action is time-free or takes own step lengths, and none takes a factor once for
+  /// a block's step (factorPerStep): a block's newborns run the list with the block's other
+  /// particles in one pass (each of those with the whole sub-step as its own).
+  bool newbornsWithBlock = false;
   bool guarded = false;  ///< some Move guards against Bounces
   /// The NaN guard must scan velocities too: not when an explicit-Euler Move follows every
   /// action that changes them, as p + v·dt is then not finite wherever v is not.

@@ -61,7 +61,9 @@ inline void logCollisions(const Bounce& b, std::uint32_t action, const Lanes& L,
     e.action = action;
     // The particle's sub-step began at the block's time, or for a newborn of the batch
     // (its own step length) (substeps - sub) of its sub-step lengths before the end.
-    const double start = c.ownDt ? log.t1 - double(dt) * double(log.substeps - log.sub) : c.time;
+    const double start = c.ownDt && i >= c.newbornsFrom
+                             ? log.t1 - double(dt) * double(log.substeps - log.sub)
+                             : c.time;
     e.time = start + double(tau);
     // A particle left NaN or infinite by the list is killed by the step, not reported.
     const float sum = e.position.x + e.position.y + e.position.z + e.velocity.x + e.velocity.y +

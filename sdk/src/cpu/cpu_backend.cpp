@@ -22,6 +22,40 @@ bool isTimeFree(const Action& a) {
          std::holds_alternative<ColorOverLife>(a) || std::holds_alternative<SizeOverLife>(a) ||
          std::holds_alternative<Constrain2D>(a) || std::holds_alternative<CopyVertexB>(a);
 }
+// Whether an action reads the time itself, not only the step's length.
+bool readsTime(const Action& act) {
+  if (const auto* t = std::get_if<Turbulence>(&act)) return t->drift != Vec3(0.0f);
+  return std::holds_alternative<Explosion>(act) || std::holds_alternative<Restore>(act) ||
+         std::holds_alternative<Callback>(act);
+}
+
+// Whether action k runs over a batch of newborns, each with its own step length
+// (BlockContext::ownDt), in one call like a block. What reads the time itself runs per
+// newborn instead, at its own time: an action, or the forces an integrating Move (or a
+// bounce on its curved path) evaluates at its stages.
+bool takesOwnDt(const std::vector<Action>& acts, const ActionPlan& list, std::size_t k) {
+  const auto forcesReadTime = [&](std::size_t move) {
+    for (std::uint32_t f : list.forcesOf[move])
+      if (readsTime(acts[f])) return true;
+    return false;
+  };
+  if (list.curvedBy[k]) return !forcesReadTime(list.curvedBy[k] - 1);
+  if (std::holds_alternative<Move>(acts[k]))
+    return list.integrator == Integrator::SemiImplicitEuler || !forcesReadTime(k);
+  return !readsTime(acts[k]);
+}
+
+// Whether the action's block form takes a factor (an exp) once for the block's step, which
+// its own-step form takes per particle: run over a whole block with own step lengths, it
+// would cost more than the newborns' runs of their own.
+bool factorPerStep(const Action& a) {
+  return std::holds_alternative<Damping>(a) || std::holds_alternative<RotDamping>(a) ||
+         std::holds_alternative<Vortex>(a) || std::holds_alternative<MatchVelocity>(a) ||
+         std::holds_alternative<MatchRotVelocity>(a) || std::holds_alternative<TargetVelocity>(a) ||
+         std::holds_alternative<TargetRotVelocity>(a) || std::holds_alternative<TargetColor>(a) ||
+         std::holds_alternative<TargetSize>(a);
+}
+
 // The axis-aligned box a shape lies in; false for unbounded shapes (plane) and for those
 // whose tests are not confined to their bounds exactly enough to rely on (mesh, union).
 bool shapeBox(const Domain& d, Vec3& lo, Vec3& hi) {
@@ -171,6 +205,13 @@ const ActionPlan& planActions(GroupImpl& g) {
     plan.guardVelocity = plan.integrator != Integrator::SemiImplicitEuler ||
                          lastMove == acts.size() ||
                          (lastChange != acts.size() && lastChange > lastMove);
+  }
+  plan.ownDt.assign(acts.size(), 0);
+  plan.newbornsWithBlock = true;
+  for (std::size_t k = 0; k < acts.size(); ++k) {
+    plan.ownDt[k] = takesOwnDt(acts, plan, k);
+    plan.newbornsWithBlock &=
+        !factorPerStep(acts[k]) && (plan.gathered[k] || plan.timeFree[k] || plan.ownDt[k]);
   }
   plan.readsNeighbours = g.actions.readsNeighbours();
   plan.firstBlocker = ~0u;

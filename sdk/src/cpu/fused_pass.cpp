@@ -324,27 +324,17 @@ void shiftStart(cpu::BlockContext& c, std::size_t by) {
     if (s) s += by;
 }
 
-// Whether an action reads the time itself, not only the step's length.
-bool readsTime(const Action& act) {
-  if (const auto* t = std::get_if<Turbulence>(&act)) return t->drift != Vec3(0.0f);
-  return std::holds_alternative<Explosion>(act) || std::holds_alternative<Restore>(act) ||
-         std::holds_alternative<Callback>(act);
+// The thread's room for `count` step lengths (BlockContext::ownDt).
+float* ownDtScratch(std::size_t count) {
+  thread_local std::vector<float> store;
+  std::vector<float>& own = store;  // one TLS lookup
+  if (own.size() < count) own.resize(std::max<std::size_t>(count, 1024));
+  return own.data();
 }
 
-// Whether action k runs over a batch of newborns, each with its own step length
-// (BlockContext::ownDt), in one call like a block. What reads the time itself runs per
-// newborn instead, at its own time: an action, or the forces an integrating Move (or a
-// bounce on its curved path) evaluates at its stages.
-bool takesOwnDt(const std::vector<Action>& acts, const ActionPlan& list, std::size_t k) {
-  const auto forcesReadTime = [&](std::size_t move) {
-    for (std::uint32_t f : list.forcesOf[move])
-      if (readsTime(acts[f])) return true;
-    return false;
-  };
-  if (list.curvedBy[k]) return !forcesReadTime(list.curvedBy[k] - 1);
-  if (std::holds_alternative<Move>(acts[k]))
-    return list.integrator == Integrator::SemiImplicitEuler || !forcesReadTime(k);
-  return !readsTime(acts[k]);
+// A newborn's sub-step: its part of the step, `remaining`, in plan.substeps.
+float newbornDt(float remaining, const Plan& plan) {
+  return float(double(remaining) / double(plan.substeps));
 }
 
 // Actions [first, last) of the list over a block's newborns, [0, count) of `lanes`: each
@@ -356,20 +346,17 @@ void runNewborns(const std::vector<Action>& acts, const Plan& plan, std::size_t 
                  const cpu::BlockContext& ctx, const float* remaining, std::uint32_t sub,
                  double t1) {
   // Each newborn's sub-step length.
-  thread_local std::vector<float> ownStore;
-  std::vector<float>& own = ownStore;
-  if (own.size() < count) own.resize(std::max<std::size_t>(count, 1024));
-  for (std::size_t i = 0; i < count; ++i)
-    own[i] = float(double(remaining[i]) / double(plan.substeps));
+  float* const own = ownDtScratch(count);
+  for (std::size_t i = 0; i < count; ++i) own[i] = newbornDt(remaining[i], plan);
   cpu::BlockContext batch = ctx;
-  batch.ownDt = own.data();
+  batch.ownDt = own;
   for (std::size_t k = first; k < last; ++k) {
     if (plan.list.gathered[k]) continue;  // evaluated inside its Move
     if (plan.list.timeFree[k]) {
       runActions(acts, plan, k, k + 1, lanes, count, ctx);
       continue;
     }
-    if (takesOwnDt(acts, plan.list, k)) {
+    if (plan.list.ownDt[k]) {
       runActions(acts, plan, k, k + 1, lanes, count, batch);
       continue;
     }
@@ -391,9 +378,23 @@ void runBlock(const std::vector<Action>& acts, const Plan& plan, std::size_t fir
               std::size_t last, const Lanes& lanes, std::size_t m, std::size_t old,
               const cpu::BlockContext& ctx, const float* remaining, std::uint32_t sub, double t1,
               Culler* cull = nullptr) {
+  if (old == m) return runActions(acts, plan, first, last, lanes, m, ctx, cull);
+  if (plan.list.newbornsWithBlock) {
+    // One pass, each particle with its own sub-step: the whole one for those that began the
+    // step (the arithmetic of a uniform step, bit for bit: both backends compute every
+    // action from a particle's own length), what is left of it for the newborns. A small
+    // group's few newborns then cost no runs of their own. The culling's swept bounds take
+    // the whole sub-step, which covers the newborns' shorter paths.
+    float* const own = ownDtScratch(m);
+    std::fill_n(own, old, ctx.dt);
+    for (std::size_t i = old; i < m; ++i) own[i] = newbornDt(remaining[i - old], plan);
+    cpu::BlockContext batch = ctx;
+    batch.ownDt = own;
+    batch.newbornsFrom = old;
+    return runActions(acts, plan, first, last, lanes, m, batch, old > 0 ? cull : nullptr);
+  }
   // Newborns (the block's tail from `old` on) are never culled.
   if (old > 0) runActions(acts, plan, first, last, lanes, old, ctx, cull);
-  if (old == m) return;
   cpu::BlockContext c = ctx;
   c.base += old;
   c.dead += old;

@@ -66,6 +66,9 @@ struct BlockContext {
   /// Newborns: each particle's own step length (what is left of its birth step), indexed as
   /// `dead`; null when every particle of the block steps `dt`.
   const float* ownDt = nullptr;
+  /// With ownDt: the newborns are the particles from this index on (those before it began
+  /// the step and step the whole sub-step: a block run with its newborns in one pass).
+  std::size_t newbornsFrom = 0;
   CollisionLog* collisions = nullptr;  ///< non-null while the group records collisions
   /// The list's records (actionRecords), made for the sub-step's length.
   const cl::FlActionParams* records = nullptr;
