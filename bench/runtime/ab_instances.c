@@ -13,7 +13,9 @@
  *
  * (one command line; OLD built as scripts/compare_libraries.py says). The same library
  * against itself gives ratios of 1 within a few percent: what a difference must beat.
- * `--bounds 1` also reads every instance's box after each step, as a game culling them does.
+ * `--bounds 1` also reads every instance's box after each step, as a game culling them does;
+ * `--move 1` moves every instance before each step (a little along x, turned a little more
+ * about y), as a game moves the effects it attaches to what moves.
  * Where the public headers changed between the two, give the old one the C API built with
  * it (`--old-capi OLD/libflurry_c.so`).
  */
@@ -98,15 +100,25 @@ static void check(flurry_status s, const char* what) {
   }
 }
 
+/* Instance k on a grid of `side` a row, turned by 0.37 k about y; `moved` steps later a
+ * hundredth of a unit further along x and turned a hundredth of a radian more each step. */
+static void place(Library* L, long k, long side, long moved) {
+  const float at[3] = {(float)(k % side) * 4.0f + 0.01f * (float)moved, 0.0f,
+                       (float)(k / side) * 4.0f};
+  const float half = ((float)k * 0.37f + 0.01f * (float)moved) * 0.5f; /* (x, y, z, w) */
+  const float turn[4] = {0.0f, sinf(half), 0.0f, cosf(half)};
+  check(L->place(L->instances[k], at, turn, 1.0f), "flurry_instance_set_transform");
+}
+
 int main(int argc, char** argv) {
   if (argc < 3) {
     fprintf(stderr,
             "usage: ab_instances OLD.so NEW.so [--instances N] [--threads T] [--slices S]\n"
-            "       [--steps K] [--rate R] [--bounds 0|1] [--capi libflurry_c.so]\n"
+            "       [--steps K] [--rate R] [--bounds 0|1] [--move 0|1] [--capi libflurry_c.so]\n"
             "       [--old-capi libflurry_c.so]\n");
     return 2;
   }
-  long instances = 1000, threads = 1, slices = 40, steps = 20, rate = 100, bounds = 0;
+  long instances = 1000, threads = 1, slices = 40, steps = 20, rate = 100, bounds = 0, move = 0;
   const char* capi = FLURRY_C_LIBRARY;
   const char* oldCapi = NULL;
   for (int i = 3; i + 1 < argc; i += 2) {
@@ -116,8 +128,8 @@ int main(int argc, char** argv) {
       continue;
     }
     const long v = strtol(argv[i + 1], NULL, 10);
-    if (!strcmp(k, "--bounds") && (v == 0 || v == 1)) {
-      bounds = v;
+    if ((!strcmp(k, "--bounds") || !strcmp(k, "--move")) && (v == 0 || v == 1)) {
+      *(!strcmp(k, "--bounds") ? &bounds : &move) = v;
       continue;
     }
     if (v <= 0) {
@@ -151,6 +163,7 @@ int main(int argc, char** argv) {
            "{\"type\": \"Move\"}, {\"type\": \"KillOld\"}]}]}",
            rate * 5 / 4 + 16, rate);
   Library L[2];
+  const long side = (long)ceil(sqrt((double)instances));
   for (int l = 0; l < 2; ++l) {
     load(&L[l], argv[1 + l], l == 0 && oldCapi ? oldCapi : capi);
     L[l].instances = malloc(sizeof(flurry_instance*) * (size_t)instances);
@@ -160,17 +173,13 @@ int main(int argc, char** argv) {
     check(L[l].create(&o, &L[l].ctx), "flurry_context_create");
     flurry_effect* effect;
     check(L[l].parse(json, "sparks", &effect), "flurry_effect_parse");
-    const long side = (long)ceil(sqrt((double)instances));
     for (long k = 0; k < instances; ++k) {
       char name[32];
       snprintf(name, sizeof name, "%ld", k);
       flurry_instance* instance;
       check(L[l].instantiate(effect, L[l].ctx, name, 0, &instance), "flurry_effect_instantiate");
-      const float at[3] = {(float)(k % side) * 4.0f, 0.0f, (float)(k / side) * 4.0f};
-      const float half = (float)k * 0.185f; /* turned by 0.37 k about y (x, y, z, w) */
-      const float turn[4] = {0.0f, sinf(half), 0.0f, cosf(half)};
-      check(L[l].place(instance, at, turn, 1.0f), "flurry_instance_set_transform");
       L[l].instances[k] = instance;
+      place(&L[l], k, side, 0);
     }
     check(L[l].run(L[l].ctx, 45), "flurry_context_run"); /* births and deaths balance */
   }
@@ -183,6 +192,7 @@ int main(int argc, char** argv) {
       const int l = (s & 1) ? 1 - j : j; /* each goes first in turn */
       const double t0 = seconds();
       for (long k = 0; k < steps; ++k) {
+        for (long i = 0; move && i < instances; ++i) place(&L[l], i, side, s * steps + k + 1);
         check(L[l].step(L[l].ctx), "flurry_context_step");
         for (long i = 0; bounds && i < instances; ++i) {
           float lo[3], hi[3];

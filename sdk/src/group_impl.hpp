@@ -179,6 +179,9 @@ class DeviceMirror {
 /// rebuilding it (and its allocations) would be a good part of the step.
 struct ActionPlan {
   std::uint64_t version = ~std::uint64_t(0);  ///< the actionsVersion it was built for
+  /// The actionsStructure its fields other than the reach were built for (a move changes
+  /// only the actions' constants, and of the plan only where they can act).
+  std::uint64_t structure = ~std::uint64_t(0);
   Integrator integrator = Integrator::SemiImplicitEuler;
   std::vector<std::uint8_t> gathered;                // a force an integrating Move evaluates
   std::vector<std::vector<std::uint32_t>> forcesOf;  // per Move: its forces

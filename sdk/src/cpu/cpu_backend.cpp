@@ -149,6 +149,10 @@ ActionPlan::Reach actionReach(const Action& a, const ActionPlan& plan, std::size
 
 }  // namespace
 
+namespace {
+void planStructure(GroupImpl& g, ActionPlan& plan);
+}  // namespace
+
 // Here, in a baseline translation unit, and not in the fused pass: the pass is compiled once
 // per instruction set, and the vector code it would instantiate here is shared between the
 // builds (the SSE2 build would then run the AVX2 copy).
@@ -156,10 +160,27 @@ const ActionPlan& planActions(GroupImpl& g) {
   ActionPlan& plan = g.plan;
   if (plan.version == g.actionsVersion) return plan;
   const auto& acts = g.actions.actions();
+  // What follows from the kinds of the actions and their order alone, which a move keeps
+  // (GroupImpl::actionsStructure): a moved instance takes only the reach of its actions
+  // again, every step it moves.
+  if (plan.structure != g.actionsStructure || plan.gathered.size() != acts.size())
+    planStructure(g, plan);
+  plan.reach.assign(acts.size(), {});
+  plan.cullable = false;
+  for (std::size_t k = 0; k < acts.size(); ++k) {
+    plan.reach[k] = actionReach(acts[k], plan, k);
+    plan.cullable |= plan.reach[k].cullable;
+  }
+  plan.version = g.actionsVersion;
+  return plan;
+}
+
+namespace {
+void planStructure(GroupImpl& g, ActionPlan& plan) {
+  const auto& acts = g.actions.actions();
   plan.integrator = g.actions.integrator();
   plan.gathered.assign(acts.size(), 0);
-  // Resized and cleared, not replaced: a moved instance rebuilds its plan every step, and
-  // the inner lists keep their storage.
+  // Resized and cleared, not replaced: the inner lists keep their storage.
   plan.forcesOf.resize(acts.size());
   plan.guardsOf.resize(acts.size());
   for (auto& f : plan.forcesOf) f.clear();
@@ -220,17 +241,11 @@ const ActionPlan& planActions(GroupImpl& g) {
       plan.firstBlocker = std::uint32_t(k);
       break;
     }
-  plan.reach.assign(acts.size(), {});
   plan.moves.assign(acts.size(), 0);
-  plan.cullable = false;
-  for (std::size_t k = 0; k < acts.size(); ++k) {
-    plan.reach[k] = actionReach(acts[k], plan, k);
-    plan.moves[k] = movesParticles(acts[k]);
-    plan.cullable |= plan.reach[k].cullable;
-  }
-  plan.version = g.actionsVersion;
-  return plan;
+  for (std::size_t k = 0; k < acts.size(); ++k) plan.moves[k] = movesParticles(acts[k]);
+  plan.structure = g.actionsStructure;
 }
+}  // namespace
 
 const cl::FlActionParams* actionRecords(GroupImpl& g, float dt) {
   ActionPlan& plan = g.plan;
