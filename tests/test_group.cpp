@@ -1623,6 +1623,40 @@ TEST(Instance, TheIdentityIsBitwiseNoTransform) {
   }
 }
 
+// A game sets every effect's transform each frame, most of them standing still: the same
+// transform again derives nothing (the actions keep their version, so no plan or device
+// constants are made again) and moves nothing, in either space (a local-space group's
+// particles are not carried by the turn times its inverse, which would round them).
+TEST(Instance, TheSameTransformAgainChangesNothing) {
+  for (const char* space : {"world", "local"}) {
+    SCOPED_TRACE(space);
+    const Effect fx = dropEffect(space);
+    Context once(fx.contextOptions()), everyStep(fx.contextOptions());
+    const Transform t{Vec3(7, 0.5f, 2), glm::angleAxis(0.3f, glm::normalize(Vec3(1, 2, 3))), 1.5f};
+    EffectInstance a = fx.instantiate(once, "x"), b = fx.instantiate(everyStep, "x");
+    a.setTransform(t);
+    b.setTransform(t);
+    const auto& impl = detail::implOf(*b.groups()[0]);
+    for (int s = 0; s < 40; ++s) {
+      const std::uint64_t version = impl.actionsVersion;
+      const auto before = allLanes(*b.groups()[0]);
+      b.setTransform(t);
+      EXPECT_EQ(impl.actionsVersion, version) << "step " << s;
+      ASSERT_EQ(allLanes(*b.groups()[0]), before) << "step " << s;
+      once.step();
+      everyStep.step();
+    }
+    ASSERT_GT(a.groups()[0]->size(), 0u);
+    EXPECT_EQ(allLanes(*a.groups()[0]), allLanes(*b.groups()[0]));
+    // A transform that differs in one bit is a move.
+    Transform nudged = t;
+    nudged.position.x = std::nextafter(t.position.x, 8.0f);
+    const std::uint64_t version = impl.actionsVersion;
+    b.setTransform(nudged);
+    EXPECT_NE(impl.actionsVersion, version);
+  }
+}
+
 namespace {
 // The effect's context options on `threads` threads.
 ContextOptions onThreads(const Effect& fx, unsigned threads) {

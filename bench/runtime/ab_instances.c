@@ -15,7 +15,8 @@
  * against itself gives ratios of 1 within a few percent: what a difference must beat.
  * `--bounds 1` also reads every instance's box after each step, as a game culling them does;
  * `--move 1` moves every instance before each step (a little along x, turned a little more
- * about y), as a game moves the effects it attaches to what moves.
+ * about y), as a game moves the effects it attaches to what moves; `--move 2` sets every
+ * instance's transform again, unchanged, as a game does for those standing still.
  * Where the public headers changed between the two, give the old one the C API built with
  * it (`--old-capi OLD/libflurry_c.so`).
  */
@@ -114,7 +115,7 @@ int main(int argc, char** argv) {
   if (argc < 3) {
     fprintf(stderr,
             "usage: ab_instances OLD.so NEW.so [--instances N] [--threads T] [--slices S]\n"
-            "       [--steps K] [--rate R] [--bounds 0|1] [--move 0|1] [--capi libflurry_c.so]\n"
+            "       [--steps K] [--rate R] [--bounds 0|1] [--move 0|1|2] [--capi libflurry_c.so]\n"
             "       [--old-capi libflurry_c.so]\n");
     return 2;
   }
@@ -128,8 +129,12 @@ int main(int argc, char** argv) {
       continue;
     }
     const long v = strtol(argv[i + 1], NULL, 10);
-    if ((!strcmp(k, "--bounds") || !strcmp(k, "--move")) && (v == 0 || v == 1)) {
-      *(!strcmp(k, "--bounds") ? &bounds : &move) = v;
+    if (!strcmp(k, "--bounds") && (v == 0 || v == 1)) {
+      bounds = v;
+      continue;
+    }
+    if (!strcmp(k, "--move") && v >= 0 && v <= 2) {
+      move = v;
       continue;
     }
     if (v <= 0) {
@@ -192,7 +197,8 @@ int main(int argc, char** argv) {
       const int l = (s & 1) ? 1 - j : j; /* each goes first in turn */
       const double t0 = seconds();
       for (long k = 0; k < steps; ++k) {
-        for (long i = 0; move && i < instances; ++i) place(&L[l], i, side, s * steps + k + 1);
+        for (long i = 0; move && i < instances; ++i)
+          place(&L[l], i, side, move == 1 ? s * steps + k + 1 : 0);
         check(L[l].step(L[l].ctx), "flurry_context_step");
         for (long i = 0; bounds && i < instances; ++i) {
           float lo[3], hi[3];

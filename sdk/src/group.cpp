@@ -367,6 +367,14 @@ namespace {
 // The world emitters and prime emitters as the frame's carried by t, in the storage of the
 // last ones: lists of the same lengths are assigned element by element, so that a group
 // moved every step allocates nothing (see carryEmitter for what still does).
+bool sameBits(const Transform& a, const Transform& b) {
+  const float x[8] = {a.position.x, a.position.y, a.position.z, a.rotation.w,
+                      a.rotation.x, a.rotation.y, a.rotation.z, a.scale};
+  const float y[8] = {b.position.x, b.position.y, b.position.z, b.rotation.w,
+                      b.rotation.x, b.rotation.y, b.rotation.z, b.scale};
+  return std::memcmp(x, y, sizeof x) == 0;
+}
+
 void deriveEmitters(detail::GroupImpl& g, const Transform& t) {
   const detail::Frame& f = *g.frame;
   const bool identity = t.isIdentity();
@@ -395,6 +403,11 @@ Group& Group::setTransform(const Transform& transform) {
   t.rotation = glm::normalize(t.rotation);
   if (t.rotation == glm::quat(-1.0f, 0.0f, 0.0f, 0.0f)) t.rotation = glm::quat(1.0f, 0, 0, 0);
   auto& g = *impl_;
+  // The same transform again, bit for bit (a game sets every effect's each frame, most of
+  // them standing still): nothing to derive, and nothing moves (a local-space group's
+  // particles, carried by the turn times its inverse, would take its rounding each time).
+  if (g.frame && sameBits(t, g.frame->transform) && g.frame->emittersDerived == g.emittersVersion)
+    return *this;
   const bool first = !g.frame;
   if (first) {
     // The lists as given become the frame's; the world's are their images at the identity.
