@@ -1657,6 +1657,45 @@ TEST(Instance, TheSameTransformAgainChangesNothing) {
   }
 }
 
+// A move leaves the group's lists to its next step (on the threads that step it) when they
+// can take any transform; a group whose emitters are edited every frame is placed at once.
+// Both end bitwise alike, in both spaces, and a group that may refuse (a box turns only by
+// quarter turns) still refuses at once and is left as it was.
+TEST(Instance, AMoveThePlacedStepTakesIsTheOneMadeAtOnce) {
+  for (const char* space : {"world", "local"}) {
+    SCOPED_TRACE(space);
+    const Effect fx = dropEffect(space);
+    ContextOptions o = fx.contextOptions();
+    o.threads = 2;
+    Context left(o), atOnce(o);
+    EffectInstance a = fx.instantiate(left, "x"), b = fx.instantiate(atOnce, "x");
+    for (int s = 0; s < 60; ++s) {
+      const Transform t{Vec3(0.05f * float(s), 0.5f, -0.03f * float(s)),
+                        glm::angleAxis(0.02f * float(s), glm::normalize(Vec3(0.3f, 1, 0.2f))),
+                        1.0f + 0.01f * float(s)};
+      a.setTransform(t);
+      (void)b.groups()[0]->emitters();  // (the span may edit them: placed at once)
+      b.setTransform(t);
+      EXPECT_EQ(b.groups()[0]->transform().position, t.position);
+      // (Once the lists have stood still from one move to the next: left to the step.)
+      if (s >= 2) EXPECT_FALSE(detail::implOf(*a.groups()[0]).frame->placed) << s;
+      EXPECT_TRUE(detail::implOf(*b.groups()[0]).frame->placed) << s;
+      left.step();
+      atOnce.step();
+    }
+    ASSERT_GT(a.groups()[0]->size(), 0u);
+    EXPECT_EQ(allLanes(*a.groups()[0]), allLanes(*b.groups()[0]));
+  }
+  Context ctx;
+  Group& g = ctx.createGroup("boxed", 100);
+  g.setActions({Sink{Domain::box(Vec3(-1.0f), Vec3(1.0f))}, Move{}});
+  const Transform quarter{Vec3(1, 2, 3), glm::angleAxis(glm::radians(90.0f), Vec3(0, 1, 0)), 1};
+  for (int k = 0; k < 3; ++k) g.setTransform(quarter);  // standing still: probed
+  g.setTransform({Vec3(2, 2, 3), quarter.rotation, 1});
+  EXPECT_THROW(g.setTransform({Vec3(0), glm::angleAxis(0.3f, Vec3(0, 1, 0)), 1}), InvalidArgument);
+  EXPECT_EQ(g.transform().position, Vec3(2, 2, 3));
+}
+
 namespace {
 // The effect's context options on `threads` threads.
 ContextOptions onThreads(const Effect& fx, unsigned threads) {

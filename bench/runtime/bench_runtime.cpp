@@ -10,7 +10,8 @@
 // After the runs it prints the ratio of the medians, per thread count, what bounds every step
 // cost, what a recorded death or collision event costs (Deaths, Collisions: recording on
 // against off), what a trail of 8 positions costs a particle (Trails), and what instances
-// out of sight cost stepped once every 4 frames (OutOfSight).
+// out of sight cost stepped once every 4 frames (OutOfSight), and what re-placing every
+// instance before each step costs, moved or set where it stands (Moving).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -99,6 +100,35 @@ void Instances(benchmark::State& state) {
   benchmark::DoNotOptimize(sink);
   state.SetItemsProcessed(std::int64_t(live));
   state.counters["live"] = live / double(state.iterations());
+  state.counters["us/instance"] =
+      benchmark::Counter(double(state.iterations()) * double(count) * 1e-6,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+// Instances a game re-places every frame: `count` (range 0) on `threads` (range 1), each given
+// before every step (range 2) a new transform (1: a hundredth of a unit further along x, a
+// hundredth of a radian more turned about y), or its own again (2: standing, set anyway), or
+// none (0: as Instances).
+void Moving(benchmark::State& state) {
+  const auto count = std::size_t(state.range(0));
+  ContextOptions o;
+  o.threads = unsigned(state.range(1));
+  Context ctx(o);
+  std::vector<EffectInstance> all = instances(ctx, count);
+  const int move = int(state.range(2));
+  std::int64_t step = 0;
+  for (auto _ : state) {
+    ++step;
+    for (std::size_t k = 0; move > 0 && k < count; ++k) {
+      Transform t = placeOf(k, count);
+      if (move == 1) {
+        t.position.x += 0.01f * float(step);
+        t.rotation = glm::angleAxis(float(k) * 0.37f + 0.01f * float(step), Vec3(0, 1, 0));
+      }
+      all[k].setTransform(t);
+    }
+    ctx.step();
+  }
   state.counters["us/instance"] =
       benchmark::Counter(double(state.iterations()) * double(count) * 1e-6,
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
@@ -231,6 +261,14 @@ void args(benchmark::internal::Benchmark* b) {
 
 BENCHMARK(Instances)->Apply(args);
 BENCHMARK(OneGroup)->Apply(args);
+BENCHMARK(Moving)->Apply([](benchmark::internal::Benchmark* b) {
+  const auto cores = int(std::max(1u, std::thread::hardware_concurrency()));
+  for (int t : {1, cores}) {
+    for (int move : {0, 1, 2}) b->Args({10000, t, move});
+    if (cores == 1) break;
+  }
+  b->ArgNames({"instances", "threads", "move"})->Unit(benchmark::kMillisecond)->UseRealTime();
+});
 BENCHMARK(OutOfSight)->Apply([](benchmark::internal::Benchmark* b) {
   const auto cores = int(std::max(1u, std::thread::hardware_concurrency()));
   for (int t : {1, cores}) {
@@ -300,6 +338,19 @@ class RatioReporter : public benchmark::ConsoleReporter {
           "  10,000 instances out of sight, threads:%s: a step every 4 frames %.2f ms a frame, "
           "every frame %.2f ms: %.2fx\n",
           threads.c_str(), ms, every->second, ms / every->second);
+    }
+    for (const auto& [name, ms] : ms_) {
+      const std::string moved = "Moving/instances:10000/threads:";
+      if (name.rfind(moved, 0) != 0 || name.substr(name.size() - 7) != "/move:1") continue;
+      const std::string threads = name.substr(moved.size(), name.size() - 7 - moved.size());
+      const auto same = ms_.find(moved + threads + "/move:2");
+      const auto still = ms_.find(moved + threads + "/move:0");
+      if (same == ms_.end() || still == ms_.end()) continue;
+      std::printf(
+          "  10,000 instances re-placed every step, threads:%s: moved %.2f ms (%.2fx), the same "
+          "transform again %.2f ms (%.2fx), none set %.2f ms\n",
+          threads.c_str(), ms, ms / still->second, same->second, same->second / still->second,
+          still->second);
     }
     // What keeping the bounds costs: the same run with and without asking every step.
     for (const auto& [name, ms] : ms_) {

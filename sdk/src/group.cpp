@@ -375,6 +375,28 @@ bool sameBits(const Transform& a, const Transform& b) {
   return std::memcmp(x, y, sizeof x) == 0;
 }
 
+// Whether the frame's lists refuse some transform: the one refusal a transform meets is a
+// box's turn by other than quarter turns (Domain::transformed), whatever the place and
+// scale, so the lists are carried once by a turn that is none (as a move would, on copies)
+// each time they change.
+bool mayRefuse(detail::GroupImpl& g) {
+  detail::Frame& f = *g.frame;
+  if (f.probed[0] == g.actionsStructure && f.probed[1] == g.emittersVersion) return f.mayRefuse;
+  const Transform turn{Vec3(0.0f), glm::angleAxis(0.5f, glm::normalize(Vec3(1.0f, 2.0f, 3.0f))),
+                       1.0f};
+  try {
+    (void)detail::transformActions(f.actions, turn);
+    for (const Emitter& e : f.emitters) (void)detail::transformEmitter(e, turn);
+    for (const PrimeEmitter& p : f.primes) (void)detail::transformPrime(p, turn);
+    f.mayRefuse = false;
+  } catch (const Error&) {
+    f.mayRefuse = true;
+  }
+  f.probed[0] = g.actionsStructure;
+  f.probed[1] = g.emittersVersion;
+  return f.mayRefuse;
+}
+
 void deriveEmitters(detail::GroupImpl& g, const Transform& t) {
   const detail::Frame& f = *g.frame;
   const bool identity = t.isIdentity();
@@ -417,6 +439,18 @@ Group& Group::setTransform(const Transform& transform) {
     g.frame->primes = g.primes;
   }
   detail::Frame& fr = *g.frame;
+  const bool still = fr.moved[0] == g.actionsStructure && fr.moved[1] == g.emittersVersion;
+  fr.moved[0] = g.actionsStructure;
+  fr.moved[1] = g.emittersVersion;
+  if (!first && still && !mayRefuse(g)) {
+    // The world's lists are placed by the group's next step, on the threads that step it
+    // (GroupImpl::placeEmitters); what the game reads of the group moves now.
+    if (fr.space == Space::Local) carryParticles(g, fr.transform, t);
+    fr.transform = t;
+    fr.placed = false;
+    ++g.actionsVersion;  // (only the actions' constants change, as below)
+    return *this;
+  }
   // The world's lists are rewritten in place (a move allocates nothing); one that refuses the
   // transform (a box turned by other than quarter turns) is derived again at the old one, so
   // that the group is left as it was.
@@ -433,6 +467,7 @@ Group& Group::setTransform(const Transform& transform) {
   }
   if (fr.space == Space::Local) carryParticles(g, fr.transform, t);
   fr.transform = t;
+  fr.placed = true;
   // Only the actions' constants change (actionsStructure stays): a device backend uploads
   // them, and its program (which depends on the kinds of actions and domains alone) is kept.
   ++g.actionsVersion;
@@ -555,7 +590,15 @@ void detail::GroupImpl::prefetchDeep() const {
 }
 
 void detail::GroupImpl::placeEmitters() {
-  if (!frame || frame->emittersDerived == emittersVersion) return;
+  if (!frame) return;
+  if (!frame->placed) {
+    // (Group::setTransform found that these lists take any transform.)
+    if (!detail::placeActions(actions, frame->actions, frame->transform))
+      actions = detail::transformActions(frame->actions, frame->transform);
+    if (frame->emittersDerived == emittersVersion) deriveEmitters(*this, frame->transform);
+    frame->placed = true;
+  }
+  if (frame->emittersDerived == emittersVersion) return;
   deriveEmitters(*this, frame->transform);
   ++emittersVersion;
   frame->emittersDerived = emittersVersion;

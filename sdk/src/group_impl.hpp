@@ -238,6 +238,18 @@ struct Frame {
   ActionList actions;
   /// GroupImpl::emittersVersion when the world emitters were last derived from these.
   std::uint64_t emittersDerived = ~std::uint64_t(0);
+  /// The world's actions and emitters are the images of these at `transform`: false after a
+  /// move left them to the group's next step (GroupImpl::placeEmitters), which the threads
+  /// take in parallel, where Group::setTransform runs on the game's one.
+  bool placed = true;
+  /// Whether these lists refuse some transform (a box turns only by quarter turns), as last
+  /// found for the actionsStructure and emittersVersion in `probed`: a move of a group that
+  /// may refuse it is placed at once, where the refusal can leave the group as it was. Found
+  /// only once the lists stood still from one move to the next (`moved`: the versions at the
+  /// last move), as a game's that edits them every frame are placed at once every time.
+  bool mayRefuse = true;
+  std::uint64_t probed[2] = {~std::uint64_t(0), ~std::uint64_t(0)};
+  std::uint64_t moved[2] = {~std::uint64_t(0), ~std::uint64_t(0)};
 };
 
 /// What Effect::build gave a group, for EffectInstance::restart: its emitters, prime
@@ -518,7 +530,8 @@ struct GroupImpl {
     if (mirror) mirror->syncStats(*this);
   }
 
-  /// Derives the world emitters from the frame's when they may have changed (a step calls it
+  /// Derives the world actions and emitters from the frame's where a move left them to the
+  /// step (Frame::placed), and the emitters where they may have changed (a step calls it
   /// first; no-op without a frame).
   void placeEmitters();
 
