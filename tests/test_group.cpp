@@ -1657,6 +1657,21 @@ TEST(Instance, TheSameTransformAgainChangesNothing) {
   }
 }
 
+namespace {
+// The effect's context options on `threads` threads.
+ContextOptions onThreads(const Effect& fx, unsigned threads) {
+  ContextOptions o = fx.contextOptions();
+  o.threads = threads;
+  return o;
+}
+// `count` instances of the effect in ctx, named by their index.
+std::vector<EffectInstance> instancesOf(const Effect& fx, Context& ctx, int count) {
+  std::vector<EffectInstance> all;
+  for (int k = 0; k < count; ++k) all.push_back(fx.instantiate(ctx, std::to_string(k)));
+  return all;
+}
+}  // namespace
+
 // A move leaves the group's lists to its next step (on the threads that step it) when they
 // can take any transform; a group whose emitters are edited every frame is placed at once.
 // Both end bitwise alike, in both spaces, and a group that may refuse (a box turns only by
@@ -1665,9 +1680,7 @@ TEST(Instance, AMoveThePlacedStepTakesIsTheOneMadeAtOnce) {
   for (const char* space : {"world", "local"}) {
     SCOPED_TRACE(space);
     const Effect fx = dropEffect(space);
-    ContextOptions o = fx.contextOptions();
-    o.threads = 2;
-    Context left(o), atOnce(o);
+    Context left(onThreads(fx, 2)), atOnce(onThreads(fx, 2));
     EffectInstance a = fx.instantiate(left, "x"), b = fx.instantiate(atOnce, "x");
     for (int s = 0; s < 60; ++s) {
       const Transform t{Vec3(0.05f * float(s), 0.5f, -0.03f * float(s)),
@@ -1695,21 +1708,6 @@ TEST(Instance, AMoveThePlacedStepTakesIsTheOneMadeAtOnce) {
   EXPECT_THROW(g.setTransform({Vec3(0), glm::angleAxis(0.3f, Vec3(0, 1, 0)), 1}), InvalidArgument);
   EXPECT_EQ(g.transform().position, Vec3(2, 2, 3));
 }
-
-namespace {
-// The effect's context options on `threads` threads.
-ContextOptions onThreads(const Effect& fx, unsigned threads) {
-  ContextOptions o = fx.contextOptions();
-  o.threads = threads;
-  return o;
-}
-// `count` instances of the effect in ctx, named by their index.
-std::vector<EffectInstance> instancesOf(const Effect& fx, Context& ctx, int count) {
-  std::vector<EffectInstance> all;
-  for (int k = 0; k < count; ++k) all.push_back(fx.instantiate(ctx, std::to_string(k)));
-  return all;
-}
-}  // namespace
 
 // Context::step runs a few groups' emissions before their act passes (CpuBackend's parts):
 // each instance of many ends bitwise as the same instance alone in a context of its own.
