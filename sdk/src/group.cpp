@@ -364,9 +364,7 @@ void carryParticles(detail::GroupImpl& g, const Transform& from, const Transform
 
 namespace {
 
-// The world emitters and prime emitters as the frame's carried by t, in the storage of the
-// last ones: lists of the same lengths are assigned element by element, so that a group
-// moved every step allocates nothing (see carryEmitter for what still does).
+// Whether two transforms are the same to the bit (-0 and +0 differ: no move is missed).
 bool sameBits(const Transform& a, const Transform& b) {
   const float x[8] = {a.position.x, a.position.y, a.position.z, a.rotation.w,
                       a.rotation.x, a.rotation.y, a.rotation.z, a.scale};
@@ -397,6 +395,9 @@ bool mayRefuse(detail::GroupImpl& g) {
   return f.mayRefuse;
 }
 
+// The world emitters and prime emitters as the frame's carried by t, in the storage of the
+// last ones: lists of the same lengths are assigned element by element, so that a group
+// moved every step allocates nothing (see carryEmitter for what still does).
 void deriveEmitters(detail::GroupImpl& g, const Transform& t) {
   const detail::Frame& f = *g.frame;
   const bool identity = t.isIdentity();
