@@ -1703,8 +1703,9 @@ TEST(Instance, AMoveThePlacedStepTakesIsTheOneMadeAtOnce) {
   Group& g = ctx.createGroup("boxed", 100);
   g.setActions({Sink{Domain::box(Vec3(-1.0f), Vec3(1.0f))}, Move{}});
   const Transform quarter{Vec3(1, 2, 3), glm::angleAxis(glm::radians(90.0f), Vec3(0, 1, 0)), 1};
-  for (int k = 0; k < 3; ++k) g.setTransform(quarter);  // standing still: probed
+  g.setTransform(quarter);  // a box turns by quarter turns
   g.setTransform({Vec3(2, 2, 3), quarter.rotation, 1});
+  // The lists stood still since that move: found to refuse other turns, so placed at once.
   EXPECT_THROW(g.setTransform({Vec3(0), glm::angleAxis(0.3f, Vec3(0, 1, 0)), 1}), InvalidArgument);
   EXPECT_EQ(g.transform().position, Vec3(2, 2, 3));
 }
