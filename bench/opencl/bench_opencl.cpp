@@ -195,6 +195,45 @@ void IdleGroups(benchmark::State& state, Backend backend) {
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
+// Ten small fountains a game moves every frame (range 0 = 1: each given a new transform
+// before every step, a little further along x and turned a little more about y) or leaves
+// standing (0): on the device a move uploads the actions' constants behind the steps in
+// flight.
+void MovedGroups(benchmark::State& state, Backend backend) {
+  if (backend == Backend::OpenCL && !haveDevice()) return state.SkipWithError("no OpenCL device");
+  ContextOptions o = options(backend);
+  o.threads = 1;
+  Context ctx(o);
+  std::vector<Group*> groups;
+  for (int k = 0; k < 10; ++k)
+    groups.push_back(&flurry::bench::smallFountain(ctx, "group" + std::to_string(k)));
+  const bool move = state.range(0) != 0;
+  int frame = 0;
+  auto place = [&] {
+    ++frame;
+    for (std::size_t k = 0; k < groups.size(); ++k) {
+      const float f = move ? float(frame) : 0.0f;
+      groups[k]->setTransform({Vec3(float(k) * 4.0f + 0.01f * f, 0.0f, 0.0f),
+                               glm::angleAxis(0.01f * f, Vec3(0.0f, 1.0f, 0.0f)), 1.0f});
+    }
+  };
+  for (int s = 0; s < 90; ++s) {
+    place();
+    ctx.step();
+  }
+  const int steps = 20;
+  for (auto _ : state) {
+    for (int s = 0; s < steps; ++s) {
+      place();
+      ctx.step();
+    }
+    for (Group* g : groups) finish(*g);
+  }
+  state.counters["us/step"] =
+      benchmark::Counter(double(state.iterations()) * steps * 1e-6,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
 // Death events (Group::recordDeaths) on both backends: ~300k short-lived fountain particles,
 // a third dying every step, recorded (range 0 = 1) or not (0). The difference over the deaths
 // is an event's cost; on the device it includes waiting for the step and reading the events
@@ -386,6 +425,16 @@ class SummaryReporter : public benchmark::ConsoleReporter {
             "aim <= 1.2)\n",
             b, i100 / i10, i100, i10);
     }
+    for (const char* b : {"cpu", "opencl"}) {
+      const std::string B = b;
+      const double moved = usPerStep_["MovedGroups/" + B + "/move:1"];
+      const double still = usPerStep_["MovedGroups/" + B + "/move:0"];
+      if (moved > 0 && still > 0)
+        std::printf(
+            "  %-6s 10 small groups moved every step / standing: %.2fx (%.1f / %.1f us "
+            "a step)\n",
+            b, moved / still, moved, still);
+    }
     // What a feature costs a unit: the step with it against without, over the units
     // (`count`: the per-step counter of the run with it).
     auto perUnit = [&](const char* what, const std::string& bench, const char* with,
@@ -475,6 +524,18 @@ BENCHMARK_CAPTURE(IdleGroups, opencl, Backend::OpenCL)
     ->Args({10, 10})
     ->Args({100, 10})
     ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(MovedGroups, cpu, Backend::Cpu)
+    ->ArgName("move")
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(MovedGroups, opencl, Backend::OpenCL)
+    ->ArgName("move")
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(DeathEvents, cpu, Backend::Cpu)
     ->ArgName("record")

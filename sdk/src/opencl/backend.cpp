@@ -126,7 +126,8 @@ struct InFlight {
   std::vector<std::uint32_t> state;
   std::uint64_t births = 0;
   StepTables tables;
-  std::vector<std::uint64_t> blob;  // the tables back to back: the step's writes read it
+  std::vector<std::uint64_t> blob;          // the tables back to back: the step's writes read it
+  std::vector<std::uint8_t> params, extra;  // the actions' constants the step wrote, if new
 };
 
 // Steps in flight, oldest first, in slots that are reused.
@@ -360,6 +361,7 @@ class ClGroup final : public DeviceMirror {
       birthEvents_;
   std::vector<cl::FlActionParams> params_host_, params_uploaded_;
   std::vector<float> extra_host_, extra_uploaded_;
+  bool paramsStale_ = false, extraStale_ = false;  // the device's differ from the host's
 
   std::vector<std::pair<std::string, Event>> profiled_;
   std::map<std::string, std::pair<double, std::uint64_t>> profile_;
@@ -862,28 +864,14 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     }
     packedVersion_ = g.actionsVersion;
     packedDt_ = dtBitsF;
-    const std::size_t paramBytes = params_host_.size() * sizeof(cl::FlActionParams);
-    if (params_uploaded_.size() != params_host_.size() ||
-        std::memcmp(params_uploaded_.data(), params_host_.data(), paramBytes) != 0) {
-      drain(g);  // steps in flight read the buffer
-      params_.reserve(context(), paramBytes, CL_MEM_READ_ONLY);
-      check(clEnqueueWriteBuffer(queue(), params_.mem.get(), CL_TRUE, 0, paramBytes,
-                                 params_host_.data(), 0, nullptr, nullptr),
-            "clEnqueueWriteBuffer (action parameters)");
-      params_uploaded_ = params_host_;
-    }
     // Compared as bytes: the floats hold integers and doubles as bit patterns (NaN patterns
     // among them), so a comparison of values could never say equal, or miss a -0.
-    if (extra_uploaded_.size() != extra_host_.size() ||
-        std::memcmp(extra_uploaded_.data(), extra_host_.data(), extra_host_.size() * 4) != 0) {
-      drain(g);
-      const std::size_t bytes = extra_host_.size() * sizeof(float);
-      extra_.reserve(context(), bytes, CL_MEM_READ_ONLY);
-      check(clEnqueueWriteBuffer(queue(), extra_.mem.get(), CL_TRUE, 0, bytes, extra_host_.data(),
-                                 0, nullptr, nullptr),
-            "clEnqueueWriteBuffer (action data)");
-      extra_uploaded_ = extra_host_;
-    }
+    paramsStale_ |= params_uploaded_.size() != params_host_.size() ||
+                    std::memcmp(params_uploaded_.data(), params_host_.data(),
+                                params_host_.size() * sizeof(cl::FlActionParams)) != 0;
+    extraStale_ |= extra_uploaded_.size() != extra_host_.size() ||
+                   std::memcmp(extra_uploaded_.data(), extra_host_.data(),
+                               extra_host_.size() * sizeof(float)) != 0;
   }
 
   InFlight& f = inFlight_.next();
@@ -905,6 +893,32 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   const bool trails = trailSlots_ > 0;
   // Nothing on the device changes (but a trail's new head, as on the CPU).
   if (!acts && births == 0 && !trails && hairStrands == 0) return;
+  // New action constants (a new list, a new dt, a move) go up behind the steps in flight,
+  // which the queue runs first, without the host waiting for them: from the step's own copy,
+  // which stays as it is until the step retires (after the write, in the queue's order). A
+  // buffer that grows is made anew; the steps in flight keep the old one until they end.
+  auto upload = [&](GrowBuffer& buf, const void* host, std::size_t bytes,
+                    std::vector<std::uint8_t>& copy, const char* what) {
+    buf.reserve(context(), bytes, CL_MEM_READ_ONLY);
+    if (bytes == 0) return;  // (an empty list: nothing reads it)
+    copy.resize(bytes);
+    std::memcpy(copy.data(), host, bytes);
+    check(clEnqueueWriteBuffer(queue(), buf.mem.get(), CL_FALSE, 0, bytes, copy.data(), 0, nullptr,
+                               nullptr),
+          what);
+  };
+  if (paramsStale_) {
+    upload(params_, params_host_.data(), params_host_.size() * sizeof(cl::FlActionParams), f.params,
+           "clEnqueueWriteBuffer (action parameters)");
+    params_uploaded_ = params_host_;
+    paramsStale_ = false;
+  }
+  if (extraStale_) {
+    upload(extra_, extra_host_.data(), extra_host_.size() * sizeof(float), f.extra,
+           "clEnqueueWriteBuffer (action data)");
+    extra_uploaded_ = extra_host_;
+    extraStale_ = false;
+  }
   if (hits && acts) {
     // Room for every particle deflected by each Bounce in each sub-step, or the most a step
     // had, within one buffer the device allows; taken before anything of the step is queued.
