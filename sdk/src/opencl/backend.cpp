@@ -362,6 +362,7 @@ class ClGroup final : public DeviceMirror {
   std::vector<cl::FlActionParams> params_host_, params_uploaded_;
   std::vector<float> extra_host_, extra_uploaded_;
   bool paramsStale_ = false, extraStale_ = false;  // the device's differ from the host's
+  bool unpushedWrite_ = false;  // a write reads the next slot's copies, not yet a step's
 
   std::vector<std::pair<std::string, Event>> profiled_;
   std::map<std::string, std::pair<double, std::uint64_t>> profile_;
@@ -772,6 +773,12 @@ void ClGroup::readStrands(GroupImpl& g, std::size_t births) {
 }
 
 void ClGroup::step(GroupImpl& g, const StepParams& sp) {
+  if (unpushedWrite_) {
+    // The last step threw after writing from its slot's copy and before taking the slot:
+    // that write must end before the slot is written again.
+    clFinish(queue());
+    unpushedWrite_ = false;
+  }
   checkEmissionSupported(g);
   // Idle, as on the CPU: nothing alive (at most: the last count read plus the births queued
   // since; the host's own count if it changed the particles) and no emitter that will fire.
@@ -903,6 +910,7 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     if (bytes == 0) return;  // (an empty list: nothing reads it)
     copy.resize(bytes);
     std::memcpy(copy.data(), host, bytes);
+    unpushedWrite_ = true;
     check(clEnqueueWriteBuffer(queue(), buf.mem.get(), CL_FALSE, 0, bytes, copy.data(), 0, nullptr,
                                nullptr),
           what);
@@ -978,6 +986,7 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     const bool same =
         !layout && staticUploaded_.size() == staticWords &&
         std::memcmp(staticUploaded_.data(), blob.data() + runsWords, staticWords * 8) == 0;
+    unpushedWrite_ = true;  // (both writes read the slot's blob)
     if (!same) {
       check(clEnqueueWriteBuffer(q, tables_.mem.get(), CL_FALSE, runsWords * 8, staticWords * 8,
                                  blob.data() + runsWords, 0, nullptr, nullptr),
@@ -1199,6 +1208,7 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
           "clEnqueueReadBuffer (state)");
     f.done = Event(e);
     inFlight_.push();
+    unpushedWrite_ = false;
   }
   check(clFlush(q), "clFlush");
   deviceNewer_ = true;
