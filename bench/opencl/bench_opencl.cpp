@@ -424,9 +424,6 @@ class SummaryReporter : public benchmark::ConsoleReporter {
             "  %-6s 100 groups of which 10 alive / the 10 alone: %.2fx (%.1f / %.1f us a step; "
             "aim <= 1.2)\n",
             b, i100 / i10, i100, i10);
-    }
-    for (const char* b : {"cpu", "opencl"}) {
-      const std::string B = b;
       const double moved = usPerStep_["MovedGroups/" + B + "/move:1"];
       const double still = usPerStep_["MovedGroups/" + B + "/move:0"];
       if (moved > 0 && still > 0)
