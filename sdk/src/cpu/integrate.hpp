@@ -75,68 +75,118 @@ inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std
         // (stageLoop): GCC read them again for each particle (the stage's stores might have
         // changed them), and kept the loop scalar.
         const cl::FlActionParams r = record;
-        const cl::FlFalloffParams f = r.falloff;
         const float* __restrict charge = L.charge;
         const float* __restrict mass = L.mass;
-        stageLoop(
-            s, n,
-            [r, f, t, charge, mass, &a, &c, &L](std::size_t i, Vec3 p, Vec3 v, float& ax, float& ay,
-                                                float& az) {
-              Vec3 acc(0.0f);  // drawn from the CPU's own domains, or summed over neighbours
-              if constexpr (std::is_same_v<A, Gravity>) {
-                kernel::fl_gravity_acc(r.own.gravity, f, p.x, p.y, p.z, &ax, &ay, &az);
-              } else if constexpr (std::is_same_v<A, Damping>) {
-                kernel::fl_damping_acc(r.own.damping, f, p.x, p.y, p.z, v.x, v.y, v.z, &ax, &ay,
-                                       &az);
-              } else if constexpr (std::is_same_v<A, OrbitPoint>) {
-                kernel::fl_orbit_point_acc(r.own.orbitPoint, p.x, p.y, p.z, &ax, &ay, &az);
-              } else if constexpr (std::is_same_v<A, OrbitLine>) {
-                kernel::fl_orbit_line_acc(r.own.orbitLine, p.x, p.y, p.z, &ax, &ay, &az);
-              } else if constexpr (std::is_same_v<A, Gravitate>) {
-                const Snapshot& sn = *c.snapshot;
-                for (std::size_t j = 0; j < sn.size; ++j)
-                  if (j != c.base + i)
-                    acc += softPull(Vec3(sn.p[0][j], sn.p[1][j], sn.p[2][j]) - p, r.own.pull);
-              } else if constexpr (std::is_same_v<A, Follow>) {
-                const Snapshot& sn = *c.snapshot;
-                const std::size_t next = c.base + i + 1;
-                if (next < sn.size)
-                  acc = softPull(Vec3(sn.p[0][next], sn.p[1][next], sn.p[2][next]) - p, r.own.pull);
-              } else if constexpr (std::is_same_v<A, Vortex>) {
-                kernel::fl_vortex_acc(r.own.vortex, p.x, p.y, p.z, v.x, v.y, v.z, &ax, &ay, &az);
-              } else if constexpr (std::is_same_v<A, Jet>) {
-                if (kernel::fl_jet_reaches(r.own.jet, p.x, p.y, p.z)) {
+        // The falloff as withFalloff gives it (kernels.hpp): an infinite radius or a power of 1
+        // folded into the loop, as in the forces' own loops, and no fl_powf in each stage.
+        auto run = [&](auto fall) {
+          stageLoop(
+              s, n,
+              [r, fall, t, charge, mass, &a, &c, &L](std::size_t i, Vec3 p, Vec3 v, float& ax,
+                                                     float& ay, float& az) {
+                const cl::FlFalloffParams f = fall();
+                Vec3 acc(0.0f);  // drawn from the CPU's own domains, or summed over neighbours
+                if constexpr (std::is_same_v<A, Gravity>) {
+                  kernel::fl_gravity_acc(r.own.gravity, f, p.x, p.y, p.z, &ax, &ay, &az);
+                } else if constexpr (std::is_same_v<A, Damping>) {
+                  kernel::fl_damping_acc(r.own.damping, f, p.x, p.y, p.z, v.x, v.y, v.z, &ax, &ay,
+                                         &az);
+                } else if constexpr (std::is_same_v<A, OrbitPoint>) {
+                  kernel::fl_orbit_point_acc(r.own.orbitPoint, p.x, p.y, p.z, &ax, &ay, &az);
+                } else if constexpr (std::is_same_v<A, OrbitLine>) {
+                  kernel::fl_orbit_line_acc(r.own.orbitLine, p.x, p.y, p.z, &ax, &ay, &az);
+                } else if constexpr (std::is_same_v<A, Gravitate>) {
+                  const Snapshot& sn = *c.snapshot;
+                  for (std::size_t j = 0; j < sn.size; ++j)
+                    if (j != c.base + i)
+                      acc += softPull(Vec3(sn.p[0][j], sn.p[1][j], sn.p[2][j]) - p, r.own.pull);
+                } else if constexpr (std::is_same_v<A, Follow>) {
+                  const Snapshot& sn = *c.snapshot;
+                  const std::size_t next = c.base + i + 1;
+                  if (next < sn.size)
+                    acc =
+                        softPull(Vec3(sn.p[0][next], sn.p[1][next], sn.p[2][next]) - p, r.own.pull);
+                } else if constexpr (std::is_same_v<A, Vortex>) {
+                  kernel::fl_vortex_acc(r.own.vortex, p.x, p.y, p.z, v.x, v.y, v.z, &ax, &ay, &az);
+                } else if constexpr (std::is_same_v<A, Jet>) {
+                  if (kernel::fl_jet_reaches(r.own.jet, p.x, p.y, p.z)) {
+                    Random rng = actionRandom(c, L, i);
+                    acc = a.acceleration.sample(rng);
+                  }
+                } else if constexpr (std::is_same_v<A, Explosion>) {
+                  kernel::fl_explosion_acc(r.own.explosion, t, p.x, p.y, p.z, &ax, &ay, &az);
+                } else if constexpr (std::is_same_v<A, RandomAccel>) {
                   Random rng = actionRandom(c, L, i);
-                  acc = a.acceleration.sample(rng);
+                  acc = a.acceleration.sample(rng) * kernel::fl_falloff_weight(f, p.x, p.y, p.z);
+                } else if constexpr (std::is_same_v<A, Turbulence>) {
+                  kernel::fl_turbulence_acc(r.own.turbulence, f, t, p.x, p.y, p.z, &ax, &ay, &az);
+                } else if constexpr (std::is_same_v<A, ElectricField>) {
+                  kernel::fl_electric_acc(r.own.electric, f, p.x, p.y, p.z, charge[i], mass[i], &ax,
+                                          &ay, &az);
+                } else if constexpr (std::is_same_v<A, MagneticField>) {
+                  kernel::fl_magnetic_acc(r.own.magnetic, f, p.x, p.y, p.z, v.x, v.y, v.z,
+                                          charge[i], mass[i], &ax, &ay, &az);
+                } else if constexpr (std::is_same_v<A, SampledField>) {
+                  const Vec3 u = sampleTrilinear(*a.field, p);
+                  kernel::fl_sampled_field_acc(r.own.sampledField,
+                                               kernel::fl_falloff_weight(f, p.x, p.y, p.z), u.x,
+                                               u.y, u.z, v.x, v.y, v.z, &ax, &ay, &az);
                 }
-              } else if constexpr (std::is_same_v<A, Explosion>) {
-                kernel::fl_explosion_acc(r.own.explosion, t, p.x, p.y, p.z, &ax, &ay, &az);
-              } else if constexpr (std::is_same_v<A, RandomAccel>) {
-                Random rng = actionRandom(c, L, i);
-                acc = a.acceleration.sample(rng) * kernel::fl_falloff_weight(f, p.x, p.y, p.z);
-              } else if constexpr (std::is_same_v<A, Turbulence>) {
-                kernel::fl_turbulence_acc(r.own.turbulence, f, t, p.x, p.y, p.z, &ax, &ay, &az);
-              } else if constexpr (std::is_same_v<A, ElectricField>) {
-                kernel::fl_electric_acc(r.own.electric, f, p.x, p.y, p.z, charge[i], mass[i], &ax,
-                                        &ay, &az);
-              } else if constexpr (std::is_same_v<A, MagneticField>) {
-                kernel::fl_magnetic_acc(r.own.magnetic, f, p.x, p.y, p.z, v.x, v.y, v.z, charge[i],
-                                        mass[i], &ax, &ay, &az);
-              } else if constexpr (std::is_same_v<A, SampledField>) {
-                const Vec3 u = sampleTrilinear(*a.field, p);
-                kernel::fl_sampled_field_acc(r.own.sampledField,
-                                             kernel::fl_falloff_weight(f, p.x, p.y, p.z), u.x, u.y,
-                                             u.z, v.x, v.y, v.z, &ax, &ay, &az);
-              }
-              if constexpr (std::is_same_v<A, Gravitate> || std::is_same_v<A, Follow> ||
-                            std::is_same_v<A, Jet> || std::is_same_v<A, RandomAccel>) {
-                ax += acc.x;
-                ay += acc.y;
-                az += acc.z;
-              }
-            });
+                if constexpr (std::is_same_v<A, Gravitate> || std::is_same_v<A, Follow> ||
+                              std::is_same_v<A, Jet> || std::is_same_v<A, RandomAccel>) {
+                  ax += acc.x;
+                  ay += acc.y;
+                  az += acc.z;
+                }
+              });
+        };
+        constexpr bool weighs = std::is_same_v<A, Gravity> || std::is_same_v<A, Damping> ||
+                                std::is_same_v<A, RandomAccel> || std::is_same_v<A, Turbulence> ||
+                                std::is_same_v<A, ElectricField> ||
+                                std::is_same_v<A, MagneticField> || std::is_same_v<A, SampledField>;
+        if constexpr (weighs)
+          withFalloff(r.falloff, run);
+        else
+          run([f = r.falloff] { return f; });
       },
       action);
+}
+
+// The integrators' per-particle steps (kernels/integrate.h) as loops over restricted arrays:
+// written over the lanes and the scratch's arrays in place, GCC could not tell them apart and
+// kept every one scalar.
+template <class Dt>
+void eulerLoop(const float* __restrict a, float* __restrict p, float* __restrict v, std::size_t n,
+               Dt dt) {
+  for (std::size_t i = 0; i < n; ++i) kernel::fl_euler_explicit(a[i], dt[i], &p[i], &v[i]);
+}
+template <class Dt>
+void verletPredictLoop(const float* __restrict p, const float* __restrict v,
+                       const float* __restrict a0, float* __restrict p1, float* __restrict v1,
+                       std::size_t n, Dt dt) {
+  for (std::size_t i = 0; i < n; ++i)
+    kernel::fl_verlet_predict(p[i], v[i], a0[i], dt[i], &p1[i], &v1[i]);
+}
+template <class Dt>
+void verletFinishLoop(const float* __restrict p1, const float* __restrict a0,
+                      const float* __restrict a1, float* __restrict p, float* __restrict v,
+                      std::size_t n, Dt dt) {
+  for (std::size_t i = 0; i < n; ++i)
+    kernel::fl_verlet_finish(p1[i], a0[i], a1[i], dt[i], &p[i], &v[i]);
+}
+// One RK4 stage: its slopes (vs, a) weighed into the sums, and the next stage's state, `next`
+// of the step on (vs is read, then written).
+template <class Dt>
+void rk4StageLoop(const float* __restrict p, const float* __restrict v, float* __restrict vs,
+                  const float* __restrict a, float w, float next, float* __restrict sp,
+                  float* __restrict sv, float* __restrict ps, std::size_t n, Dt dt) {
+  for (std::size_t i = 0; i < n; ++i)
+    kernel::fl_rk4_stage(p[i], v[i], vs[i], a[i], w, next * dt[i], &sp[i], &sv[i], &ps[i], &vs[i]);
+}
+template <class Dt>
+void rk4FinishLoop(const float* __restrict sp, const float* __restrict sv, float* __restrict p,
+                   float* __restrict v, std::size_t n, Dt dt) {
+  for (std::size_t i = 0; i < n; ++i) kernel::fl_rk4_finish(sp[i], sv[i], dt[i], &p[i], &v[i]);
 }
 
 /// Scratch for one block's integration (per thread).
@@ -200,9 +250,7 @@ inline void integrate(Integrator integrator, const std::vector<Action>& acts,
   switch (integrator) {
     case Integrator::ExplicitEuler: {
       evaluate(L.p, L.v, a0, t);
-      for (int d = 0; d < 3; ++d)
-        for (std::size_t i = 0; i < n; ++i)
-          kernel::fl_euler_explicit(a0[d][i], dt[i], &L.p[d][i], &L.v[d][i]);
+      for (int d = 0; d < 3; ++d) eulerLoop(a0[d], L.p[d], L.v[d], n, dt);
       break;
     }
     case Integrator::VelocityVerlet: {
@@ -211,13 +259,9 @@ inline void integrate(Integrator integrator, const std::vector<Action>& acts,
       arrays3(p1);
       arrays3(v1);
       evaluate(L.p, L.v, a0, t);
-      for (int d = 0; d < 3; ++d)
-        for (std::size_t i = 0; i < n; ++i)
-          kernel::fl_verlet_predict(L.p[d][i], L.v[d][i], a0[d][i], dt[i], &p1[d][i], &v1[d][i]);
+      for (int d = 0; d < 3; ++d) verletPredictLoop(L.p[d], L.v[d], a0[d], p1[d], v1[d], n, dt);
       evaluate(p1, v1, a1, t + h0);
-      for (int d = 0; d < 3; ++d)
-        for (std::size_t i = 0; i < n; ++i)
-          kernel::fl_verlet_finish(p1[d][i], a0[d][i], a1[d][i], dt[i], &L.p[d][i], &L.v[d][i]);
+      for (int d = 0; d < 3; ++d) verletFinishLoop(p1[d], a0[d], a1[d], L.p[d], L.v[d], n, dt);
       break;
     }
     case Integrator::RK4: {
@@ -239,13 +283,9 @@ inline void integrate(Integrator integrator, const std::vector<Action>& acts,
         evaluate(ps, vs, a1, t + h[k] * h0);
         const float hn = k < 3 ? h[k + 1] : 0.0f;
         for (int d = 0; d < 3; ++d)
-          for (std::size_t i = 0; i < n; ++i)
-            kernel::fl_rk4_stage(L.p[d][i], L.v[d][i], vs[d][i], a1[d][i], w[k], hn * dt[i],
-                                 &sp[d][i], &sv[d][i], &ps[d][i], &vs[d][i]);
+          rk4StageLoop(L.p[d], L.v[d], vs[d], a1[d], w[k], hn, sp[d], sv[d], ps[d], n, dt);
       }
-      for (int d = 0; d < 3; ++d)
-        for (std::size_t i = 0; i < n; ++i)
-          kernel::fl_rk4_finish(sp[d][i], sv[d][i], dt[i], &L.p[d][i], &L.v[d][i]);
+      for (int d = 0; d < 3; ++d) rk4FinishLoop(sp[d], sv[d], L.p[d], L.v[d], n, dt);
       break;
     }
     case Integrator::Exact: {
