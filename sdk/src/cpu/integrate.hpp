@@ -174,19 +174,36 @@ void verletFinishLoop(const float* __restrict p1, const float* __restrict a0,
   for (std::size_t i = 0; i < n; ++i)
     kernel::fl_verlet_finish(p1[i], a0[i], a1[i], dt[i], &p[i], &v[i]);
 }
-// One RK4 stage: its slopes (vs, a) weighed into the sums, and the next stage's state, `next`
-// of the step on (vs is read, then written).
+// RK4's stages (kernels/integrate.h): each weighs its slopes (vs, a) into the sums and makes
+// the next stage's state, `next` of the step on. The first takes its slopes from the lanes and
+// starts the sums from 0; a middle one reads vs, then writes it; the last one ends the step.
 template <class Dt>
-void rk4StageLoop(const float* __restrict p, const float* __restrict v, float* __restrict vs,
-                  const float* __restrict a, float w, float next, float* __restrict sp,
-                  float* __restrict sv, float* __restrict ps, std::size_t n, Dt dt) {
-  for (std::size_t i = 0; i < n; ++i)
-    kernel::fl_rk4_stage(p[i], v[i], vs[i], a[i], w, next * dt[i], &sp[i], &sv[i], &ps[i], &vs[i]);
+void rk4FirstLoop(const float* __restrict p, const float* __restrict v, const float* __restrict a,
+                  float next, float* __restrict sp, float* __restrict sv, float* __restrict ps,
+                  float* __restrict vs, std::size_t n, Dt dt) {
+  for (std::size_t i = 0; i < n; ++i) {
+    float s0 = 0.0f, s1 = 0.0f;
+    kernel::fl_rk4_stage(p[i], v[i], v[i], a[i], 1.0f, next * dt[i], &s0, &s1, &ps[i], &vs[i]);
+    sp[i] = s0, sv[i] = s1;
+  }
 }
 template <class Dt>
-void rk4FinishLoop(const float* __restrict sp, const float* __restrict sv, float* __restrict p,
-                   float* __restrict v, std::size_t n, Dt dt) {
-  for (std::size_t i = 0; i < n; ++i) kernel::fl_rk4_finish(sp[i], sv[i], dt[i], &p[i], &v[i]);
+void rk4StageLoop(const float* __restrict p, const float* __restrict v, float* __restrict vs,
+                  const float* __restrict a, float next, float* __restrict sp, float* __restrict sv,
+                  float* __restrict ps, std::size_t n, Dt dt) {
+  for (std::size_t i = 0; i < n; ++i)
+    kernel::fl_rk4_stage(p[i], v[i], vs[i], a[i], 2.0f, next * dt[i], &sp[i], &sv[i], &ps[i],
+                         &vs[i]);
+}
+template <class Dt>
+void rk4LastLoop(const float* __restrict vs, const float* __restrict a, const float* __restrict sp,
+                 const float* __restrict sv, float* __restrict p, float* __restrict v,
+                 std::size_t n, Dt dt) {
+  for (std::size_t i = 0; i < n; ++i) {
+    float s0 = sp[i], s1 = sv[i], unused0, unused1;  // (the next state: there is none)
+    kernel::fl_rk4_stage(p[i], v[i], vs[i], a[i], 1.0f, 0.0f, &s0, &s1, &unused0, &unused1);
+    kernel::fl_rk4_finish(s0, s1, dt[i], &p[i], &v[i]);
+  }
 }
 
 /// Scratch for one block's integration (per thread).
@@ -265,27 +282,25 @@ inline void integrate(Integrator integrator, const std::vector<Action>& acts,
       break;
     }
     case Integrator::RK4: {
-      // Classic RK4 on (p, v): k_p = v, k_v = a(p, v, t).
+      // Classic RK4 on (p, v): k_p = v, k_v = a(p, v, t); stages at 0, h/2, h/2 and h, their
+      // slopes weighed 1, 2, 2, 1.
       float *ps[3], *vs[3], *sp[3], *sv[3];
       arrays3(a1);  // stage acceleration
       arrays3(ps);
       arrays3(vs);
       arrays3(sp);  // weighted sums
       arrays3(sv);
-      for (int d = 0; d < 3; ++d) {
-        std::fill_n(sp[d], n, 0.0f);
-        std::fill_n(sv[d], n, 0.0f);
-        std::copy_n(L.p[d], n, ps[d]);
-        std::copy_n(L.v[d], n, vs[d]);
-      }
-      const float h[4] = {0.0f, 0.5f, 0.5f, 1.0f}, w[4] = {1.0f, 2.0f, 2.0f, 1.0f};
-      for (int k = 0; k < 4; ++k) {
-        evaluate(ps, vs, a1, t + h[k] * h0);
-        const float hn = k < 3 ? h[k + 1] : 0.0f;
+      evaluate(L.p, L.v, a1, t);
+      for (int d = 0; d < 3; ++d)
+        rk4FirstLoop(L.p[d], L.v[d], a1[d], 0.5f, sp[d], sv[d], ps[d], vs[d], n, dt);
+      for (int k = 1; k < 3; ++k) {
+        evaluate(ps, vs, a1, t + 0.5f * h0);
+        const float next = k == 1 ? 0.5f : 1.0f;
         for (int d = 0; d < 3; ++d)
-          rk4StageLoop(L.p[d], L.v[d], vs[d], a1[d], w[k], hn, sp[d], sv[d], ps[d], n, dt);
+          rk4StageLoop(L.p[d], L.v[d], vs[d], a1[d], next, sp[d], sv[d], ps[d], n, dt);
       }
-      for (int d = 0; d < 3; ++d) rk4FinishLoop(sp[d], sv[d], L.p[d], L.v[d], n, dt);
+      evaluate(ps, vs, a1, t + 1.0f * h0);
+      for (int d = 0; d < 3; ++d) rk4LastLoop(vs[d], a1[d], sp[d], sv[d], L.p[d], L.v[d], n, dt);
       break;
     }
     case Integrator::Exact: {
