@@ -676,13 +676,17 @@ FL_INLINE void fl_magnetic_acc(FlMagneticParams m, FlFalloffParams f, float px, 
 /* SampledField, from the field's value (ux, uy, uz) at p (each side samples its own copy of
  * the grid with fl_field_axis and fl_field_blend) and the falloff's weight w: an acceleration
  * (v + u s dt w), or carried towards it (Mode::Velocity). */
-FL_INLINE void fl_sampled_field(FlSampledFieldParams s, float dt, float w, float ux, float uy,
-                                float uz, float* vx, float* vy, float* vz) {
+/* The same with the carry's approach over dt given (fl_force_approach(s.responsiveness, dt,
+ * s.dt, s.decay); unread without a carry): a loop over particles of one step length takes it
+ * once. */
+FL_INLINE void fl_sampled_field_approach(FlSampledFieldParams s, float approach, float dt, float w,
+                                         float ux, float uy, float uz, float* vx, float* vy,
+                                         float* vz) {
   ux = ux * s.strength;
   uy = uy * s.strength;
   uz = uz * s.strength;
   if (s.carry) {
-    const float kw = fl_force_approach(s.responsiveness, dt, s.dt, s.decay) * w;
+    const float kw = approach * w;
     *vx = *vx + (ux - *vx) * kw;
     *vy = *vy + (uy - *vy) * kw;
     *vz = *vz + (uz - *vz) * kw;
@@ -692,6 +696,12 @@ FL_INLINE void fl_sampled_field(FlSampledFieldParams s, float dt, float w, float
     *vy = *vy + uy * k;
     *vz = *vz + uz * k;
   }
+}
+
+FL_INLINE void fl_sampled_field(FlSampledFieldParams s, float dt, float w, float ux, float uy,
+                                float uz, float* vx, float* vy, float* vz) {
+  const float approach = s.carry ? fl_force_approach(s.responsiveness, dt, s.dt, s.decay) : 0.0f;
+  fl_sampled_field_approach(s, approach, dt, w, ux, uy, uz, vx, vy, vz);
 }
 
 FL_INLINE void fl_sampled_field_acc(FlSampledFieldParams s, float w, float ux, float uy, float uz,

@@ -594,6 +594,34 @@ inline void apply(const MagneticField&, const Lanes& L, std::size_t n, const Blo
   });
 }
 
+// SampledField over a grid of fewer than 2^31 floats (its lookups gathered with 32-bit
+// offsets), in mode kCarry; `fall` the falloff as withFalloff gives it.
+template <int kCarry, class Dt>
+[[gnu::flatten]] inline void sampledFieldLoop(
+    const float* __restrict px, const float* __restrict py, const float* __restrict pz,
+    float* __restrict vx, float* __restrict vy, float* __restrict vz, std::size_t n, Dt dt,
+    const float* __restrict grid, int nx, int ny, int nz, Vec3 o, float voxel,
+    cl::FlSampledFieldParams s, cl::FlFalloffParams fall) {
+  s.carry = kCarry;
+  const float ox = o.x, oy = o.y, oz = o.z;
+  // The carry's approach (an exp) once for a step length all share.
+  constexpr bool kUniform = std::is_same_v<Dt, UniformDt>;
+  float approach = 0.0f;
+  if constexpr (kCarry && kUniform)
+    approach = kernel::fl_force_approach(s.responsiveness, dt[0], s.dt, s.decay);
+  for (std::size_t i = 0; i < n; ++i) {
+    const float x0 = px[i], y0 = py[i], z0 = pz[i];
+    const Vec3 u = kernel::fl_grid_sample_int(grid, nx, ny, nz, ox, oy, oz, voxel, x0, y0, z0);
+    float x = vx[i], y = vy[i], z = vz[i];
+    const float w = kernel::fl_falloff_weight(fall, x0, y0, z0);
+    if constexpr (kCarry && !kUniform)
+      kernel::fl_sampled_field(s, dt[i], w, u.x, u.y, u.z, &x, &y, &z);
+    else
+      kernel::fl_sampled_field_approach(s, approach, dt[i], w, u.x, u.y, u.z, &x, &y, &z);
+    vx[i] = x, vy[i] = y, vz[i] = z;
+  }
+}
+
 // The grid is the CPU's own copy (VectorField), sampled as the device samples its buffer.
 inline void apply(const SampledField& a, const Lanes& L, std::size_t n, const BlockContext& c) {
   const cl::FlActionParams& r = c.record();
@@ -605,14 +633,18 @@ inline void apply(const SampledField& a, const Lanes& L, std::size_t n, const Bl
     const int nx = field.dims.x, ny = field.dims.y, nz = field.dims.z;
     const Vec3 o = field.origin;
     const float vs = field.voxelSize;
+    // The mode too as a constant of the loop (as withFalloff the falloff's), and the grid's
+    // lookups in a loop of its own over restricted arrays: GCC left the loop scalar with the
+    // mode's branch inside it, and with the grid reached through the lambda's captures.
     withFalloff(f, [&](auto fall) {
-      velocityLoop(
-          L, n, c, [=](float px, float py, float pz, float dt, float* x, float* y, float* z) {
-            const Vec3 u =
-                kernel::fl_grid_sample_int(grid, nx, ny, nz, o.x, o.y, o.z, vs, px, py, pz);
-            kernel::fl_sampled_field(s, dt, kernel::fl_falloff_weight(fall(), px, py, pz), u.x, u.y,
-                                     u.z, x, y, z);
-          });
+      withDt(c, [&](auto dt) {
+        if (s.carry)
+          sampledFieldLoop<1>(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, dt, grid, nx, ny,
+                              nz, o, vs, s, fall());
+        else
+          sampledFieldLoop<0>(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n, dt, grid, nx, ny,
+                              nz, o, vs, s, fall());
+      });
     });
     return;
   }
