@@ -68,6 +68,46 @@ inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std
     }
     return;
   }
+  // Drawn accelerations (Jet, RandomAccel): every particle's drawn in batches, the same
+  // numbers as one Random each (sampleFromActionStreams), then weighed at the stage's place.
+  const Domain* drawn = nullptr;
+  if (const auto* jet = std::get_if<Jet>(&action)) drawn = &jet->acceleration;
+  if (const auto* ra = std::get_if<RandomAccel>(&action)) drawn = &ra->acceleration;
+  if (drawn) {
+    const bool isJet = std::holds_alternative<Jet>(action);
+    const cl::FlJetParams jet = record.own.jet;
+    withFalloff(f, [&](auto fall) {
+      sampleFromActionStreams(
+          *drawn, L, n, c, [&](std::size_t first, std::size_t m, float* dx, float* dy, float* dz) {
+            const float* __restrict px = s.p[0] + first;
+            const float* __restrict py = s.p[1] + first;
+            const float* __restrict pz = s.p[2] + first;
+            float* __restrict ax = s.a[0] + first;
+            float* __restrict ay = s.a[1] + first;
+            float* __restrict az = s.a[2] + first;
+            const float* __restrict sx = dx;
+            const float* __restrict sy = dy;
+            const float* __restrict sz = dz;
+            if (isJet) {
+              for (std::size_t k = 0; k < m; ++k) {  // (out of reach: + 0, as the sum was)
+                const int in = kernel::fl_jet_reaches(jet, px[k], py[k], pz[k]);
+                ax[k] += in ? sx[k] : 0.0f;
+                ay[k] += in ? sy[k] : 0.0f;
+                az[k] += in ? sz[k] : 0.0f;
+              }
+            } else {
+              const cl::FlFalloffParams ff = fall();
+              for (std::size_t k = 0; k < m; ++k) {
+                const float w = kernel::fl_falloff_weight(ff, px[k], py[k], pz[k]);
+                ax[k] += sx[k] * w;
+                ay[k] += sy[k] * w;
+                az[k] += sz[k] * w;
+              }
+            }
+          });
+    });
+    return;
+  }
   std::visit(
       [&](const auto& a) {
         using A = std::decay_t<decltype(a)>;
@@ -85,7 +125,7 @@ inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std
               [r, fall, t, charge, mass, &a, &c, &L](std::size_t i, Vec3 p, Vec3 v, float& ax,
                                                      float& ay, float& az) {
                 const cl::FlFalloffParams f = fall();
-                Vec3 acc(0.0f);  // drawn from the CPU's own domains, or summed over neighbours
+                Vec3 acc(0.0f);  // summed over neighbours
                 if constexpr (std::is_same_v<A, Gravity>) {
                   kernel::fl_gravity_acc(r.own.gravity, f, p.x, p.y, p.z, &ax, &ay, &az);
                 } else if constexpr (std::is_same_v<A, Damping>) {
@@ -108,16 +148,8 @@ inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std
                         softPull(Vec3(sn.p[0][next], sn.p[1][next], sn.p[2][next]) - p, r.own.pull);
                 } else if constexpr (std::is_same_v<A, Vortex>) {
                   kernel::fl_vortex_acc(r.own.vortex, p.x, p.y, p.z, v.x, v.y, v.z, &ax, &ay, &az);
-                } else if constexpr (std::is_same_v<A, Jet>) {
-                  if (kernel::fl_jet_reaches(r.own.jet, p.x, p.y, p.z)) {
-                    Random rng = actionRandom(c, L, i);
-                    acc = a.acceleration.sample(rng);
-                  }
                 } else if constexpr (std::is_same_v<A, Explosion>) {
                   kernel::fl_explosion_acc(r.own.explosion, t, p.x, p.y, p.z, &ax, &ay, &az);
-                } else if constexpr (std::is_same_v<A, RandomAccel>) {
-                  Random rng = actionRandom(c, L, i);
-                  acc = a.acceleration.sample(rng) * kernel::fl_falloff_weight(f, p.x, p.y, p.z);
                 } else if constexpr (std::is_same_v<A, Turbulence>) {
                   kernel::fl_turbulence_acc(r.own.turbulence, f, t, p.x, p.y, p.z, &ax, &ay, &az);
                 } else if constexpr (std::is_same_v<A, ElectricField>) {
@@ -127,13 +159,21 @@ inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std
                   kernel::fl_magnetic_acc(r.own.magnetic, f, p.x, p.y, p.z, v.x, v.y, v.z,
                                           charge[i], mass[i], &ax, &ay, &az);
                 } else if constexpr (std::is_same_v<A, SampledField>) {
-                  const Vec3 u = sampleTrilinear(*a.field, p);
+                  // (a grid of fewer than 2^31 floats in 32-bit offsets, gathered in vectors:
+                  // the same values, as in its own loop)
+                  const VectorField& field = *a.field;
+                  const Vec3 u =
+                      field.data.size() * 3 < (std::size_t(1) << 31)
+                          ? kernel::fl_grid_sample_int(
+                                reinterpret_cast<const float*>(field.data.data()), field.dims.x,
+                                field.dims.y, field.dims.z, field.origin.x, field.origin.y,
+                                field.origin.z, field.voxelSize, p.x, p.y, p.z)
+                          : sampleTrilinear(field, p);
                   kernel::fl_sampled_field_acc(r.own.sampledField,
                                                kernel::fl_falloff_weight(f, p.x, p.y, p.z), u.x,
                                                u.y, u.z, v.x, v.y, v.z, &ax, &ay, &az);
                 }
-                if constexpr (std::is_same_v<A, Gravitate> || std::is_same_v<A, Follow> ||
-                              std::is_same_v<A, Jet> || std::is_same_v<A, RandomAccel>) {
+                if constexpr (std::is_same_v<A, Gravitate> || std::is_same_v<A, Follow>) {
                   ax += acc.x;
                   ay += acc.y;
                   az += acc.z;
@@ -141,8 +181,7 @@ inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std
               });
         };
         constexpr bool weighs = std::is_same_v<A, Gravity> || std::is_same_v<A, Damping> ||
-                                std::is_same_v<A, RandomAccel> || std::is_same_v<A, Turbulence> ||
-                                std::is_same_v<A, ElectricField> ||
+                                std::is_same_v<A, Turbulence> || std::is_same_v<A, ElectricField> ||
                                 std::is_same_v<A, MagneticField> || std::is_same_v<A, SampledField>;
         if constexpr (weighs)
           withFalloff(r.falloff, run);
