@@ -108,6 +108,34 @@ inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std
     });
     return;
   }
+  // A SampledField on a grid of fewer than 2^31 floats: its lookups in 32-bit offsets,
+  // gathered in vectors, and its mode a constant of the loop (as in its own loop).
+  if (const auto* sf = std::get_if<SampledField>(&action);
+      sf && sf->field->data.size() * 3 < (std::size_t(1) << 31)) {
+    const VectorField& field = *sf->field;
+    const float* grid = reinterpret_cast<const float*>(field.data.data());
+    const int nx = field.dims.x, ny = field.dims.y, nz = field.dims.z;
+    const float ox = field.origin.x, oy = field.origin.y, oz = field.origin.z;
+    const float voxel = field.voxelSize;
+    const cl::FlSampledFieldParams params = record.own.sampledField;
+    auto mode = [&](auto carry) {
+      cl::FlSampledFieldParams sp = params;
+      sp.carry = decltype(carry)::value;
+      withFalloff(f, [&](auto fall) {
+        stageLoop(s, n, [=](std::size_t, Vec3 p, Vec3 v, float& ax, float& ay, float& az) {
+          const Vec3 u =
+              kernel::fl_grid_sample_int(grid, nx, ny, nz, ox, oy, oz, voxel, p.x, p.y, p.z);
+          kernel::fl_sampled_field_acc(sp, kernel::fl_falloff_weight(fall(), p.x, p.y, p.z), u.x,
+                                       u.y, u.z, v.x, v.y, v.z, &ax, &ay, &az);
+        });
+      });
+    };
+    if (params.carry)
+      mode(std::integral_constant<int, 1>{});
+    else
+      mode(std::integral_constant<int, 0>{});
+    return;
+  }
   std::visit(
       [&](const auto& a) {
         using A = std::decay_t<decltype(a)>;
@@ -159,16 +187,7 @@ inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std
                   kernel::fl_magnetic_acc(r.own.magnetic, f, p.x, p.y, p.z, v.x, v.y, v.z,
                                           charge[i], mass[i], &ax, &ay, &az);
                 } else if constexpr (std::is_same_v<A, SampledField>) {
-                  // (a grid of fewer than 2^31 floats in 32-bit offsets, gathered in vectors:
-                  // the same values, as in its own loop)
-                  const VectorField& field = *a.field;
-                  const Vec3 u =
-                      field.data.size() * 3 < (std::size_t(1) << 31)
-                          ? kernel::fl_grid_sample_int(
-                                reinterpret_cast<const float*>(field.data.data()), field.dims.x,
-                                field.dims.y, field.dims.z, field.origin.x, field.origin.y,
-                                field.origin.z, field.voxelSize, p.x, p.y, p.z)
-                          : sampleTrilinear(field, p);
+                  const Vec3 u = sampleTrilinear(*a.field, p);  // (a larger grid)
                   kernel::fl_sampled_field_acc(r.own.sampledField,
                                                kernel::fl_falloff_weight(f, p.x, p.y, p.z), u.x,
                                                u.y, u.z, v.x, v.y, v.z, &ax, &ay, &az);
