@@ -353,6 +353,36 @@ FL_INLINE float3 fl_closest_triangle(float3 a, float3 b, float3 c, float3 p) {
   return a + ab * (vb * denom) + ac * (vc * denom);
 }
 
+/* c ? a : b, one component at a time (a choice of whole vectors is a copy through memory on
+ * the CPU, which a vector loop cannot take). */
+FL_INLINE float3 fl_choose3(int c, float3 a, float3 b) {
+  return make_float3(c ? a.x : b.x, c ? a.y : b.y, c ? a.z : b.z);
+}
+
+/* fl_closest_triangle with every case computed and the first that holds chosen: the same
+ * point, bit for bit (tests/test_domain.cpp), without a branch, for a loop over many points
+ * that vectorises (a chunk's crossings of a triangle). The cases not chosen may divide by
+ * zero; their values are dropped. The tests are combined with & (not &&: GCC does not
+ * evaluate a float comparison that && would skip, and the loop keeps a branch). */
+FL_INLINE float3 fl_closest_triangle_chosen(float3 a, float3 b, float3 c, float3 p) {
+  const float3 ab = b - a, ac = c - a, ap = p - a, bp = p - b, cp = p - c;
+  const float d1 = fl_dotv(ab, ap), d2 = fl_dotv(ac, ap);
+  const float d3 = fl_dotv(ab, bp), d4 = fl_dotv(ac, bp);
+  const float d5 = fl_dotv(ab, cp), d6 = fl_dotv(ac, cp);
+  const float vc = d1 * d4 - d3 * d2, vb = d5 * d2 - d1 * d6, va = d3 * d6 - d5 * d4;
+  const float denom = 1.0f / (va + vb + vc);
+  float3 q = a + ab * (vb * denom) + ac * (vc * denom);
+  /* From the last case to the first, so that the first that holds is the one kept. */
+  q = fl_choose3((va <= 0.0f) & ((d4 - d3) >= 0.0f) & ((d5 - d6) >= 0.0f),
+                 b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))), q);
+  q = fl_choose3((vb <= 0.0f) & (d2 >= 0.0f) & (d6 <= 0.0f), a + ac * (d2 / (d2 - d6)), q);
+  q = fl_choose3((d6 >= 0.0f) & (d5 <= d6), c, q);
+  q = fl_choose3((vc <= 0.0f) & (d1 >= 0.0f) & (d3 <= 0.0f), a + ab * (d1 / (d1 - d3)), q);
+  q = fl_choose3((d3 >= 0.0f) & (d4 <= d3), b, q);
+  q = fl_choose3((d1 <= 0.0f) & (d2 <= 0.0f), a, q);
+  return q;
+}
+
 /* The nearest point of a plane through `point` with unit normal n. */
 FL_INLINE float3 fl_closest_plane(float3 point, float3 n, float3 p) {
   return p - n * fl_dotv(p - point, n);

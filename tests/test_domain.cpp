@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <limits>
 #include <string>
@@ -15,6 +16,7 @@
 #include "flurry/domain.hpp"
 #include "flurry/error.hpp"
 #include "flurry/random.hpp"
+#include "shape_math.hpp"  // kernels/domain.h on the CPU
 
 namespace {
 
@@ -694,3 +696,36 @@ TEST(DomainValidation, FactoriesNormaliseAndOrder) {
 }
 
 }  // namespace
+
+// The branch-free nearest point of a triangle (kernels/domain.h fl_closest_triangle_chosen, the
+// vector loops' form) is the branching one's, bit for bit: points all around and in the plane
+// (every Voronoi region), on edges and corners, and degenerate triangles.
+TEST(Domain, BranchFreeNearestPointOfATriangleIsTheBranchingOnes) {
+  namespace k = flurry::detail::kernel;
+  Random rng(11, 0, 0, 0);
+  auto same = [](Vec3 a, Vec3 b) {
+    return std::memcmp(&a, &b, sizeof a) == 0 || (std::isnan(a.x) && std::isnan(b.x));
+  };
+  std::size_t checked = 0;
+  for (int piece = 0; piece < 400; ++piece) {
+    auto point = [&](float r) {
+      return Vec3(rng.uniform(-r, r), rng.uniform(-r, r), rng.uniform(-r, r));
+    };
+    Vec3 a = point(2.0f), b = point(2.0f), c = point(2.0f);
+    if (piece % 50 == 1) c = b;                   // a degenerate triangle: two corners one
+    if (piece % 50 == 2) c = a + (b - a) * 0.5f;  // ... its corners on a line
+    if (piece % 50 == 3) b = c = a;               // ... a point
+    const Vec3 u = b - a, w = c - a;
+    for (int q = 0; q < 60; ++q) {
+      Vec3 p = point(4.0f);
+      if (q % 6 == 1) p = a + (b - a) * rng.uniform();                // on an edge
+      if (q % 6 == 2) p = (q % 12 == 2) ? b : c;                      // on a corner
+      if (q % 6 == 3) p = a + u * rng.uniform() + w * rng.uniform();  // in the plane
+      const Vec3 t0 = k::fl_closest_triangle(a, b, c, p);
+      const Vec3 t1 = k::fl_closest_triangle_chosen(a, b, c, p);
+      EXPECT_TRUE(same(t0, t1)) << "triangle " << piece << " point " << q;
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 400u * 60u);
+}

@@ -342,6 +342,17 @@ ActionList forceAloneEuler(const std::string& name) {
     const Domain disc = Domain::disc(Vec3(0.0f, 9.0f, 0.0f), Vec3(0.0f, 1.0f, 0.0f), 3.0f);
     return {Sink{disc, 0.0f, Sink::Mode::Hit}, Move{}};
   }
+  if (name == "SinkHitRectangle") {  // the same above the box, a rectangle's nearest point
+    const Domain r =
+        Domain::rectangle(Vec3(-3.0f, 9.0f, -3.0f), Vec3(6.0f, 0.0f, 0.0f), Vec3(0.0f, 0.0f, 6.0f));
+    return {Sink{r, 0.0f, Sink::Mode::Hit}, Move{}};
+  }
+  if (name == "AvoidTriangle") {  // a triangle across the box, its crossings tested
+    Avoid a;
+    a.obstacle =
+        Domain::triangle(Vec3(-4.0f, 4.0f, -4.0f), Vec3(4.0f, 4.0f, -4.0f), Vec3(0.0f, 4.0f, 4.0f));
+    return {a, Move{}};
+  }
   return {};
 }
 
@@ -593,6 +604,8 @@ FLURRY_FORCE(JetDrawn)
 FLURRY_FORCE(Avoid)
 FLURRY_FORCE(AvoidPlane)
 FLURRY_FORCE(SinkHit)
+FLURRY_FORCE(SinkHitRectangle)
+FLURRY_FORCE(AvoidTriangle)
 BENCHMARK_CAPTURE(Flock, MatchVelocity, "MatchVelocity")
     ->Arg(4096)
     ->Unit(benchmark::kMillisecond)

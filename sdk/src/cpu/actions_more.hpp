@@ -126,7 +126,8 @@ inline void threatLoop(const Shape& shape, const float* __restrict px, const flo
 // from the piece's nearest point, as Domain gives it), *h, and how far that lies from the
 // piece (Domain::distance), into gap; infinite where it does not cross. Sink's Hit and a
 // planar obstacle's Avoid test a chunk of particles so, in vectors where the piece's nearest
-// point is branch-free (plane, disc).
+// point is branch-free (plane, disc, a triangle's in its branch-free form: closestChosen; a
+// rectangle's branches, and its loop stays scalar).
 template <class Shape, class Len>
 [[gnu::flatten]] inline void planarCrossingLoop(
     const Shape& s, const float* __restrict px, const float* __restrict py,
@@ -137,8 +138,8 @@ template <class Shape, class Len>
     const Vec3 p(px[i], py[i], pz[i]);
     const Vec3 q = p + Vec3(vx[i], vy[i], vz[i]) * len[i];
     Vec3 h = p;
-    const int crosses = kernel::fl_path_crosses(p, q, detail::closest(s, p), s.normal, &h);
-    const float d = glm::length(h - detail::closest(s, h));
+    const int crosses = kernel::fl_path_crosses(p, q, detail::closestChosen(s, p), s.normal, &h);
+    const float d = glm::length(h - detail::closestChosen(s, h));
     gap[i] = crosses ? d : kInfinity;
     hx[i] = h.x, hy[i] = h.y, hz[i] = h.z;
   }
