@@ -218,19 +218,12 @@ void eulerLoop(const float* __restrict a, float* __restrict p, float* __restrict
                Dt dt) {
   for (std::size_t i = 0; i < n; ++i) kernel::fl_euler_explicit(a[i], dt[i], &p[i], &v[i]);
 }
-template <class Dt>
-void verletPredictLoop(const float* __restrict p, const float* __restrict v,
-                       const float* __restrict a0, float* __restrict p1, float* __restrict v1,
-                       std::size_t n, Dt dt) {
-  for (std::size_t i = 0; i < n; ++i)
-    kernel::fl_verlet_predict(p[i], v[i], a0[i], dt[i], &p1[i], &v1[i]);
-}
-template <class Dt>
-void verletFinishLoop(const float* __restrict p1, const float* __restrict a0,
-                      const float* __restrict a1, float* __restrict p, float* __restrict v,
-                      std::size_t n, Dt dt) {
-  for (std::size_t i = 0; i < n; ++i)
-    kernel::fl_verlet_finish(p1[i], a0[i], a1[i], dt[i], &p[i], &v[i]);
+// f(x[i], y[i], z[i], dt[i], &out0[i], &out1[i]): Verlet's halves.
+template <class Dt, class F>
+[[gnu::flatten]] void threeToTwoLoop(const float* __restrict x, const float* __restrict y,
+                                     const float* __restrict z, float* __restrict out0,
+                                     float* __restrict out1, std::size_t n, Dt dt, F f) {
+  for (std::size_t i = 0; i < n; ++i) f(x[i], y[i], z[i], dt[i], &out0[i], &out1[i]);
 }
 // RK4's stages (kernels/integrate.h): each weighs its slopes (vs, a) into the sums and makes
 // the next stage's state, `next` of the step on. The first takes its slopes from the lanes and
@@ -334,9 +327,13 @@ inline void integrate(Integrator integrator, const std::vector<Action>& acts,
       arrays3(p1);
       arrays3(v1);
       evaluate(L.p, L.v, a0, t);
-      for (int d = 0; d < 3; ++d) verletPredictLoop(L.p[d], L.v[d], a0[d], p1[d], v1[d], n, dt);
+      for (int d = 0; d < 3; ++d)
+        threeToTwoLoop(L.p[d], L.v[d], a0[d], p1[d], v1[d], n, dt,
+                       [](auto... x) { kernel::fl_verlet_predict(x...); });
       evaluate(p1, v1, a1, t + h0);
-      for (int d = 0; d < 3; ++d) verletFinishLoop(p1[d], a0[d], a1[d], L.p[d], L.v[d], n, dt);
+      for (int d = 0; d < 3; ++d)
+        threeToTwoLoop(p1[d], a0[d], a1[d], L.p[d], L.v[d], n, dt,
+                       [](auto... x) { kernel::fl_verlet_finish(x...); });
       break;
     }
     case Integrator::RK4: {
