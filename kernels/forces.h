@@ -675,10 +675,9 @@ FL_INLINE void fl_magnetic_acc(FlMagneticParams m, FlFalloffParams f, float px, 
 
 /* SampledField, from the field's value (ux, uy, uz) at p (each side samples its own copy of
  * the grid with fl_field_axis and fl_field_blend) and the falloff's weight w: an acceleration
- * (v + u s dt w), or carried towards it (Mode::Velocity). */
-/* The same with the carry's approach over dt given (fl_force_approach(s.responsiveness, dt,
- * s.dt, s.decay); unread without a carry): a loop over particles of one step length takes it
- * once. */
+ * (v + u s dt w), or carried towards it (Mode::Velocity) by `approach`, the carry's
+ * fl_force_approach(s.responsiveness, dt, s.dt, s.decay) (unread without a carry), which a
+ * loop over particles of one step length takes once. fl_sampled_field takes it itself. */
 FL_INLINE void fl_sampled_field_approach(FlSampledFieldParams s, float approach, float dt, float w,
                                          float ux, float uy, float uz, float* vx, float* vy,
                                          float* vz) {
