@@ -412,6 +412,49 @@ FL_INLINE float3 fl_closest_rectangle(float3 a, float3 u, float3 w, float3 p) {
   return best;
 }
 
+/* fl_closest_segment's point with its guard of a degenerate segment as a mask of bits: t's
+ * bits are kept where len2 > 0 and are +0 where not, as the guard's 0. In a loop over points
+ * the segment is the same for all, and GCC 12 vectorises no choice by a loop-invariant
+ * comparison (its AVX-512 loop stays scalar); an AND with an invariant mask it takes. */
+FL_INLINE float3 fl_closest_segment_masked(float3 a, float3 b, float3 p) {
+  const float3 ab = b - a;
+  const float len2 = fl_dotv(ab, ab);
+  const uint keep = 0u - (uint)(len2 > 0.0f);
+  const float t = as_float(as_uint(fl_clampf(fl_dotv(p - a, ab) / len2, 0.0f, 1.0f)) & keep);
+  return a + ab * t;
+}
+
+/* fl_closest_rectangle with both cases computed and chosen component by component, as
+ * fl_closest_triangle_chosen: the same point, bit for bit (tests/test_domain.cpp), for the
+ * loops over a chunk's crossings of a rectangle. The nearest of the edges' points is taken as
+ * the branching form takes it (the first of equals kept). */
+FL_INLINE float3 fl_closest_rectangle_chosen(float3 a, float3 u, float3 w, float3 p) {
+  const float3 r = p - a;
+  const float uu = fl_dotv(u, u), uv = fl_dotv(u, w), vv = fl_dotv(w, w);
+  const float ru = fl_dotv(r, u), rv = fl_dotv(r, w);
+  const float3 c = fl_crossv(u, w);
+  const float det = fl_dotv(c, c);
+  const float s = (vv * ru - uv * rv) / det, t = (uu * rv - uv * ru) / det;
+  const float3 b = a + u, cc = a + u + w, e = a + w;
+  float3 best = fl_closest_segment_masked(a, b, p);
+  float bestD2 = fl_dotv(p - best, p - best);
+  const float3 q1 = fl_closest_segment_masked(b, cc, p);
+  const float d1 = fl_dotv(p - q1, p - q1);
+  const int n1 = d1 < bestD2;
+  best = fl_choose3(n1, q1, best);
+  bestD2 = n1 ? d1 : bestD2;
+  const float3 q2 = fl_closest_segment_masked(cc, e, p);
+  const float d2 = fl_dotv(p - q2, p - q2);
+  const int n2 = d2 < bestD2;
+  best = fl_choose3(n2, q2, best);
+  bestD2 = n2 ? d2 : bestD2;
+  const float3 q3 = fl_closest_segment_masked(e, a, p);
+  const float d3 = fl_dotv(p - q3, p - q3);
+  best = fl_choose3(d3 < bestD2, q3, best);
+  return fl_choose3((s >= 0.0f) & (s <= 1.0f) & (t >= 0.0f) & (t <= 1.0f), a + u * s + w * t,
+                    best);
+}
+
 /* Disc or ring ri..ro around `center` with unit normal n; `perp` is fl_any_perpendicular(n),
  * the direction taken on the axis of a ring, where every rim point is as near. */
 FL_INLINE float3 fl_closest_disc(float3 center, float3 n, float3 perp, float ro, float ri,

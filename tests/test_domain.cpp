@@ -729,3 +729,39 @@ TEST(Domain, BranchFreeNearestPointOfATriangleIsTheBranchingOnes) {
   }
   EXPECT_EQ(checked, 400u * 60u);
 }
+
+TEST(Domain, BranchFreeNearestPointOfARectangleIsTheBranchingOnes) {
+  namespace k = flurry::detail::kernel;
+  Random rng(12, 0, 0, 0);
+  auto same = [](Vec3 a, Vec3 b) {
+    return std::memcmp(&a, &b, sizeof a) == 0 || (std::isnan(a.x) && std::isnan(b.x));
+  };
+  const float inf = std::numeric_limits<float>::infinity();
+  std::size_t checked = 0;
+  for (int piece = 0; piece < 400; ++piece) {
+    auto point = [&](float r) {
+      return Vec3(rng.uniform(-r, r), rng.uniform(-r, r), rng.uniform(-r, r));
+    };
+    const Vec3 a = point(2.0f);
+    Vec3 u = point(2.0f), w = point(2.0f);
+    if (piece % 50 == 1) w = u * 0.5f;                  // degenerate: its edges on a line
+    if (piece % 50 == 2) u = Vec3(0.0f);                // ... an edge of no length
+    if (piece % 50 == 3) u = w = Vec3(0.0f);            // ... a point
+    if (piece % 50 == 4) u = Vec3(1e-30f, 0.0f, 0.0f);  // ... an edge whose length² is 0
+    if (piece % 50 == 5) w = Vec3(0.0f, -1e-30f, 0.0f);
+    for (int q = 0; q < 60; ++q) {
+      Vec3 p = point(4.0f);
+      if (q % 6 == 1) p = a + u * rng.uniform();                      // on an edge
+      if (q % 6 == 2) p = (q % 12 == 2) ? a + u : a + u + w;          // on a corner
+      if (q % 6 == 3) p = a + u * rng.uniform() + w * rng.uniform();  // on it
+      if (q == 5) p.y = inf;
+      if (q == 11) p.x = -inf;
+      if (q == 17) p.z = std::numeric_limits<float>::quiet_NaN();
+      const Vec3 r0 = k::fl_closest_rectangle(a, u, w, p);
+      const Vec3 r1 = k::fl_closest_rectangle_chosen(a, u, w, p);
+      EXPECT_TRUE(same(r0, r1)) << "rectangle " << piece << " point " << q;
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 400u * 60u);
+}

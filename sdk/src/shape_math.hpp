@@ -65,12 +65,14 @@ inline Vec3 closest(const DiscDomain& d, Vec3 p) {
   return kernel::fl_closest_disc(d.center, d.normal, kernel::fl_any_perpendicular(d.normal),
                                  d.outerRadius, d.innerRadius, p);
 }
-/// The same point without a branch (kernels/domain.h fl_closest_triangle_chosen), for loops
-/// over many points that vectorise; a plane's and a disc's are branch-free already. (A
-/// parallelogram's branch-free form, tried, stayed scalar in GCC 12's AVX-512 loop and cost
-/// more than its branches: it keeps them.)
+/// The same point without a branch (kernels/domain.h fl_closest_triangle_chosen,
+/// fl_closest_rectangle_chosen), for loops over many points that vectorise; a plane's and a
+/// disc's are branch-free already.
 inline Vec3 closestChosen(const TriangleDomain& d, Vec3 p) {
   return kernel::fl_closest_triangle_chosen(d.p0, d.p1, d.p2, p);
+}
+inline Vec3 closestChosen(const RectangleDomain& d, Vec3 p) {
+  return kernel::fl_closest_rectangle_chosen(d.origin, d.u, d.v, p);
 }
 template <class Shape>
 inline Vec3 closestChosen(const Shape& d, Vec3 p) {

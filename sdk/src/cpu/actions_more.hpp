@@ -125,23 +125,30 @@ inline void threatLoop(const Shape& shape, const float* __restrict px, const flo
 // Where each straight path p -> p + v·len crosses a planar piece's plane (fl_path_crosses
 // from the piece's nearest point, as Domain gives it), *h, and how far that lies from the
 // piece (Domain::distance), into gap; infinite where it does not cross. Sink's Hit and a
-// planar obstacle's Avoid test a chunk of particles so, in vectors where the piece's nearest
-// point is branch-free (plane, disc, a triangle's in its branch-free form: closestChosen; a
-// rectangle's branches, and its loop stays scalar).
+// planar obstacle's Avoid test a chunk of particles so, in vectors: the piece's nearest point
+// is branch-free (a plane's and a disc's as they are, a triangle's and a rectangle's in their
+// branch-free forms: closestChosen).
 template <class Shape, class Len>
 [[gnu::flatten]] inline void planarCrossingLoop(
     const Shape& s, const float* __restrict px, const float* __restrict py,
     const float* __restrict pz, const float* __restrict vx, const float* __restrict vy,
     const float* __restrict vz, Len len, std::size_t n, float* __restrict gap, float* __restrict hx,
     float* __restrict hy, float* __restrict hz) {
+  // Two loops: the crossings, then their distances. In one, GCC 12 chose between the two
+  // points' tests inside the piece (a choice of masks) and vectorised neither a triangle's nor
+  // a rectangle's loop.
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3 p(px[i], py[i], pz[i]);
     const Vec3 q = p + Vec3(vx[i], vy[i], vz[i]) * len[i];
     Vec3 h = p;
     const int crosses = kernel::fl_path_crosses(p, q, detail::closestChosen(s, p), s.normal, &h);
-    const float d = glm::length(h - detail::closestChosen(s, h));
-    gap[i] = crosses ? d : kInfinity;
+    gap[i] = crosses ? 0.0f : kInfinity;
     hx[i] = h.x, hy[i] = h.y, hz[i] = h.z;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 h(hx[i], hy[i], hz[i]);
+    const float d = glm::length(h - detail::closestChosen(s, h));
+    gap[i] = gap[i] == 0.0f ? d : kInfinity;
   }
 }
 
