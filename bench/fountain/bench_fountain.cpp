@@ -318,6 +318,7 @@ ActionList forceAloneEuler(const std::string& name) {
   }
   if (name == "Spin") return {Move{}};  // Move turning the up vector (Forces stores it)
   if (name == "OrbitPoint") return {OrbitPoint{}, Move{}};
+  if (name == "Follow") return {Follow{0.5f, 0.01f}, Move{}};  // each towards the next
   if (name.rfind("Jet", 0) == 0) {
     Jet j;
     j.center = Vec3(0.0f, 4.0f, 0.0f);
@@ -402,16 +403,21 @@ void Forces(benchmark::State& state, const char* name) {
   state.SetBytesProcessed(std::int64_t(double(state.iterations()) * double(n) * bytes));
 }
 
-// A flock: MatchVelocity (or Gravitate) over `n` particles in a 4 m box, each against all the
-// others (the classic API's neighbour actions are O(n^2)): items are particle pairs.
+// A flock: MatchVelocity (or Gravitate, alone or under RK4) over `n` particles in a 4 m box, each
+// against all the others (the classic API's neighbour actions are O(n^2)): items are particle
+// pairs.
 void Flock(benchmark::State& state, const char* action) {
   const auto n = std::size_t(state.range(0));
   Context ctx(sixtyHertz());
   Group& g = burstOf(ctx, n, Domain::box(Vec3(-2.0f), Vec3(2.0f)), 1.0f);
-  if (std::string(action) == "Gravitate")
-    g.setActions({Gravitate{0.01f, 0.01f}, Move{}});
-  else
+  const std::string name = action;
+  if (name.rfind("Gravitate", 0) == 0) {
+    ActionList list{Gravitate{0.01f, 0.01f}, Move{}};
+    if (name == "GravitateRK4") list.setIntegrator(Integrator::RK4);  // four scans a step
+    g.setActions(list);
+  } else {
     g.setActions({MatchVelocity{}, Move{}});
+  }
   ctx.step();
   for (auto _ : state) ctx.step();
   state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(n) * std::int64_t(n));
@@ -596,6 +602,7 @@ FLURRY_FORCE(VortexRK4)
 FLURRY_FORCE(ElectricFieldRK4)
 FLURRY_FORCE(JetDrawnRK4)
 FLURRY_FORCE(SampledFieldRK4)
+FLURRY_FORCE(FollowRK4)
 FLURRY_FORCE(SampledField)
 FLURRY_FORCE(SampledFieldCarry)
 FLURRY_FORCE(OrbitPoint)
@@ -611,6 +618,10 @@ BENCHMARK_CAPTURE(Flock, MatchVelocity, "MatchVelocity")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(Flock, Gravitate, "Gravitate")
+    ->Arg(4096)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(Flock, GravitateRK4, "GravitateRK4")
     ->Arg(4096)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();

@@ -48,6 +48,21 @@ inline void stageLoop(const Stage& s, std::size_t n, F f) {
   stageLoop(s.p[0], s.p[1], s.p[2], s.v[0], s.v[1], s.v[2], s.a[0], s.a[1], s.a[2], n, f);
 }
 
+// Follow's pull at a stage: towards the leader (the next particle) at (lx, ly, lz)[i].
+inline void followStageLoop(const float* __restrict lx, const float* __restrict ly,
+                            const float* __restrict lz, const float* __restrict px,
+                            const float* __restrict py, const float* __restrict pz,
+                            float* __restrict ax, float* __restrict ay, float* __restrict az,
+                            std::size_t n, const cl::FlPullParams q) {
+  for (std::size_t i = 0; i < n; ++i) {
+    float ox, oy, oz;
+    kernel::fl_pull(q, lx[i] - px[i], ly[i] - py[i], lz[i] - pz[i], &ox, &oy, &oz);
+    ax[i] += ox;
+    ay[i] += oy;
+    az[i] += oz;
+  }
+}
+
 // Adds one force's acceleration at (p, v, t), from its record (c.record()) by the shared
 // kernel functions (kernels/forces.h), which add to the stage's sums as the device's do. `L`
 // gives the per-particle constants (charge, mass, id); `c` the step (its random numbers are the
@@ -108,6 +123,35 @@ inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std
     });
     return;
   }
+  // Gravitate: each stage's pulls summed as in its own loop (gravitateScan: two vectors'
+  // worth of particles against the step's snapshot, each in the scalar order, itself adding
+  // -0), from the stage's positions; then added to the stage's sums.
+  if (std::holds_alternative<Gravitate>(action)) {
+    const Snapshot& sn = *c.snapshot;
+    for (std::size_t i0 = 0; i0 < n; i0 += kMatchLanes) {
+      const ScanLanes at0(s.p, c.base, i0, n);
+      alignas(64) float gx[kMatchLanes], gy[kMatchLanes], gz[kMatchLanes];
+      gravitateScan(sn.p[0], sn.p[1], sn.p[2], sn.size, at0.p[0], at0.p[1], at0.p[2], at0.own,
+                    record.own.pull, gx, gy, gz);
+      for (std::size_t l = 0; l < at0.lanes; ++l) {
+        s.a[0][i0 + l] += gx[l];
+        s.a[1][i0 + l] += gy[l];
+        s.a[2][i0 + l] += gz[l];
+      }
+    }
+    return;
+  }
+  // Follow: the pull towards the next particle as it was at the step's start, a loop over
+  // those that have one; the last of the group leads (it adds +0, as the sum of none).
+  if (std::holds_alternative<Follow>(action)) {
+    const Snapshot& sn = *c.snapshot;
+    const std::size_t led = sn.size > c.base + 1 ? std::min(n, sn.size - c.base - 1) : 0;
+    followStageLoop(sn.p[0] + c.base + 1, sn.p[1] + c.base + 1, sn.p[2] + c.base + 1, s.p[0],
+                    s.p[1], s.p[2], s.a[0], s.a[1], s.a[2], led, record.own.pull);
+    for (int d = 0; d < 3; ++d)
+      for (std::size_t i = led; i < n; ++i) s.a[d][i] += 0.0f;
+    return;
+  }
   // A SampledField on a grid of fewer than 2^31 floats: its lookups in 32-bit offsets,
   // gathered in vectors, and its mode a constant of the loop (as in its own loop).
   if (const auto* sf = std::get_if<SampledField>(&action);
@@ -150,10 +194,9 @@ inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std
         auto run = [&](auto fall) {
           stageLoop(
               s, n,
-              [r, fall, t, charge, mass, &a, &c, &L](std::size_t i, Vec3 p, Vec3 v, float& ax,
-                                                     float& ay, float& az) {
+              [r, fall, t, charge, mass, &a](std::size_t i, Vec3 p, Vec3 v, float& ax, float& ay,
+                                             float& az) {
                 const cl::FlFalloffParams f = fall();
-                Vec3 acc(0.0f);  // summed over neighbours
                 if constexpr (std::is_same_v<A, Gravity>) {
                   kernel::fl_gravity_acc(r.own.gravity, f, p.x, p.y, p.z, &ax, &ay, &az);
                 } else if constexpr (std::is_same_v<A, Damping>) {
@@ -163,17 +206,6 @@ inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std
                   kernel::fl_orbit_point_acc(r.own.orbitPoint, p.x, p.y, p.z, &ax, &ay, &az);
                 } else if constexpr (std::is_same_v<A, OrbitLine>) {
                   kernel::fl_orbit_line_acc(r.own.orbitLine, p.x, p.y, p.z, &ax, &ay, &az);
-                } else if constexpr (std::is_same_v<A, Gravitate>) {
-                  const Snapshot& sn = *c.snapshot;
-                  for (std::size_t j = 0; j < sn.size; ++j)
-                    if (j != c.base + i)
-                      acc += softPull(Vec3(sn.p[0][j], sn.p[1][j], sn.p[2][j]) - p, r.own.pull);
-                } else if constexpr (std::is_same_v<A, Follow>) {
-                  const Snapshot& sn = *c.snapshot;
-                  const std::size_t next = c.base + i + 1;
-                  if (next < sn.size)
-                    acc =
-                        softPull(Vec3(sn.p[0][next], sn.p[1][next], sn.p[2][next]) - p, r.own.pull);
                 } else if constexpr (std::is_same_v<A, Vortex>) {
                   kernel::fl_vortex_acc(r.own.vortex, p.x, p.y, p.z, v.x, v.y, v.z, &ax, &ay, &az);
                 } else if constexpr (std::is_same_v<A, Explosion>) {
@@ -191,11 +223,6 @@ inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std
                   kernel::fl_sampled_field_acc(r.own.sampledField,
                                                kernel::fl_falloff_weight(f, p.x, p.y, p.z), u.x,
                                                u.y, u.z, v.x, v.y, v.z, &ax, &ay, &az);
-                }
-                if constexpr (std::is_same_v<A, Gravitate> || std::is_same_v<A, Follow>) {
-                  ax += acc.x;
-                  ay += acc.y;
-                  az += acc.z;
                 }
               });
         };
