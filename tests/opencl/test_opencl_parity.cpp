@@ -384,6 +384,16 @@ TEST(OpenCLParity, WhichActionsAreBitwise) {
             ActionList{jet, Move{}, KillOld{}});
     }
   }
+  // The neighbours' pulls under the integrators that sum them at each stage (the CPU scans
+  // two vectors' worth of particles at once, each in the device's order).
+  for (const Integrator in : {Integrator::RK4, Integrator::VelocityVerlet}) {
+    ActionList pulled{bitwiseCase<Gravitate>(), Move{}, KillOld{}};
+    pulled.setIntegrator(in);
+    check(std::string("Gravitate, ") + integratorName(in), pulled);
+    ActionList led{bitwiseCase<Follow>(), Move{}, KillOld{}};
+    led.setIntegrator(in);
+    check(std::string("Follow, ") + integratorName(in), led);
+  }
   desc::forEachAction([&](auto tag) {
     using A = typename decltype(tag)::type;
     if constexpr (!std::is_same_v<A, Move> && !std::is_same_v<A, KillOld>)
