@@ -319,6 +319,9 @@ ActionList forceAloneEuler(const std::string& name) {
   if (name == "Spin") return {Move{}};  // Move turning the up vector (Forces stores it)
   if (name == "OrbitPoint") return {OrbitPoint{}, Move{}};
   if (name == "Follow") return {Follow{0.5f, 0.01f}, Move{}};  // each towards the next
+  if (name == "Constrain2D")
+    return {Constrain2D{Vec3(0.0f, 4.0f, 0.0f), glm::normalize(Vec3(0.3f, 0.2f, 1.0f))}, Move{}};
+  if (name == "Restore") return {Restore{0.0f, 1000.0f}, Move{}};  // towards where each began
   if (name.rfind("Jet", 0) == 0) {
     Jet j;
     j.center = Vec3(0.0f, 4.0f, 0.0f);
@@ -602,7 +605,10 @@ FLURRY_FORCE(VortexRK4)
 FLURRY_FORCE(ElectricFieldRK4)
 FLURRY_FORCE(JetDrawnRK4)
 FLURRY_FORCE(SampledFieldRK4)
+FLURRY_FORCE(Follow)
 FLURRY_FORCE(FollowRK4)
+FLURRY_FORCE(Constrain2D)
+FLURRY_FORCE(Restore)
 FLURRY_FORCE(SampledField)
 FLURRY_FORCE(SampledFieldCarry)
 FLURRY_FORCE(OrbitPoint)

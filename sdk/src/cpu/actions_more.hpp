@@ -710,15 +710,31 @@ inline void apply(const Avoid& a, const Lanes& L, std::size_t n, const BlockCont
       a.obstacle.shape());
 }
 
+// Follow's step: each pulled towards its leader (the next particle) at (lx, ly, lz)[i].
+template <class Dt>
+inline void followLoop(const float* __restrict lx, const float* __restrict ly,
+                       const float* __restrict lz, const float* __restrict px,
+                       const float* __restrict py, const float* __restrict pz, float* __restrict vx,
+                       float* __restrict vy, float* __restrict vz, std::size_t n, Dt dt,
+                       const cl::FlPullParams q) {
+  for (std::size_t i = 0; i < n; ++i) {
+    float ox, oy, oz;
+    kernel::fl_pull(q, lx[i] - px[i], ly[i] - py[i], lz[i] - pz[i], &ox, &oy, &oz);
+    vx[i] = vx[i] + ox * dt[i];
+    vy[i] = vy[i] + oy * dt[i];
+    vz[i] = vz[i] + oz * dt[i];
+  }
+}
+
 inline void apply(const Follow&, const Lanes& L, std::size_t n, const BlockContext& c) {
   const cl::FlPullParams q = c.record().own.pull;
   const Snapshot& s = *c.snapshot;
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t next = c.base + i + 1;
-    if (next >= s.size) continue;  // the last particle leads
-    const Vec3 d = Vec3(s.p[0][next], s.p[1][next], s.p[2][next]) - at(L.p, i);
-    put(L.v, i, at(L.v, i) + softPull(d, q) * c.dtAt(i));
-  }
+  // Those with a leader as the step began: the last particle of the group leads.
+  const std::size_t led = s.size > c.base + 1 ? std::min(n, s.size - c.base - 1) : 0;
+  withDt(c, [&](auto dt) {
+    followLoop(s.p[0] + c.base + 1, s.p[1] + c.base + 1, s.p[2] + c.base + 1, L.p[0], L.p[1],
+               L.p[2], L.v[0], L.v[1], L.v[2], led, dt, q);
+  });
 }
 
 // Towards the mean of the neighbours' values within maxRadius, at `magnitude` per second
@@ -896,19 +912,26 @@ inline void apply(const SizeOverLife& a, const Lanes& L, std::size_t n, const Bl
 
 // ---- Bookkeeping -------------------------------------------------------------------------
 
-inline void apply(const Constrain2D&, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const cl::FlConstrain2DParams plane = c.record().own.constrain2d;
-  float* __restrict px = L.p[0];
-  float* __restrict py = L.p[1];
-  float* __restrict pz = L.p[2];
-  float* __restrict vx = L.v[0];
-  float* __restrict vy = L.v[1];
-  float* __restrict vz = L.v[2];
+// f(&x, &y, &z, &u, &v, &w, i) on locals holding particle i's position and velocity, stored
+// back: a loop over restricted arguments, which GCC 12 vectorises (over restricted locals
+// loaded from a struct it did not).
+template <class F>
+[[gnu::flatten]] inline void positionVelocityLoop(float* __restrict px, float* __restrict py,
+                                                  float* __restrict pz, float* __restrict vx,
+                                                  float* __restrict vy, float* __restrict vz,
+                                                  std::size_t n, F f) {
   for (std::size_t i = 0; i < n; ++i) {
     float x = px[i], y = py[i], z = pz[i], u = vx[i], v = vy[i], w = vz[i];
-    kernel::fl_constrain2d(plane, &x, &y, &z, &u, &v, &w);
+    f(&x, &y, &z, &u, &v, &w, i);
     px[i] = x, py[i] = y, pz[i] = z, vx[i] = u, vy[i] = v, vz[i] = w;
   }
+}
+
+inline void apply(const Constrain2D&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  const cl::FlConstrain2DParams plane = c.record().own.constrain2d;
+  positionVelocityLoop(L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n,
+                       [plane](float* x, float* y, float* z, float* u, float* v, float* w,
+                               std::size_t) { kernel::fl_constrain2d(plane, x, y, z, u, v, w); });
 }
 
 inline void apply(const CopyVertexB& a, const Lanes& L, std::size_t n, const BlockContext&) {
@@ -919,12 +942,17 @@ inline void apply(const CopyVertexB& a, const Lanes& L, std::size_t n, const Blo
 inline void apply(const Restore&, const Lanes& L, std::size_t n, const BlockContext& c) {
   const cl::FlRestoreParams r = c.record().own.restore;
   if (!kernel::fl_restore_started(kernel::fl_real_from_bits(r.start), c.time)) return;
-  for (std::size_t i = 0; i < n; ++i) {
-    float x = L.p[0][i], y = L.p[1][i], z = L.p[2][i], u = L.v[0][i], v = L.v[1][i], w = L.v[2][i];
-    kernel::fl_restore(r, c.dt, c.time, &x, &y, &z, &u, &v, &w, L.posB[0][i], L.posB[1][i],
-                       L.posB[2][i]);
-    L.p[0][i] = x, L.p[1][i] = y, L.p[2][i] = z, L.v[0][i] = u, L.v[1][i] = v, L.v[2][i] = w;
-  }
+  // fl_restore's step, its time left and the step's length the same for the block.
+  const float left = kernel::fl_restore_left(kernel::fl_real_from_bits(r.end), c.time);
+  const float dt = c.dt;
+  const float* __restrict hx = L.posB[0];
+  const float* __restrict hy = L.posB[1];
+  const float* __restrict hz = L.posB[2];
+  positionVelocityLoop(
+      L.p[0], L.p[1], L.p[2], L.v[0], L.v[1], L.v[2], n,
+      [=](float* x, float* y, float* z, float* u, float* v, float* w, std::size_t i) {
+        kernel::fl_restore_step(left, dt, hx[i], hy[i], hz[i], x, y, z, u, v, w);
+      });
 }
 
 inline void apply(const Callback& a, const Lanes& L, std::size_t n, const BlockContext& c) {
