@@ -98,19 +98,25 @@ FL_INLINE void fl_bounce_sphere_once(FlReflect rf, float Cx, float Cy, float Cz,
 /* Inside a sphere, after fl_bounce_sphere_once: a particle that crosses the sphere more than
  * once in a step bounces at every exit for what is left of the step, from where it began;
  * past 16 bounces it ends inside. Particles whose step ends inside are left as they are. */
+/* Whether fl_bounce_sphere_again acts on the particle: not if it bounced already (its end is
+ * inside) or was outside to begin with (the CPU tests a chunk with it, in vectors, and runs
+ * fl_bounce_sphere_again for the few it holds for). */
+FL_INLINE int fl_bounce_sphere_again_acts(float Cx, float Cy, float Cz, float R, float dt, float x,
+                                          float y, float z, float vx, float vy, float vz) {
+  const float speed = sqrt(vx * vx + vy * vy + vz * vz);
+  const float slack = 4e-7f * (R + speed * dt);
+  const float ex = x + vx * dt - Cx, ey = y + vy * dt - Cy, ez = z + vz * dt - Cz;
+  const float bx = x - Cx, by = y - Cy, bz = z - Cz;
+  return (sqrt(ex * ex + ey * ey + ez * ez) > R - slack) &
+         !(sqrt(bx * bx + by * by + bz * bz) > R + slack);
+}
+
 FL_INLINE void fl_bounce_sphere_again(FlReflect rf, float Cx, float Cy, float Cz, float R, float R2,
                                       float dt, float* px, float* py, float* pz, float* vxs,
                                       float* vys, float* vzs) {
   const float x = *px, y = *py, z = *pz;
   float vx = *vxs, vy = *vys, vz = *vzs;
-  const float speed = sqrt(vx * vx + vy * vy + vz * vz);
-  const float slack = 4e-7f * (R + speed * dt);
-  const float ex = x + vx * dt - Cx, ey = y + vy * dt - Cy, ez = z + vz * dt - Cz;
-  const float bx = x - Cx, by = y - Cy, bz = z - Cz;
-  /* Bounced already (its end is inside), or outside to begin with: not ours. */
-  if (!(sqrt(ex * ex + ey * ey + ez * ez) > R - slack) ||
-      sqrt(bx * bx + by * by + bz * bz) > R + slack)
-    return;
+  if (!fl_bounce_sphere_again_acts(Cx, Cy, Cz, R, dt, x, y, z, vx, vy, vz)) return;
   float cx = x, cy = y, cz = z;
   float left = dt;
   for (int bounce = 0; bounce < 16; ++bounce) {
@@ -151,6 +157,14 @@ FL_INLINE void fl_bounce_sphere_again(FlReflect rf, float Cx, float Cy, float Cz
 /* A box (lo, hi: its corners as arrays of three) keeping particles inside: each axis is its
  * own pair of walls (exact for an axis-aligned box, also in corners); friction acts on the
  * other two axes on a hit. */
+/* Whether fl_bounce_box_inside acts on the particle: its step's end leaves the box on some
+ * axis (its own test, the same arithmetic; the CPU tests a chunk with it, in vectors). */
+FL_INLINE int fl_bounce_box_inside_acts(const float* lo, const float* hi, float dt, float x,
+                                        float y, float z, float vx, float vy, float vz) {
+  const float qx = x + vx * dt, qy = y + vy * dt, qz = z + vz * dt;
+  return (qx < lo[0]) | (qx > hi[0]) | (qy < lo[1]) | (qy > hi[1]) | (qz < lo[2]) | (qz > hi[2]);
+}
+
 FL_INLINE void fl_bounce_box_inside(FlReflect rf, const float* lo, const float* hi, float dt,
                                     float* px, float* py, float* pz, float* vxs, float* vys,
                                     float* vzs) {

@@ -322,6 +322,16 @@ ActionList forceAloneEuler(const std::string& name) {
   if (name == "Constrain2D")
     return {Constrain2D{Vec3(0.0f, 4.0f, 0.0f), glm::normalize(Vec3(0.3f, 0.2f, 1.0f))}, Move{}};
   if (name == "Restore") return {Restore{0.0f, 1000.0f}, Move{}};  // towards where each began
+  if (name == "BounceBoxInside") {  // a room around the box: a few hit its walls each step
+    Bounce b{Domain::box(Vec3(-4.01f, -0.01f, -4.01f), Vec3(4.01f, 8.01f, 4.01f)), 0.8f};
+    b.inside = true;
+    return {b, Move{}};
+  }
+  if (name == "BounceSphereInside") {  // a sphere around it
+    Bounce b{Domain::sphere(Vec3(0.0f, 4.0f, 0.0f), 7.0f), 0.8f};
+    b.inside = true;
+    return {b, Move{}};
+  }
   if (name.rfind("Jet", 0) == 0) {
     Jet j;
     j.center = Vec3(0.0f, 4.0f, 0.0f);
@@ -609,6 +619,8 @@ FLURRY_FORCE(Follow)
 FLURRY_FORCE(FollowRK4)
 FLURRY_FORCE(Constrain2D)
 FLURRY_FORCE(Restore)
+FLURRY_FORCE(BounceBoxInside)
+FLURRY_FORCE(BounceSphereInside)
 FLURRY_FORCE(SampledField)
 FLURRY_FORCE(SampledFieldCarry)
 FLURRY_FORCE(OrbitPoint)

@@ -507,6 +507,32 @@ inline void bouncePlanarAccelLoop(float* __restrict px, float* __restrict py, fl
   }
 }
 
+/// acts(x, y, z, vx, vy, vz, dt) for particles [0, n) in vectors, a chunk at a time, then
+/// f(i) for each it holds for, in order: a deflector that acts on few of them in a step.
+template <class Dt, class Acts>
+[[gnu::flatten]] inline void actingLoop(const float* __restrict px, const float* __restrict py,
+                                        const float* __restrict pz, const float* __restrict vx,
+                                        const float* __restrict vy, const float* __restrict vz,
+                                        std::size_t n, Dt dt, Acts acts,
+                                        std::uint8_t* __restrict out) {
+  for (std::size_t i = 0; i < n; ++i)
+    out[i] = std::uint8_t(acts(px[i], py[i], pz[i], vx[i], vy[i], vz[i], dt[i]) != 0);
+}
+template <class Dt, class Acts, class F>
+inline void withActing(const float* px, const float* py, const float* pz, const float* vx,
+                       const float* vy, const float* vz, std::size_t n, Dt dt, Acts acts, F f) {
+  constexpr std::size_t kChunk = 256;
+  alignas(64) std::uint8_t out[kChunk];
+  for (std::size_t c0 = 0; c0 < n; c0 += kChunk) {
+    const std::size_t m = std::min(kChunk, n - c0);
+    actingLoop(px + c0, py + c0, pz + c0, vx + c0, vy + c0, vz + c0, m, OffsetDt<Dt>{dt, c0}, acts,
+               out);
+    for (std::size_t i = 0; i < m; ++i)
+      if (out[i]) [[unlikely]]
+        f(c0 + i);
+  }
+}
+
 /// A sphere deflecting from outside (Inside = false) or keeping particles in (Inside = true):
 /// kernels/deflect.h, shared with the device.
 template <bool Inside, class Dt>
@@ -526,10 +552,21 @@ inline void bounceSphereLoop(float* __restrict px, float* __restrict py, float* 
                                   &z, &vx, &vy, &vz);
     px[i] = x, py[i] = y, pz[i] = z, vxs[i] = vx, vys[i] = vy, vzs[i] = vz;
   }
-  if constexpr (Inside)
-    for (std::size_t i = 0; i < n; ++i)
-      kernel::fl_bounce_sphere_again(rf, C.x, C.y, C.z, R, R2, dts[i], &px[i], &py[i], &pz[i],
-                                     &vxs[i], &vys[i], &vzs[i]);
+  if constexpr (Inside) {
+    // The bounces after the first: the few it acts on (fl_bounce_sphere_again_acts), marked in
+    // vectors a chunk at a time.
+    withActing(
+        px, py, pz, vxs, vys, vzs, n, dts,
+        [=](float x, float y, float z, float vx, float vy, float vz, float dt) {
+          return kernel::fl_bounce_sphere_again_acts(C.x, C.y, C.z, R, dt, x, y, z, vx, vy, vz);
+        },
+        [&](std::size_t i) {
+          float x = px[i], y = py[i], z = pz[i], vx = vxs[i], vy = vys[i], vz = vzs[i];
+          kernel::fl_bounce_sphere_again(rf, C.x, C.y, C.z, R, R2, dts[i], &x, &y, &z, &vx, &vy,
+                                         &vz);
+          px[i] = x, py[i] = y, pz[i] = z, vxs[i] = vx, vys[i] = vy, vzs[i] = vz;
+        });
+  }
 }
 
 /// A box keeping particles in, or deflecting them from outside: kernels/deflect.h.
@@ -539,13 +576,28 @@ inline void bounceBoxLoop(float* __restrict px, float* __restrict py, float* __r
                           std::size_t n, Dt dts, const BoxDomain& box, const Bounce& b) {
   const kernel::FlReflect rf{b.restitution, 1.0f - b.friction, b.cutoff * b.cutoff};
   const float lo[3] = {box.min.x, box.min.y, box.min.z}, hi[3] = {box.max.x, box.max.y, box.max.z};
-  for (std::size_t i = 0; i < n; ++i)
+  auto bounce = [&](std::size_t i) {
+    float x = px[i], y = py[i], z = pz[i], vx = vxs[i], vy = vys[i], vz = vzs[i];
     if constexpr (Inside)
-      kernel::fl_bounce_box_inside(rf, lo, hi, dts[i], &px[i], &py[i], &pz[i], &vxs[i], &vys[i],
-                                   &vzs[i]);
+      kernel::fl_bounce_box_inside(rf, lo, hi, dts[i], &x, &y, &z, &vx, &vy, &vz);
     else
-      kernel::fl_bounce_box_outside(rf, lo, hi, dts[i], &px[i], &py[i], &pz[i], &vxs[i], &vys[i],
-                                    &vzs[i]);
+      kernel::fl_bounce_box_outside(rf, lo, hi, dts[i], &x, &y, &z, &vx, &vy, &vz);
+    px[i] = x, py[i] = y, pz[i] = z, vxs[i] = vx, vys[i] = vy, vzs[i] = vz;
+  };
+  if constexpr (Inside) {
+    // Most stay in for the step: those whose end leaves the box (fl_bounce_box_inside_acts),
+    // marked in vectors a chunk at a time, take the kernel.
+    const float l0 = lo[0], l1 = lo[1], l2 = lo[2], h0 = hi[0], h1 = hi[1], h2 = hi[2];
+    withActing(
+        px, py, pz, vxs, vys, vzs, n, dts,
+        [=](float x, float y, float z, float vx, float vy, float vz, float dt) {
+          const float l[3] = {l0, l1, l2}, h[3] = {h0, h1, h2};
+          return kernel::fl_bounce_box_inside_acts(l, h, dt, x, y, z, vx, vy, vz);
+        },
+        bounce);
+  } else {
+    for (std::size_t i = 0; i < n; ++i) bounce(i);
+  }
 }
 
 // Calls f(P, N, onPiece) for a planar Bounce surface (plane, rectangle, triangle, disc, and
