@@ -327,6 +327,8 @@ ActionList forceAloneEuler(const std::string& name) {
     b.inside = true;
     return {b, Move{}};
   }
+  if (name == "BounceBoxOutside")  // a crate in the middle
+    return {Bounce{Domain::box(Vec3(-1.0f, 3.0f, -1.0f), Vec3(1.0f, 5.0f, 1.0f)), 0.8f}, Move{}};
   if (name == "BounceSphereInside") {  // a sphere around it
     Bounce b{Domain::sphere(Vec3(0.0f, 4.0f, 0.0f), 7.0f), 0.8f};
     b.inside = true;
@@ -620,6 +622,7 @@ FLURRY_FORCE(FollowRK4)
 FLURRY_FORCE(Constrain2D)
 FLURRY_FORCE(Restore)
 FLURRY_FORCE(BounceBoxInside)
+FLURRY_FORCE(BounceBoxOutside)
 FLURRY_FORCE(BounceSphereInside)
 FLURRY_FORCE(SampledField)
 FLURRY_FORCE(SampledFieldCarry)

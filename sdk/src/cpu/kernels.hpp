@@ -596,7 +596,26 @@ inline void bounceBoxLoop(float* __restrict px, float* __restrict py, float* __r
         },
         bounce);
   } else {
-    for (std::size_t i = 0; i < n; ++i) bounce(i);
+    // Outside: fl_bounce_box_outside leaves a particle already in (its own first test) and one
+    // whose step's segment misses the box; a segment whose two ends lie past one face, by far
+    // more than the rounding of the kernel's slab test (1e-4 of the magnitudes; its entry
+    // time is then past the step), misses it. The rest are marked in vectors and take it
+    // (NaN, infinities: marked).
+    const float l0 = lo[0], l1 = lo[1], l2 = lo[2], h0 = hi[0], h1 = hi[1], h2 = hi[2];
+    withActing(
+        px, py, pz, vxs, vys, vzs, n, dts,
+        [=](float x, float y, float z, float vx, float vy, float vz, float dt) {
+          const int in = (x >= l0) & (x <= h0) & (y >= l1) & (y <= h1) & (z >= l2) & (z <= h2);
+          auto apart = [](float a, float q, float l, float h) {
+            const float m =
+                1e-4f * (std::abs(l) + std::abs(h) + std::abs(a) + std::abs(q)) + 1e-30f;
+            return ((a > h + m) & (q > h + m)) | ((a < l - m) & (q < l - m));
+          };
+          const int misses = apart(x, x + vx * dt, l0, h0) | apart(y, y + vy * dt, l1, h1) |
+                             apart(z, z + vz * dt, l2, h2);
+          return !in & !misses;
+        },
+        bounce);
   }
 }
 
