@@ -384,6 +384,18 @@ TEST(OpenCLParity, WhichActionsAreBitwise) {
             ActionList{jet, Move{}, KillOld{}});
     }
   }
+  // Boxes and a sphere, which the CPU tests a chunk at a time and bounces only the particles
+  // that may reach (the device: every particle through the kernel).
+  {
+    Bounce room{Domain::box(Vec3(-1.2f, 0.3f, -1.1f), Vec3(1.1f, 2.2f, 1.3f)), 0.7f, 0.2f, 0.1f};
+    room.inside = true;
+    check("Bounce, box inside", ActionList{room, Move{}, KillOld{}});
+    const Bounce crate{Domain::box(Vec3(-0.4f, 1.6f, -0.5f), Vec3(0.5f, 2.0f, 0.4f)), 0.6f};
+    check("Bounce, box outside", ActionList{crate, Move{}, KillOld{}});
+    Bounce ball{Domain::sphere(Vec3(0.0f, 1.0f, 0.0f), 1.6f), 0.9f, 0.1f};
+    ball.inside = true;
+    check("Bounce, sphere inside", ActionList{ball, Move{}, KillOld{}});
+  }
   // The neighbours' pulls under the integrators that sum them at each stage (the CPU scans
   // two vectors' worth of particles at once, each in the device's order).
   for (const Integrator in : {Integrator::RK4, Integrator::VelocityVerlet}) {
