@@ -395,6 +395,15 @@ TEST(OpenCLParity, WhichActionsAreBitwise) {
     Bounce ball{Domain::sphere(Vec3(0.0f, 1.0f, 0.0f), 1.6f), 0.9f, 0.1f};
     ball.inside = true;
     check("Bounce, sphere inside", ActionList{ball, Move{}, KillOld{}});
+    // The crossings of a rectangle and a triangle (their nearest points branch-free on the
+    // CPU, in vectors).
+    const Domain plate =
+        Domain::rectangle(Vec3(-0.8f, 1.8f, -0.7f), Vec3(1.5f, 0.2f, 0.0f), Vec3(0.3f, 0.1f, 1.4f));
+    const Domain sail =
+        Domain::triangle(Vec3(-1.0f, 1.7f, -1.0f), Vec3(1.0f, 1.9f, -0.6f), Vec3(0.1f, 2.1f, 1.2f));
+    check("Sink, hit a rectangle",
+          ActionList{Sink{plate, 0.0f, Sink::Mode::Hit}, Move{}, KillOld{}});
+    check("Avoid, a triangle", ActionList{Avoid{sail, 4.0f, 1e-3f, 0.4f}, Move{}, KillOld{}});
   }
   // The neighbours' pulls under the integrators that sum them at each stage (the CPU scans
   // two vectors' worth of particles at once, each in the device's order).
