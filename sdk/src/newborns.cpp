@@ -131,6 +131,29 @@ void placeOnPath(const Emitter& em, const double* t, std::size_t m, float* px, f
   }
 }
 
+// birthTime for births q0 .. q0 + m of a run, in vector loops: the run's kind chosen once,
+// and each birth's index counted in double (exact below 2^53, as the integer it was).
+void birthTimes(const BirthRun& run, const Emitter& em, std::uint64_t q0, std::size_t m,
+                double* __restrict tb) {
+  switch (run.kind) {
+    case BirthRun::Rate: {
+      const double start = em.start, rate = em.rate, first = double(run.first + q0 + 1);
+      for (std::size_t k = 0; k < m; ++k) tb[k] = start + (first + double(std::uint32_t(k))) / rate;
+      return;
+    }
+    case BirthRun::Burst:
+      std::fill_n(tb, m, run.time);
+      return;
+    default: {
+      const double time = run.time, dt = run.dt, s0 = run.s0, spacing = run.spacing,
+                   span = run.span, q = double(q0);
+      for (std::size_t k = 0; k < m; ++k)
+        tb[k] = time + dt * (s0 + (q + double(std::uint32_t(k))) * spacing) / span;
+      return;
+    }
+  }
+}
+
 // Emitters with one particle type: every draw of a batch at once (see sampling.hpp).
 void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em, std::uint64_t q0,
                std::size_t i0, std::size_t m) {
@@ -202,7 +225,7 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
   float* const py = attr[4];
   float* const pz = attr[5];
   double* const tb = sc.time;
-  for (std::size_t k = 0; k < m; ++k) tb[k] = birthTime(run, em, q0 + k);
+  birthTimes(run, em, q0, m, tb);
   for (std::size_t k = 0; k < m; ++k) {
     nc.remaining[i0 + k] = nc.left(tb[k]);
     age[k] = 0.0f;
