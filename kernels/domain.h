@@ -388,17 +388,24 @@ FL_INLINE float3 fl_closest_plane(float3 point, float3 n, float3 p) {
   return p - n * fl_dotv(p - point, n);
 }
 
-/* Parallelogram origin a, edges u and w. Inside: p's projection's coordinates in the (possibly
- * skewed) basis, from the normal equations of the 2x2 least-squares problem (|u x w|^2 is
- * their determinant without cancellation). Outside, clamping them separately is wrong for
- * skewed edges: the nearest point of a convex polygon to an outside point is on its boundary. */
-FL_INLINE float3 fl_closest_rectangle(float3 a, float3 u, float3 w, float3 p) {
+/* p's projection's coordinates (s, t) on the parallelogram of origin a and edges u and w, in
+ * its (possibly skewed) basis, from the normal equations of the 2x2 least-squares problem
+ * (|u x w|^2 is their determinant without cancellation). */
+FL_INLINE void fl_rectangle_coords(float3 a, float3 u, float3 w, float3 p, float* s, float* t) {
   const float3 r = p - a;
   const float uu = fl_dotv(u, u), uv = fl_dotv(u, w), vv = fl_dotv(w, w);
   const float ru = fl_dotv(r, u), rv = fl_dotv(r, w);
   const float3 c = fl_crossv(u, w);
   const float det = fl_dotv(c, c);
-  const float s = (vv * ru - uv * rv) / det, t = (uu * rv - uv * ru) / det;
+  *s = (vv * ru - uv * rv) / det;
+  *t = (uu * rv - uv * ru) / det;
+}
+/* Parallelogram origin a, edges u and w. Inside: p's projection (fl_rectangle_coords).
+ * Outside, clamping the coordinates separately is wrong for skewed edges: the nearest point of
+ * a convex polygon to an outside point is on its boundary. */
+FL_INLINE float3 fl_closest_rectangle(float3 a, float3 u, float3 w, float3 p) {
+  float s, t;
+  fl_rectangle_coords(a, u, w, p, &s, &t);
   if (s >= 0.0f && s <= 1.0f && t >= 0.0f && t <= 1.0f) return a + u * s + w * t;
   const float3 b = a + u, cc = a + u + w, e = a + w;
   float3 best = fl_closest_segment(a, b, p);
@@ -429,12 +436,8 @@ FL_INLINE float3 fl_closest_segment_masked(float3 a, float3 b, float3 p) {
  * loops over a chunk's crossings of a rectangle. The nearest of the edges' points is taken as
  * the branching form takes it (the first of equals kept). */
 FL_INLINE float3 fl_closest_rectangle_chosen(float3 a, float3 u, float3 w, float3 p) {
-  const float3 r = p - a;
-  const float uu = fl_dotv(u, u), uv = fl_dotv(u, w), vv = fl_dotv(w, w);
-  const float ru = fl_dotv(r, u), rv = fl_dotv(r, w);
-  const float3 c = fl_crossv(u, w);
-  const float det = fl_dotv(c, c);
-  const float s = (vv * ru - uv * rv) / det, t = (uu * rv - uv * ru) / det;
+  float s, t;
+  fl_rectangle_coords(a, u, w, p, &s, &t);
   const float3 b = a + u, cc = a + u + w, e = a + w;
   float3 best = fl_closest_segment_masked(a, b, p);
   float bestD2 = fl_dotv(p - best, p - best);

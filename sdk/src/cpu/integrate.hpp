@@ -48,30 +48,6 @@ inline void stageLoop(const Stage& s, std::size_t n, F f) {
   stageLoop(s.p[0], s.p[1], s.p[2], s.v[0], s.v[1], s.v[2], s.a[0], s.a[1], s.a[2], n, f);
 }
 
-// A drawn acceleration (d) at a stage, where each particle stands: a falloff's weight times
-// d, or (kReach) d where weight() is not 0 and +0 where it is, as a jet's sum was (not d·0,
-// a -0 for a negative draw). Over restricted arguments: GCC 12 kept the same loop over
-// restricted locals scalar.
-template <bool kReach, class Weight>
-[[gnu::flatten]] inline void drawnStageLoop(const float* __restrict px, const float* __restrict py,
-                                            const float* __restrict pz, const float* __restrict dx,
-                                            const float* __restrict dy, const float* __restrict dz,
-                                            float* __restrict ax, float* __restrict ay,
-                                            float* __restrict az, std::size_t n, Weight weight) {
-  for (std::size_t i = 0; i < n; ++i) {
-    const float w = weight(px[i], py[i], pz[i]);
-    if constexpr (kReach) {
-      ax[i] += w != 0.0f ? dx[i] : 0.0f;
-      ay[i] += w != 0.0f ? dy[i] : 0.0f;
-      az[i] += w != 0.0f ? dz[i] : 0.0f;
-    } else {
-      ax[i] += dx[i] * w;
-      ay[i] += dy[i] * w;
-      az[i] += dz[i] * w;
-    }
-  }
-}
-
 // Follow's pull at a stage: towards the leader (the next particle) at (lx, ly, lz)[i].
 inline void followStageLoop(const float* __restrict lx, const float* __restrict ly,
                             const float* __restrict lz, const float* __restrict px,
@@ -120,17 +96,25 @@ inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std
           *drawn, L, n, c, [&](std::size_t first, std::size_t m, float* dx, float* dy, float* dz) {
             const float* const p[3] = {s.p[0] + first, s.p[1] + first, s.p[2] + first};
             float* const a[3] = {s.a[0] + first, s.a[1] + first, s.a[2] + first};
-            if (isJet) {  // (out of reach: + 0, as the sum was)
-              drawnStageLoop<true>(p[0], p[1], p[2], dx, dy, dz, a[0], a[1], a[2], m,
-                                   [jet](float x, float y, float z) {
-                                     return kernel::fl_jet_reaches(jet, x, y, z) ? 1.0f : 0.0f;
-                                   });
+            // (stageLoop's velocities are the draws here: a loop over restricted arguments,
+            // which GCC 12 vectorised where the same loop over restricted locals was scalar)
+            if (isJet) {  // d in reach, + 0 out of it, as the sum was (not d·0: -0 for d < 0)
+              stageLoop(p[0], p[1], p[2], dx, dy, dz, a[0], a[1], a[2], m,
+                        [jet](std::size_t, Vec3 q, Vec3 d, float& ax, float& ay, float& az) {
+                          const int in = kernel::fl_jet_reaches(jet, q.x, q.y, q.z);
+                          ax += in ? d.x : 0.0f;
+                          ay += in ? d.y : 0.0f;
+                          az += in ? d.z : 0.0f;
+                        });
             } else {
               const cl::FlFalloffParams ff = fall();
-              drawnStageLoop<false>(p[0], p[1], p[2], dx, dy, dz, a[0], a[1], a[2], m,
-                                    [ff](float x, float y, float z) {
-                                      return kernel::fl_falloff_weight(ff, x, y, z);
-                                    });
+              stageLoop(p[0], p[1], p[2], dx, dy, dz, a[0], a[1], a[2], m,
+                        [ff](std::size_t, Vec3 q, Vec3 d, float& ax, float& ay, float& az) {
+                          const float w = kernel::fl_falloff_weight(ff, q.x, q.y, q.z);
+                          ax += d.x * w;
+                          ay += d.y * w;
+                          az += d.z * w;
+                        });
             }
           });
     });
