@@ -65,14 +65,23 @@ void writeNewborns(GroupImpl& g, const StepParams& sp, const BirthRun* runs,
                    const std::uint64_t* runStart, std::size_t runCount, std::size_t accepted);
 
 inline namespace FLURRY_ISA_NAMESPACE {  // see isa_namespace.hpp
+/// A Rate run's birth of `index` since the emitter's start (1 the first), and a Distance
+/// run's birth q: their times, the indices in double (exact below 2^53, as the integers were),
+/// so that a batch's loop over them vectorises (newborns.cpp birthTimes).
+inline double rateBirthTime(const Emitter& em, double index) {
+  return em.start + index / em.rate;
+}
+inline double distanceBirthTime(const BirthRun& run, double q) {
+  return run.time + run.dt * (run.s0 + q * run.spacing) / run.span;
+}
 inline double birthTime(const BirthRun& run, const Emitter& em, std::uint64_t q) {
   switch (run.kind) {
     case BirthRun::Rate:
-      return em.start + double(run.first + q + 1) / em.rate;
+      return rateBirthTime(em, double(run.first + q + 1));
     case BirthRun::Burst:
       return run.time;
     default:
-      return run.time + run.dt * (run.s0 + double(q) * run.spacing) / run.span;
+      return distanceBirthTime(run, double(q));
   }
 }
 

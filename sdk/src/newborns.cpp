@@ -131,24 +131,23 @@ void placeOnPath(const Emitter& em, const double* t, std::size_t m, float* px, f
   }
 }
 
-// birthTime for births q0 .. q0 + m of a run, in vector loops: the run's kind chosen once,
-// and each birth's index counted in double (exact below 2^53, as the integer it was).
+// birthTime for births q0 .. q0 + m of a run, in vector loops: the run's kind chosen once.
 void birthTimes(const BirthRun& run, const Emitter& em, std::uint64_t q0, std::size_t m,
                 double* __restrict tb) {
   switch (run.kind) {
     case BirthRun::Rate: {
-      const double start = em.start, rate = em.rate, first = double(run.first + q0 + 1);
-      for (std::size_t k = 0; k < m; ++k) tb[k] = start + (first + double(std::uint32_t(k))) / rate;
+      const double first = double(run.first + q0 + 1);
+      for (std::size_t k = 0; k < m; ++k)
+        tb[k] = rateBirthTime(em, first + double(std::uint32_t(k)));
       return;
     }
     case BirthRun::Burst:
       std::fill_n(tb, m, run.time);
       return;
     default: {
-      const double time = run.time, dt = run.dt, s0 = run.s0, spacing = run.spacing,
-                   span = run.span, q = double(q0);
+      const double q = double(q0);
       for (std::size_t k = 0; k < m; ++k)
-        tb[k] = time + dt * (s0 + (q + double(std::uint32_t(k))) * spacing) / span;
+        tb[k] = distanceBirthTime(run, q + double(std::uint32_t(k)));
       return;
     }
   }

@@ -352,20 +352,25 @@ inline void gravitateScan(const float* __restrict sx, const float* __restrict sy
   std::memcpy(sumz, az, sizeof az);
 }
 
-inline void apply(const Gravitate&, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const cl::FlPullParams q = c.record().own.pull;
-  const Snapshot& s = *c.snapshot;
+// f(i, pull) for particles [0, n) of a block at `base`, at positions `pos`: each one's pulls
+// towards the snapshot's others, summed by gravitateScan (its own loop's and, at each stage,
+// an integrator's).
+template <class F>
+inline void forEachGravitatePull(const Snapshot& s, const float* const* pos, std::size_t base,
+                                 std::size_t n, const cl::FlPullParams& q, F f) {
   for (std::size_t i0 = 0; i0 < n; i0 += kMatchLanes) {
-    const ScanLanes at0(L.p, c.base, i0, n);
-    const std::size_t lanes = at0.lanes;
+    const ScanLanes at0(pos, base, i0, n);
     alignas(64) float ax[kMatchLanes], ay[kMatchLanes], az[kMatchLanes];
     gravitateScan(s.p[0], s.p[1], s.p[2], s.size, at0.p[0], at0.p[1], at0.p[2], at0.own, q, ax, ay,
                   az);
-    for (std::size_t l = 0; l < lanes; ++l) {
-      const std::size_t i = i0 + l;
-      put(L.v, i, at(L.v, i) + Vec3(ax[l], ay[l], az[l]) * c.dtAt(i));
-    }
+    for (std::size_t l = 0; l < at0.lanes; ++l) f(i0 + l, Vec3(ax[l], ay[l], az[l]));
   }
+}
+
+inline void apply(const Gravitate&, const Lanes& L, std::size_t n, const BlockContext& c) {
+  forEachGravitatePull(
+      *c.snapshot, L.p, c.base, n, c.record().own.pull,
+      [&](std::size_t i, Vec3 pull) { put(L.v, i, at(L.v, i) + pull * c.dtAt(i)); });
 }
 
 // fl_vortex, bit for bit, with its approach factor apart from the field: once for a block's
@@ -710,31 +715,37 @@ inline void apply(const Avoid& a, const Lanes& L, std::size_t n, const BlockCont
       a.obstacle.shape());
 }
 
-// Follow's step: each pulled towards its leader (the next particle) at (lx, ly, lz)[i].
+// Follow's pull: out[i] += pull towards its leader (the next particle) at (lx, ly, lz)[i],
+// times dt[i] (its own loop: out is the velocity; an integrator's stage: the acceleration's
+// sums, with dt 1, whose product is the pull itself).
 template <class Dt>
 inline void followLoop(const float* __restrict lx, const float* __restrict ly,
                        const float* __restrict lz, const float* __restrict px,
-                       const float* __restrict py, const float* __restrict pz, float* __restrict vx,
-                       float* __restrict vy, float* __restrict vz, std::size_t n, Dt dt,
+                       const float* __restrict py, const float* __restrict pz, float* __restrict ox,
+                       float* __restrict oy, float* __restrict oz, std::size_t n, Dt dt,
                        const cl::FlPullParams q) {
   for (std::size_t i = 0; i < n; ++i) {
-    float ox, oy, oz;
-    kernel::fl_pull(q, lx[i] - px[i], ly[i] - py[i], lz[i] - pz[i], &ox, &oy, &oz);
-    vx[i] = vx[i] + ox * dt[i];
-    vy[i] = vy[i] + oy * dt[i];
-    vz[i] = vz[i] + oz * dt[i];
+    float x, y, z;
+    kernel::fl_pull(q, lx[i] - px[i], ly[i] - py[i], lz[i] - pz[i], &x, &y, &z);
+    ox[i] = ox[i] + x * dt[i];
+    oy[i] = oy[i] + y * dt[i];
+    oz[i] = oz[i] + z * dt[i];
   }
+}
+// followLoop for the particles of a block at `base` that have a leader as the step began (the
+// last of the group leads); returns their count.
+template <class Dt>
+inline std::size_t followPulls(const Snapshot& s, std::size_t base, const float* const* pos,
+                               float* const* out, std::size_t n, Dt dt, const cl::FlPullParams& q) {
+  const std::size_t led = s.size > base + 1 ? std::min(n, s.size - base - 1) : 0;
+  followLoop(s.p[0] + base + 1, s.p[1] + base + 1, s.p[2] + base + 1, pos[0], pos[1], pos[2],
+             out[0], out[1], out[2], led, dt, q);
+  return led;
 }
 
 inline void apply(const Follow&, const Lanes& L, std::size_t n, const BlockContext& c) {
-  const cl::FlPullParams q = c.record().own.pull;
-  const Snapshot& s = *c.snapshot;
-  // Those with a leader as the step began: the last particle of the group leads.
-  const std::size_t led = s.size > c.base + 1 ? std::min(n, s.size - c.base - 1) : 0;
-  withDt(c, [&](auto dt) {
-    followLoop(s.p[0] + c.base + 1, s.p[1] + c.base + 1, s.p[2] + c.base + 1, L.p[0], L.p[1],
-               L.p[2], L.v[0], L.v[1], L.v[2], led, dt, q);
-  });
+  withDt(c,
+         [&](auto dt) { followPulls(*c.snapshot, c.base, L.p, L.v, n, dt, c.record().own.pull); });
 }
 
 // Towards the mean of the neighbours' values within maxRadius, at `magnitude` per second

@@ -48,21 +48,6 @@ inline void stageLoop(const Stage& s, std::size_t n, F f) {
   stageLoop(s.p[0], s.p[1], s.p[2], s.v[0], s.v[1], s.v[2], s.a[0], s.a[1], s.a[2], n, f);
 }
 
-// Follow's pull at a stage: towards the leader (the next particle) at (lx, ly, lz)[i].
-inline void followStageLoop(const float* __restrict lx, const float* __restrict ly,
-                            const float* __restrict lz, const float* __restrict px,
-                            const float* __restrict py, const float* __restrict pz,
-                            float* __restrict ax, float* __restrict ay, float* __restrict az,
-                            std::size_t n, const cl::FlPullParams q) {
-  for (std::size_t i = 0; i < n; ++i) {
-    float ox, oy, oz;
-    kernel::fl_pull(q, lx[i] - px[i], ly[i] - py[i], lz[i] - pz[i], &ox, &oy, &oz);
-    ax[i] += ox;
-    ay[i] += oy;
-    az[i] += oz;
-  }
-}
-
 // Adds one force's acceleration at (p, v, t), from its record (c.record()) by the shared
 // kernel functions (kernels/forces.h), which add to the stage's sums as the device's do. `L`
 // gives the per-particle constants (charge, mass, id); `c` the step (its random numbers are the
@@ -124,27 +109,15 @@ inline void accumulate(const Action& action, const Stage& s, const Lanes& L, std
   // worth of particles against the step's snapshot, each in the scalar order, itself adding
   // -0), from the stage's positions; then added to the stage's sums.
   if (std::holds_alternative<Gravitate>(action)) {
-    const Snapshot& sn = *c.snapshot;
-    for (std::size_t i0 = 0; i0 < n; i0 += kMatchLanes) {
-      const ScanLanes at0(s.p, c.base, i0, n);
-      alignas(64) float gx[kMatchLanes], gy[kMatchLanes], gz[kMatchLanes];
-      gravitateScan(sn.p[0], sn.p[1], sn.p[2], sn.size, at0.p[0], at0.p[1], at0.p[2], at0.own,
-                    record.own.pull, gx, gy, gz);
-      for (std::size_t l = 0; l < at0.lanes; ++l) {
-        s.a[0][i0 + l] += gx[l];
-        s.a[1][i0 + l] += gy[l];
-        s.a[2][i0 + l] += gz[l];
-      }
-    }
+    forEachGravitatePull(*c.snapshot, s.p, c.base, n, record.own.pull,
+                         [&](std::size_t i, Vec3 pull) { add(s.a, i, pull); });
     return;
   }
-  // Follow: the pull towards the next particle as it was at the step's start, a loop over
-  // those that have one; the last of the group leads (it adds +0, as the sum of none).
+  // Follow: the pull towards the next particle as it was at the step's start, for those that
+  // have one; the last of the group leads (it adds +0, as the sum of none).
   if (std::holds_alternative<Follow>(action)) {
-    const Snapshot& sn = *c.snapshot;
-    const std::size_t led = sn.size > c.base + 1 ? std::min(n, sn.size - c.base - 1) : 0;
-    followStageLoop(sn.p[0] + c.base + 1, sn.p[1] + c.base + 1, sn.p[2] + c.base + 1, s.p[0],
-                    s.p[1], s.p[2], s.a[0], s.a[1], s.a[2], led, record.own.pull);
+    const std::size_t led =
+        followPulls(*c.snapshot, c.base, s.p, s.a, n, UniformDt{1.0f}, record.own.pull);
     for (int d = 0; d < 3; ++d)
       for (std::size_t i = led; i < n; ++i) s.a[d][i] += 0.0f;
     return;
