@@ -103,14 +103,36 @@ FL_INLINE uint fl_pick(__global const float* sums, uint n, uint stride, float u)
   return lo < n - 1 ? lo : n - 1;
 }
 
+/* The triangle of a mesh a uniform u picks, in proportion to area: its record (vertices a b
+ * c, then its unit normal). */
+FL_INLINE __global const float* fl_mesh_triangle(__global const float* v, float u,
+                                                 __global const float* shapes) {
+  __global const float* m = shapes + fl_word(v);
+  return m + fl_pick(m, fl_word(v + 1), FL_MESH_STRIDE, u) * FL_MESH_STRIDE + 2;
+}
+
 /* A point of a mesh from u[0..2]: a triangle by area, then a point on it. */
 FL_INLINE float3 fl_sample_mesh(__global const float* v, const float* u,
                                 __global const float* shapes) {
-  __global const float* m = shapes + fl_word(v);
-  const uint k = fl_pick(m, fl_word(v + 1), FL_MESH_STRIDE, u[0]);
-  __global const float* t = m + k * FL_MESH_STRIDE + 2;
+  __global const float* t = fl_mesh_triangle(v, u[0], shapes);
   const float3 a = fl_v3(t);
   return fl_triangle_at(a, fl_v3(t + 3) - a, fl_v3(t + 6) - a, u[1], u[2]);
+}
+
+/* The leaf a union's sample from draws u picks: a part by measure from the next uniform at
+ * each level of nesting. Leaves the leaf's v in *v and its kind in *kind, and returns where
+ * the leaf's own draws start in u. */
+FL_INLINE uint fl_union_leaf(__global const float** v, uint* kind, const float* u,
+                             __global const float* shapes) {
+  uint next = 0;
+  while (*kind == FL_DOMAIN_UNION) {
+    __global const float* parts = shapes + fl_word(*v);
+    const uint k = fl_pick(parts, fl_word(*v + 1), FL_UNION_STRIDE, u[next++]);
+    __global const FlDomain* part = (__global const FlDomain*)(parts + k * FL_UNION_STRIDE + 2);
+    *v = part->v;
+    *kind = part->kind;
+  }
+  return next;
 }
 
 /* A point of a union: its draws first (a fixed count), then a part by measure from the next
@@ -120,14 +142,8 @@ FL_NOINLINE float3 fl_sample_union(__global const float* v, FlRandom* rng,
   float u[FL_MAX_DOMAIN_DRAWS];
   const uint n = fl_word(v + 2);
   for (uint k = 0; k < n && k < FL_MAX_DOMAIN_DRAWS; ++k) u[k] = fl_uniform(rng);
-  uint kind = FL_DOMAIN_UNION, next = 0;
-  while (kind == FL_DOMAIN_UNION) {
-    __global const float* parts = shapes + fl_word(v);
-    const uint k = fl_pick(parts, fl_word(v + 1), FL_UNION_STRIDE, u[next++]);
-    __global const FlDomain* part = (__global const FlDomain*)(parts + k * FL_UNION_STRIDE + 2);
-    v = part->v;
-    kind = part->kind;
-  }
+  uint kind = FL_DOMAIN_UNION;
+  const uint next = fl_union_leaf(&v, &kind, u, shapes);
   if (kind == FL_DOMAIN_MESH) return fl_sample_mesh(v, u + next, shapes);
   return fl_sample_u(v, kind, u + next);
 }
@@ -291,11 +307,17 @@ FL_NOINLINE float3 fl_normal_union(__global const float* v, float3 p,
   return fl_normal_leaf(part->v, part->kind, p, shapes);
 }
 
-/* Domain::normal at p, for every kind. */
-FL_INLINE float3 fl_normal_at(__global const FlDomain* d, uint kind, float3 p,
-                              __global const float* shapes) {
-  if (kind == FL_DOMAIN_UNION) return fl_normal_union(d->v, p, shapes);
-  return fl_normal_leaf(d->v, kind, p, shapes);
+/* The normal where a sample of the domain from draws u landed, at p (Emitter::normalSpeed):
+ * a mesh's is that of the triangle the sample picked, and a union's that of the leaf it
+ * picked, found again from the same draws (sampling.cpp sampledNormals): a search as the
+ * sample's, not a nearest part's over all of them, and a point on an edge two faces share
+ * keeps its own face's normal. */
+FL_NOINLINE float3 fl_sampled_normal(__global const FlDomain* d, uint kind, const float* u,
+                                     float3 p, __global const float* shapes) {
+  __global const float* v = d->v;
+  const uint next = fl_union_leaf(&v, &kind, u, shapes);
+  if (kind == FL_DOMAIN_MESH) return fl_v3(fl_mesh_triangle(v, u[next], shapes) + 9);
+  return fl_normal_leaf(v, kind, p, shapes);
 }
 
 /* ---- Meshes and unions as actions' regions (containment, closest points); `shapes` is the

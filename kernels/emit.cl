@@ -104,10 +104,17 @@ FL_INLINE void fl_newborn(FL_LANE_PARAMS, uint slot, uint id, float3 at,
   fl_seek(rng, from.shape);
   const float3 shape = fl_sample_any(&em->shape, shapeKind, rng, shapes);
   if (normalMode != 0) {
-    /* Every face emits along its normal: the shape's normal where the particle was born. */
+    /* Every face emits along its normal: the shape's normal where the particle was born (a
+     * mesh's or a union's from the sample's own draws, drawn again). */
+    float u[FL_MAX_DOMAIN_DRAWS];
+    if (shapeKind == FL_DOMAIN_MESH || shapeKind == FL_DOMAIN_UNION) {
+      fl_seek(rng, from.shape);
+      const uint n = fl_domain_draws(&em->shape, shapeKind);
+      for (uint k = 0; k < n && k < FL_MAX_DOMAIN_DRAWS; ++k) u[k] = fl_uniform(rng);
+    }
     fl_seek(rng, from.normal);
     const float speed = fl_fuzzy(&em->normalSpeed, normalMode - 1, rng);
-    vel = vel + fl_normal_at(&em->shape, shapeKind, shape, shapes) * speed;
+    vel = vel + fl_sampled_normal(&em->shape, shapeKind, u, shape, shapes) * speed;
   }
   /* Born where the emitter was at its birth time; the act kernel moves it on from there. */
   const float3 pos = shape + at;

@@ -171,3 +171,67 @@ TEST(Sampling, UniformBatchIsScalarPhiloxBitForBit) {
   }
   EXPECT_GT(checked, 0u);
 }
+
+// The normals of a batch's newborns along Emitter::normalSpeed: on every shape but a mesh
+// and a union, Domain::normal's at the sampled point, bit for bit; on a mesh, the normal of a
+// face the point lies on (the face its draw picked), and on a union the picked part's.
+TEST(Sampling, SampledNormalsAreTheShapesNormalsWhereTheSamplesLanded) {
+  const std::vector<Vec3> tv = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  const std::vector<glm::uvec3> tt = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  const Domain tetra = Domain::mesh(tv, tt);
+  const Domain shapes[] = {
+      Domain::point(Vec3(0.1f, 0.2f, 0.3f)),
+      Domain::line(Vec3(-1.0f, 0.0f, 0.0f), Vec3(1.0f, 0.5f, 0.0f)),
+      Domain::triangle(Vec3(0.0f), Vec3(1.0f, 0.0f, 0.0f), Vec3(0.0f, 1.0f, 1.0f)),
+      Domain::rectangle(Vec3(0.0f), Vec3(1.0f, 0.0f, 0.0f), Vec3(0.2f, 0.0f, 1.0f)),
+      Domain::disc(Vec3(0.0f), Vec3(0.3f, 1.0f, 0.0f), 1.0f, 0.4f),
+      Domain::box(Vec3(-1.0f), Vec3(1.0f, 2.0f, 3.0f)),
+      Domain::sphere(Vec3(0.0f, 1.0f, 0.0f), 1.0f, 0.5f),
+      Domain::sphere(Vec3(0.0f), 2.0f, 2.0f),
+      Domain::cylinder(Vec3(0.0f), Vec3(0.0f, 2.0f, 1.0f), 0.5f, 0.2f),
+      Domain::cone(Vec3(0.0f), Vec3(1.0f, 3.0f, 0.0f), 1.0f, 1.0f),
+      Domain::blob(Vec3(0.0f, 1.0f, 0.0f), 0.5f),
+      tetra,
+      Domain::unite({Domain::sphere(Vec3(5.0f, 0.0f, 0.0f), 1.0f, 1.0f), tetra}),
+  };
+  constexpr std::size_t n = 301;  // not whole vectors
+  std::vector<float> rows[detail::kMaxDomainDraws];
+  const float* u[detail::kMaxDomainDraws];
+  for (int d = 0; d < detail::kMaxDomainDraws; ++d) {
+    rows[d].resize(n);
+    u[d] = rows[d].data();
+  }
+  for (int blk = 0; blk * 4 < detail::kMaxDomainDraws; ++blk)
+    detail::uniformBatch(99, 0, 5, 6, std::uint32_t(blk), n, rows[4 * blk].data(),
+                         rows[4 * blk + 1].data(), rows[4 * blk + 2].data(),
+                         rows[4 * blk + 3].data());
+  int kind = 0;
+  for (const Domain& d : shapes) {
+    std::vector<float> x(n), y(n), z(n), nx(n), ny(n), nz(n);
+    detail::sampleBatch(d, u, n, x.data(), y.data(), z.data());
+    detail::sampledNormals(d, u, n, x.data(), y.data(), z.data(), nx.data(), ny.data(), nz.data());
+    const bool faces = kind >= 11;  // the tetrahedron and the union holding it
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3 p(x[i], y[i], z[i]), nrm(nx[i], ny[i], nz[i]);
+      if (!faces) {
+        const Vec3 want = d.normal(p);
+        ASSERT_EQ(floatBits(nrm.x), floatBits(want.x)) << d.name() << " " << i;
+        ASSERT_EQ(floatBits(nrm.y), floatBits(want.y)) << d.name() << " " << i;
+        ASSERT_EQ(floatBits(nrm.z), floatBits(want.z)) << d.name() << " " << i;
+        continue;
+      }
+      if (p.x > 3.0f) {  // the union's sphere
+        ASSERT_NEAR(glm::length(nrm - (p - Vec3(5.0f, 0.0f, 0.0f))), 0.0f, 1e-5f) << i;
+        continue;
+      }
+      // One of the faces' outward normals, and the point on that face's plane.
+      bool onItsFace = false;
+      for (const glm::uvec3& f : tt) {
+        const Vec3 a = tv[f.x], want = glm::normalize(glm::cross(tv[f.y] - a, tv[f.z] - a));
+        if (glm::length(nrm - want) < 1e-6f) onItsFace = std::abs(glm::dot(p - a, want)) < 1e-6f;
+      }
+      ASSERT_TRUE(onItsFace) << d.name() << " " << i;
+    }
+    ++kind;
+  }
+}

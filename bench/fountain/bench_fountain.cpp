@@ -26,6 +26,8 @@
 #include "common/read_modify_write.hpp"
 #include "common/scenes.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
@@ -115,6 +117,90 @@ void Emission(benchmark::State& state) {
   o.threads = threads();
   Context ctx(o);
   Group& g = samples::buildFountain(ctx, n, double(n) / o.dt, 1e-6f);
+  g.setActions({Move{}, KillOld{}});
+  ctx.run(3);
+  const std::uint64_t before = g.stats().emitted;
+  for (auto _ : state) ctx.step();
+  const double born = double(g.stats().emitted - before);
+  state.SetItemsProcessed(std::int64_t(born));
+  state.counters["ns/newborn/core"] = benchmark::Counter(
+      born / threads() * 1e-9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+// A closed lat-long sphere of about `triangles` faces (2·rings·segments), radius 1.
+Domain latLongSphere(std::size_t triangles) {
+  const auto rings = std::max<std::size_t>(2, std::size_t(std::sqrt(double(triangles) / 4.0)));
+  const std::size_t segments = std::max<std::size_t>(3, triangles / (2 * rings));
+  std::vector<Vec3> v;
+  std::vector<glm::uvec3> t;
+  for (std::size_t r = 0; r <= rings; ++r)
+    for (std::size_t s = 0; s < segments; ++s) {
+      const double th = 3.14159265358979 * double(r) / double(rings),
+                   ph = 2.0 * 3.14159265358979 * double(s) / double(segments);
+      v.emplace_back(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph));
+    }
+  for (std::size_t r = 0; r < rings; ++r)
+    for (std::size_t s = 0; s < segments; ++s) {
+      const auto a = std::uint32_t(r * segments + s),
+                 b = std::uint32_t(r * segments + (s + 1) % segments);
+      const auto c = std::uint32_t(a + segments), d = std::uint32_t(b + segments);
+      if (r > 0) t.emplace_back(a, b, c);  // (the poles' rings are points: no empty faces)
+      if (r + 1 < rings) t.emplace_back(b, d, c);
+    }
+  return Domain::mesh(v, t);
+}
+
+// Births along the shape's normal (Emitter::normalSpeed): 65,536 a step from a sphere's
+// surface (range 0: 0) or a mesh sphere of about range 0 triangles, each dying in its birth
+// step. Reports ns a newborn, to set beside Emission's.
+void EmissionAlongNormals(benchmark::State& state) {
+  const auto triangles = std::size_t(state.range(0));
+  constexpr std::size_t n = 1 << 16;
+  ContextOptions o;
+  o.threads = threads();
+  Context ctx(o);
+  Group& g = ctx.createGroup("skin", n + n / 4);
+  Emitter e;
+  e.shape = triangles == 0 ? Domain::sphere(Vec3(0.0f), 1.0f, 1.0f) : latLongSphere(triangles);
+  e.normalSpeed = Fuzzy(1.0f, 0.2f);
+  e.rate = double(n) / o.dt;
+  e.types[0].velocity = Domain::point(Vec3(0.0f));
+  e.types[0].lifetime = 1e-6f;
+  g.addEmitter(e);
+  g.setActions({Move{}, KillOld{}});
+  ctx.run(3);
+  const std::uint64_t before = g.stats().emitted;
+  for (auto _ : state) ctx.step();
+  const double born = double(g.stats().emitted - before);
+  state.SetItemsProcessed(std::int64_t(born));
+  state.counters["ns/newborn/core"] = benchmark::Counter(
+      born / threads() * 1e-9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+// Births from an emitter with range 0 particle types of equal weight (each its own velocity
+// and lifetime; colour and size stored, drawn per type), 65,536 a step, each dying in its
+// birth step. Reports ns a newborn.
+void EmissionTypes(benchmark::State& state) {
+  const auto types = std::size_t(state.range(0));
+  constexpr std::size_t n = 1 << 16;
+  ContextOptions o;
+  o.threads = threads();
+  Context ctx(o);
+  Group& g = ctx.createGroup("sparks", n + n / 4);
+  g.require({Attribute::Color, Attribute::Size});
+  Emitter e;
+  e.shape = Domain::disc(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f), 1.0f);
+  e.rate = double(n) / o.dt;
+  e.types.clear();
+  for (std::size_t k = 0; k < types; ++k) {
+    ParticleType t;
+    t.velocity = Domain::cone(Vec3(0.0f), Vec3(0.0f, 3.0f + float(k), 0.0f), 1.0f);
+    t.lifetime = Fuzzy(1e-6f, 1e-7f);
+    t.color = Domain::box(Vec3(0.1f * float(k)), Vec3(1.0f));
+    t.size = Fuzzy(0.05f, 0.01f);
+    e.types.push_back(t);
+  }
+  g.addEmitter(e);
   g.setActions({Move{}, KillOld{}});
   ctx.run(3);
   const std::uint64_t before = g.stats().emitted;
@@ -592,6 +678,19 @@ BENCHMARK_CAPTURE(UpdatePass, unfused, false)
     ->UseRealTime();
 BENCHMARK(FountainStep)->Arg(1 << 20)->Arg(1 << 22)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(Emission)->Arg(1 << 18)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(EmissionTypes)
+    ->ArgName("types")
+    ->Arg(1)
+    ->Arg(3)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(EmissionAlongNormals)
+    ->ArgName("triangles")
+    ->Arg(0)
+    ->Arg(80)
+    ->Arg(2000)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(ReadModifyWrite6)->Arg(1 << 20)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(Deflectors)
     ->ArgNames({"deflectors", "cull"})

@@ -111,42 +111,9 @@ Vec3 closestShape(const ConeDomain& d, Vec3 p) {
   return kern::fl_closest_axial(d.apex, d.base - d.apex, d.outerRadius, d.innerRadius, 1, p);
 }
 
-Vec3 normalShape(const PointDomain& d, Vec3 p) {
-  return kern::fl_point_normal(d.p, p);
-}
-Vec3 normalShape(const LineDomain& d, Vec3 p) {
-  return kern::fl_line_normal(d.p0, d.p1, p);
-}
-Vec3 normalShape(const TriangleDomain& d, Vec3) {
-  return d.normal;
-}
-Vec3 normalShape(const PlaneDomain& d, Vec3) {
-  return d.normal;
-}
-Vec3 normalShape(const RectangleDomain& d, Vec3) {
-  return d.normal;
-}
-Vec3 normalShape(const DiscDomain& d, Vec3) {
-  return d.normal;
-}
-Vec3 normalShape(const BoxDomain& d, Vec3 p) {
-  return kern::fl_box_normal(d.min, d.max, p);
-}
-Vec3 normalShape(const SphereDomain& d, Vec3 p) {
-  Vec3 n;
-  kern::fl_closest_ball(d.center, d.outerRadius, d.innerRadius, p, &n);
-  return n;
-}
-Vec3 normalShape(const BlobDomain& d, Vec3 p) {
-  Vec3 n;
-  kern::fl_closest_ball(d.center, d.stddev, 0.0f, p, &n);
-  return n;
-}
-Vec3 normalShape(const CylinderDomain& d, Vec3 p) {
-  return kern::fl_axial_normal(d.p0, d.p1 - d.p0, d.outerRadius, d.innerRadius, 0, p);
-}
-Vec3 normalShape(const ConeDomain& d, Vec3 p) {
-  return kern::fl_axial_normal(d.apex, d.base - d.apex, d.outerRadius, d.innerRadius, 1, p);
+template <class Shape>
+Vec3 normalShape(const Shape& d, Vec3 p) {
+  return detail::normal(d, p);  // shape_math.hpp: every shape but a mesh and a union
 }
 
 Vec3 closestShape(const MeshDomain& d, Vec3 p) {

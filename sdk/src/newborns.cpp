@@ -43,48 +43,12 @@ struct NewbornContext {
   float left(double tb) const { return float(std::max(0.0, t1 - tb)); }
 };
 
-// One newborn, where and as it was born.
-struct Newborn {
-  Vec3 pos, vel;
-  float lifetime, r, gr, bl, alpha, size, mass, charge;
-  Vec3 up, rot;
-};
-
 // What the curves over life scale: the colour and size just stored (Particle's defaults for
 // a lane not stored).
 void storeBirth(const Lanes& L, std::size_t slot) {
   for (int c = 0; c < 4; ++c)
     if (L.birthColor[c]) L.birthColor[c][slot] = L.color[c] ? L.color[c][slot] : 1.0f;
   if (L.birthSize) L.birthSize[slot] = L.size ? L.size[slot] : Particle().size;
-}
-
-void store(const NewbornContext& nc, std::size_t slot, std::uint32_t id, const Newborn& b) {
-  const Lanes& L = nc.L;
-  for (int c = 0; c < 3; ++c) {
-    L.p[c][slot] = b.pos[c];
-    if (L.v[c]) L.v[c][slot] = b.vel[c];
-    if (L.prev[c]) L.prev[c][slot] = b.pos[c];
-    // A newborn's rest pose is where it was born, still (as ensureStorage gives a new lane).
-    if (L.posB[c]) L.posB[c][slot] = b.pos[c];
-    if (L.velB[c]) L.velB[c][slot] = 0.0f;
-    if (L.up[c]) L.up[c][slot] = b.up[c];
-    if (L.rot[c]) L.rot[c][slot] = b.rot[c];
-  }
-  if (L.lifetime) L.lifetime[slot] = std::max(b.lifetime, 0.0f);
-  if (L.color[0]) {
-    L.color[0][slot] = b.r;
-    L.color[1][slot] = b.gr;
-    L.color[2][slot] = b.bl;
-    L.color[3][slot] = b.alpha;
-  }
-  if (L.size) L.size[slot] = std::max(b.size, 0.0f);
-  storeBirth(L, slot);
-  if (L.mass) L.mass[slot] = b.mass;
-  if (L.charge) L.charge[slot] = b.charge;
-  if (L.age) L.age[slot] = 0.0f;
-  L.id[slot] = id;
-  if (L.visible) L.visible[slot] = 1u;
-  if (L.user) L.user[slot] = 0.0f;
 }
 
 // Where a newborn of `type` from `em` starts each value's draws: the draw counts of what the
@@ -153,76 +117,154 @@ void birthTimes(const BirthRun& run, const Emitter& em, std::uint64_t q0, std::s
   }
 }
 
-// Emitters with one particle type: every draw of a batch at once (see sampling.hpp).
+// v += n·speed, per newborn (Vec3 arithmetic, element by element).
+void normalVelocity(float* __restrict vx, float* __restrict vy, float* __restrict vz,
+                    const float* __restrict nx, const float* __restrict ny,
+                    const float* __restrict nz, const float* __restrict speed, std::size_t n) {
+  for (std::size_t k = 0; k < n; ++k) {
+    vx[k] += nx[k] * speed[k];
+    vy[k] += ny[k] * speed[k];
+    vz[k] += nz[k] * speed[k];
+  }
+}
+
+// A batch's values before they are placed and stored: one row of kBatch per value and
+// component, in this order (rows kNormalSpeed and after are shaping's own scratch).
+enum Row : int {
+  kVelocity = 0,  // 0-2
+  kPosition = 3,  // 3-5: on the shape; the emitter's place is added after
+  kLifetime = 6,
+  kColor = 7,  // 7-9, then alpha
+  kAlpha = 10,
+  kSize = 11,
+  kMass = 12,
+  kCharge = 13,
+  kUp = 14,           // 14-16
+  kRotVelocity = 17,  // 17-19
+  kNormalSpeed = 20,
+  kNormal = 21,  // 21-23
+  kRows = 24
+};
+struct Values {
+  float row[kRows][kBatch];
+};
+
+// The values of newborns [0, n) of `type` from their draws row[0 .. at.total) into v: what
+// the group stores of them (each newborn's from its own draws only). Returns the rows it
+// wrote below kNormalSpeed, a bit each.
+std::uint32_t shapeNewborns(const Lanes& L, const Emitter& em, const ParticleType& type,
+                            const kernel::FlNewbornDraws& at, const float* const* row,
+                            std::size_t n, Values& v) {
+  std::uint32_t wrote = 0;
+  auto vec = [&](const Domain& d, kernel::uint from, int a) {
+    sampleBatch(d, row + from, n, v.row[a], v.row[a + 1], v.row[a + 2]);
+    wrote |= 7u << a;
+  };
+  auto scalar = [&](const Fuzzy& f, kernel::uint from, int a) {
+    sampleBatch(f, row + from, n, v.row[a]);
+    wrote |= 1u << a;
+  };
+  vec(type.velocity, at.velocity, kVelocity);
+  vec(em.shape, at.shape, kPosition);
+  if (!(em.normalSpeed.constant() && em.normalSpeed.center == 0.0f)) {
+    // Every face emits along its normal: the shape's normal where the particle was born.
+    sampleBatch(em.normalSpeed, row + at.normal, n, v.row[kNormalSpeed]);
+    float(*nrm)[kBatch] = v.row + kNormal;
+    sampledNormals(em.shape, row + at.shape, n, v.row[kPosition], v.row[kPosition + 1],
+                   v.row[kPosition + 2], nrm[0], nrm[1], nrm[2]);
+    normalVelocity(v.row[kVelocity], v.row[kVelocity + 1], v.row[kVelocity + 2], nrm[0], nrm[1],
+                   nrm[2], v.row[kNormalSpeed], n);
+  }
+  if (L.lifetime) scalar(type.lifetime, at.lifetime, kLifetime);
+  if (L.color[0]) {
+    vec(type.color, at.color, kColor);
+    scalar(type.alpha, at.alpha, kAlpha);
+  }
+  if (L.size) scalar(type.size, at.size, kSize);
+  if (L.mass) scalar(type.mass, at.mass, kMass);
+  if (L.charge) scalar(type.charge, at.charge, kCharge);
+  if (L.up[0]) vec(type.up, at.up, kUp);
+  if (L.rot[0]) vec(type.rotVelocity, at.rot, kRotVelocity);
+  return wrote;
+}
+
+// A batch of m newborns of one emitter: every draw at once (see sampling.hpp), then each
+// value shaped for the whole batch. With several particle types each newborn picks its type
+// with its first draw, and each type's newborns are gathered and shaped together.
 void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em, std::uint64_t q0,
                std::size_t i0, std::size_t m) {
   const Lanes& L = nc.L;
-  const ParticleType& type = em.types[0];
   // Scratch per thread, on the heap and reached through a pointer read once: in a shared
   // library every access to a thread_local object goes through __tls_get_addr, and GCC
   // folds a reference to one back into such accesses, once per element of the loops below.
   struct Scratch {
     float rows[kMaxDraws][kBatch];
-    float attr[16][kBatch];
-    float up[3][kBatch], rot[3][kBatch];
+    Values values;
     float age[kBatch];    // zeros
     double time[kBatch];  // birth times
+    // Several types: each newborn's type, one type's newborns, their draws and values.
+    std::uint32_t type[kBatch];
+    std::uint16_t of[kBatch];
+    float gathered[kMaxDraws][kBatch];
+    Values typed;
   };
   thread_local std::unique_ptr<Scratch> scratch;
   if (!scratch) scratch = std::make_unique<Scratch>();  // once per thread
   Scratch& sc = *scratch;
   auto& rows = sc.rows;
-  auto& attr = sc.attr;
-  auto& up = sc.up;
-  auto& rot = sc.rot;
+  auto& v = sc.values.row;
   auto& age = sc.age;
   const float* row[kMaxDraws];
   for (int k = 0; k < kMaxDraws; ++k) row[k] = rows[k];
 
-  const bool alongNormal = !(em.normalSpeed.constant() && em.normalSpeed.center == 0.0f);
-  const kernel::FlNewbornDraws at = newbornDraws(L, em, type);
-  const int draws = int(at.total);
   const std::uint32_t firstId = nc.firstId + std::uint32_t(i0);
   // Drawn and shaped in whole vectors (of this build's width: 16 floats would cost an AVX2
   // build twice the work): a small group's few newborns a step then run the vector loops
   // alone, not their scalar remainders. Each newborn's values depend on its own draws only;
   // the extra lanes are never stored.
   const std::size_t mv = std::min(kBatch, (m + kVector - 1) / kVector * kVector);
-  for (int blk = 0; blk * 4 < draws; ++blk)
-    uniformBatch(nc.sp.seed, firstId, nc.g.streamKey(), stream::kEmission, std::uint32_t(blk), mv,
-                 rows[4 * blk], rows[4 * blk + 1], rows[4 * blk + 2], rows[4 * blk + 3]);
-
-  auto vec = [&](const Domain& d, kernel::uint from, int a) {
-    sampleBatch(d, row + from, mv, attr[a], attr[a + 1], attr[a + 2]);
+  auto draw = [&](int draws) {
+    for (int blk = 0; blk * 4 < draws; ++blk)
+      uniformBatch(nc.sp.seed, firstId, nc.g.streamKey(), stream::kEmission, std::uint32_t(blk), mv,
+                   rows[4 * blk], rows[4 * blk + 1], rows[4 * blk + 2], rows[4 * blk + 3]);
   };
-  auto scalar = [&](const Fuzzy& f, kernel::uint from, int a) {
-    sampleBatch(f, row + from, mv, attr[a]);
-  };
-  vec(type.velocity, at.velocity, 0);  // attr 0-2
-  vec(em.shape, at.shape, 3);          // 3-5
-  if (alongNormal) {
-    // Every face emits along its normal: the shape's normal where the particle was born.
-    scalar(em.normalSpeed, at.normal, 15);
-    for (std::size_t k = 0; k < m; ++k) {
-      const Vec3 nrm = em.shape.normal(Vec3(attr[3][k], attr[4][k], attr[5][k]));
-      for (int d = 0; d < 3; ++d) attr[d][k] += nrm[d] * attr[15][k];
+  if (em.types.size() == 1) {
+    const kernel::FlNewbornDraws at = newbornDraws(L, em, em.types[0]);
+    draw(int(at.total));
+    shapeNewborns(L, em, em.types[0], at, row, mv, sc.values);
+  } else {
+    int most = 0;
+    for (const ParticleType& t : em.types) most = std::max(most, int(newbornDraws(L, em, t).total));
+    draw(most);
+    // (kernels/newborn.h: the type's draw is a newborn's first)
+    for (std::size_t k = 0; k < m; ++k)
+      sc.type[k] = std::uint32_t(chooseType(em.types, rows[0][k]));
+    const float* gathered[kMaxDraws];
+    for (int d = 0; d < kMaxDraws; ++d) gathered[d] = sc.gathered[d];
+    for (std::size_t t = 0; t < em.types.size(); ++t) {
+      std::size_t c = 0;
+      for (std::size_t k = 0; k < m; ++k) {
+        sc.of[c] = std::uint16_t(k);
+        c += sc.type[k] == t;
+      }
+      if (c == 0) continue;
+      // Padded with copies of the first to whole vectors, as the batch is.
+      const std::size_t cv = std::min(kBatch, (c + kVector - 1) / kVector * kVector);
+      for (std::size_t j = c; j < cv; ++j) sc.of[j] = sc.of[0];
+      const kernel::FlNewbornDraws at = newbornDraws(L, em, em.types[t]);
+      for (kernel::uint d = 0; d < at.total; ++d)
+        for (std::size_t j = 0; j < cv; ++j) sc.gathered[d][j] = rows[d][sc.of[j]];
+      const std::uint32_t wrote = shapeNewborns(L, em, em.types[t], at, gathered, cv, sc.typed);
+      for (int r = 0; r < kNormalSpeed; ++r)
+        if (wrote >> r & 1u)
+          for (std::size_t j = 0; j < c; ++j) v[r][sc.of[j]] = sc.typed.row[r][j];
     }
   }
-  if (L.lifetime) scalar(type.lifetime, at.lifetime, 6);
-  if (L.color[0]) {
-    vec(type.color, at.color, 7);  // 7-9
-    scalar(type.alpha, at.alpha, 10);
-  }
-  if (L.size) scalar(type.size, at.size, 11);
-  if (L.mass) scalar(type.mass, at.mass, 12);
-  if (L.charge) scalar(type.charge, at.charge, 13);
-  if (L.up[0]) sampleBatch(type.up, row + at.up, mv, up[0], up[1], up[2]);
-  if (L.rot[0]) sampleBatch(type.rotVelocity, row + at.rot, mv, rot[0], rot[1], rot[2]);
 
   // Birth places: where the emitter was at the birth time; and the time left of the step.
-  float* const px = attr[3];
-  float* const py = attr[4];
-  float* const pz = attr[5];
+  float* const px = v[kPosition];
+  float* const py = v[kPosition + 1];
+  float* const pz = v[kPosition + 2];
   double* const tb = sc.time;
   birthTimes(run, em, q0, m, tb);
   for (std::size_t k = 0; k < m; ++k) {
@@ -250,77 +292,25 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
     put(lane, src);
   };
   for (int c = 0; c < 3; ++c) {
-    put(L.p[c], attr[3 + c]);
-    put(L.v[c], attr[c]);
-    put(L.prev[c], attr[3 + c]);
-    put(L.posB[c], attr[3 + c]);
+    put(L.p[c], v[kPosition + c]);
+    put(L.v[c], v[kVelocity + c]);
+    put(L.prev[c], v[kPosition + c]);
+    put(L.posB[c], v[kPosition + c]);
     if (L.velB[c]) std::fill_n(L.velB[c] + first, m, 0.0f);
-    put(L.up[c], up[c]);
-    put(L.rot[c], rot[c]);
+    put(L.up[c], v[kUp + c]);
+    put(L.rot[c], v[kRotVelocity + c]);
   }
-  putNonNegative(L.lifetime, attr[6]);
-  for (int c = 0; c < 4; ++c) put(L.color[c], attr[7 + c]);
-  putNonNegative(L.size, attr[11]);
-  put(L.mass, attr[12]);
-  put(L.charge, attr[13]);
+  putNonNegative(L.lifetime, v[kLifetime]);
+  for (int c = 0; c < 4; ++c) put(L.color[c], v[kColor + c]);
+  putNonNegative(L.size, v[kSize]);
+  put(L.mass, v[kMass]);
+  put(L.charge, v[kCharge]);
   put(L.age, age);
   if (L.birthColor[0] || L.birthSize)
     for (std::size_t k = 0; k < m; ++k) storeBirth(L, first + k);
   for (std::size_t k = 0; k < m; ++k) L.id[first + k] = firstId + std::uint32_t(k);
   if (L.visible) std::fill_n(L.visible + first, m, 1u);
   if (L.user) std::fill_n(L.user + first, m, 0.0f);
-}
-
-// Several particle types: each newborn picks its type with its first draw, then takes its
-// values from its draws as emitBatch does (a batch of one).
-void emitOneByOne(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
-                  std::uint64_t q0, std::size_t i0, std::size_t m) {
-  const Lanes& L = nc.L;
-  std::size_t key = 0;  // the path's key the last birth found
-  float u[kMaxDraws];
-  const float* row[kMaxDraws];
-  for (int d = 0; d < kMaxDraws; ++d) row[d] = u + d;
-  for (std::size_t k = 0; k < m; ++k) {
-    const std::uint32_t id = nc.firstId + std::uint32_t(i0 + k);
-    Random rng(nc.sp.seed, id, nc.g.streamKey(), stream::kEmission);
-    const float pick = rng.uniform();
-    const ParticleType& type = em.types[chooseType(em.types, pick)];
-    const kernel::FlNewbornDraws at = newbornDraws(L, em, type);
-    u[at.type] = pick;
-    for (kernel::uint d = at.type + 1; d < at.total; ++d) u[d] = rng.uniform();
-    const double tb = birthTime(run, em, q0 + k);
-    nc.remaining[i0 + k] = nc.left(tb);
-    Newborn b{};
-    auto vec = [&](const Domain& dom, kernel::uint from) {
-      Vec3 r;
-      sampleBatch(dom, row + from, 1, &r.x, &r.y, &r.z);
-      return r;
-    };
-    auto scalar = [&](const Fuzzy& f, kernel::uint from) {
-      float r;
-      sampleBatch(f, row + from, 1, &r);
-      return r;
-    };
-    b.vel = vec(type.velocity, at.velocity);
-    const Vec3 local = vec(em.shape, at.shape);
-    if (!(em.normalSpeed.constant() && em.normalSpeed.center == 0.0f))
-      b.vel += em.shape.normal(local) * scalar(em.normalSpeed, at.normal);
-    b.pos = local + pathPositionAt(em, tb, key);
-    if (L.lifetime) b.lifetime = scalar(type.lifetime, at.lifetime);
-    if (L.color[0]) {
-      const Vec3 rgb = vec(type.color, at.color);
-      b.r = rgb.x;
-      b.gr = rgb.y;
-      b.bl = rgb.z;
-      b.alpha = scalar(type.alpha, at.alpha);
-    }
-    if (L.size) b.size = scalar(type.size, at.size);
-    if (L.mass) b.mass = scalar(type.mass, at.mass);
-    if (L.charge) b.charge = scalar(type.charge, at.charge);
-    if (L.up[0]) b.up = vec(type.up, at.up);
-    if (L.rot[0]) b.rot = vec(type.rotVelocity, at.rot);
-    store(nc, nc.slot(i0 + k), id, b);
-  }
 }
 
 }  // namespace
@@ -342,10 +332,7 @@ void writeNewborns(GroupImpl& g, const StepParams& sp, const BirthRun* runs,
       const Emitter& em = emitterOf(g, runs[r]);
       for (std::size_t j = i; j < end; j += kBatch) {
         const std::size_t m = std::min(kBatch, end - j);
-        if (em.types.size() == 1)
-          emitBatch(nc, runs[r], em, j - runStart[r], j, m);
-        else
-          emitOneByOne(nc, runs[r], em, j - runStart[r], j, m);
+        emitBatch(nc, runs[r], em, j - runStart[r], j, m);
       }
       i = end;
     }

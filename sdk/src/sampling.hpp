@@ -33,6 +33,13 @@ inline int drawCount(const Fuzzy& f) {
 /// Samples n points of `d` into x, y, z from the uniform arrays u[0 .. drawCount(d)).
 void sampleBatch(const Domain& d, const float* const* u, std::size_t n, float* x, float* y,
                  float* z);
+/// The normals where the n samples sampleBatch(d, u, ...) drew landed, at (x, y, z): a
+/// mesh's are those of the triangles the samples picked and a union's those of the parts
+/// they picked (the same draws picking them again: a search, where Domain::normal's nearest
+/// part is a walk over all of them, and a point on an edge two faces share keeps its own
+/// face's); every other shape's is Domain::normal's.
+void sampledNormals(const Domain& d, const float* const* u, std::size_t n, const float* x,
+                    const float* y, const float* z, float* nx, float* ny, float* nz);
 /// Samples n fuzzy values into out from u[0 .. drawCount(f)).
 void sampleBatch(const Fuzzy& f, const float* const* u, std::size_t n, float* out);
 

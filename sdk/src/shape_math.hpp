@@ -78,6 +78,46 @@ template <class Shape>
 inline Vec3 closestChosen(const Shape& d, Vec3 p) {
   return closest(d, p);
 }
+// The normal at p of every shape but a mesh and a union (Domain::normal; also a newborn's
+// along Emitter::normalSpeed, sampling.cpp sampledNormals): a planar piece's is its own.
+inline Vec3 normal(const PointDomain& d, Vec3 p) {
+  return kernel::fl_point_normal(d.p, p);
+}
+inline Vec3 normal(const LineDomain& d, Vec3 p) {
+  return kernel::fl_line_normal(d.p0, d.p1, p);
+}
+inline Vec3 normal(const TriangleDomain& d, Vec3) {
+  return d.normal;
+}
+inline Vec3 normal(const PlaneDomain& d, Vec3) {
+  return d.normal;
+}
+inline Vec3 normal(const RectangleDomain& d, Vec3) {
+  return d.normal;
+}
+inline Vec3 normal(const DiscDomain& d, Vec3) {
+  return d.normal;
+}
+inline Vec3 normal(const BoxDomain& d, Vec3 p) {
+  return kernel::fl_box_normal(d.min, d.max, p);
+}
+inline Vec3 normal(const SphereDomain& d, Vec3 p) {
+  Vec3 n;
+  kernel::fl_closest_ball(d.center, d.outerRadius, d.innerRadius, p, &n);
+  return n;
+}
+inline Vec3 normal(const BlobDomain& d, Vec3 p) {
+  Vec3 n;
+  kernel::fl_closest_ball(d.center, d.stddev, 0.0f, p, &n);
+  return n;
+}
+inline Vec3 normal(const CylinderDomain& d, Vec3 p) {
+  return kernel::fl_axial_normal(d.p0, d.p1 - d.p0, d.outerRadius, d.innerRadius, 0, p);
+}
+inline Vec3 normal(const ConeDomain& d, Vec3 p) {
+  return kernel::fl_axial_normal(d.apex, d.base - d.apex, d.outerRadius, d.innerRadius, 1, p);
+}
+
 template <class Shape>
 constexpr bool kPlanarShape =
     std::is_same_v<Shape, PlaneDomain> || std::is_same_v<Shape, RectangleDomain> ||

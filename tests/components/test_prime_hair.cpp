@@ -203,6 +203,39 @@ TEST(Emitter, PolyhedronFacesEmitAlongTheirNormals) {
   EXPECT_EQ(outward, 4000);
 }
 
+// A newborn takes the normal of the face it was born on, not of the face nearest its birth
+// place: a two-sided square (each side's two triangles in the same plane, wound opposite
+// ways) emits from each side in proportion to its area, where the nearest face, the first
+// of equals, would send every particle up. The same with one particle type and with two
+// (whose newborns are shaped type by type).
+TEST(Emitter, TwoSidedFaceEmitsFromTheSideEachParticleWasBornOn) {
+  const std::vector<Vec3> v = {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}};
+  const std::vector<glm::uvec3> t = {{0, 3, 2}, {0, 2, 1}, {0, 2, 3}, {0, 1, 2}};
+  for (int types : {1, 2}) {
+    Context ctx;
+    Group& g = ctx.createGroup("g", 5000);
+    g.require({Attribute::Velocity});
+    Emitter e;
+    e.shape = Domain::mesh(v, t);
+    e.normalSpeed = 2.0f;
+    e.types[0].velocity = Domain::point(Vec3(0));
+    if (types == 2) e.types.push_back(e.types[0]);
+    e.bursts = {{0.0, 4000, 0.0, 1}};
+    g.addEmitter(e);
+    g.setActions({});
+    ctx.step();
+    ASSERT_EQ(g.size(), 4000u);
+    int up = 0;
+    for (std::size_t i = 0; i < g.size(); ++i) {
+      const Vec3 vel = g.particle(i).velocity;
+      ASSERT_EQ(std::abs(vel.y), 2.0f) << i;
+      up += vel.y > 0.0f;
+    }
+    EXPECT_GT(up, 1800) << types;  // half of them: 2000 ± 3.2 standard deviations
+    EXPECT_LT(up, 2200) << types;
+  }
+}
+
 TEST(Hair, StrandsHoldEachParticlesWholeLife) {
   ContextOptions o;
   o.dt = 0.05;

@@ -177,7 +177,7 @@ TEST(OpenCLEmission, NormalSpeedOnEveryShape) {
           t.velocity = Domain::point(Vec3(0.0f, 0.5f, 0.0f));
           t.lifetime = Fuzzy(1.5f, 0.3f);
           e.types = {t};
-          if (k % 4 == 1) {  // several types: the CPU's one-by-one path
+          if (k % 4 == 1) {  // several types: the CPU gathers each type's newborns
             ParticleType u = t;
             u.velocity = Domain::sphere(Vec3(0.0f), 0.3f);
             u.weight = 0.5f;

@@ -76,7 +76,8 @@ struct Emitter {
   /// step's path, and counts the rest as dropped (up to 2^40 a step).
   float spacing = 0.0f;
   /// Adds the shape's outward normal where each particle is born, times this speed, to its
-  /// velocity: every face of a polyhedron (Domain::mesh) emits along its normal.
+  /// velocity: every face of a polyhedron (Domain::mesh) emits along its normal, each
+  /// particle along that of the face it was born on (of a union, the part it was born on).
   Fuzzy normalSpeed = 0.0f;
 
   /// The emitter's position at time t (seconds).
