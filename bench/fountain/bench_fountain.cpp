@@ -150,6 +150,37 @@ Domain latLongSphere(std::size_t triangles) {
   return Domain::mesh(v, t);
 }
 
+// ColorOverLife and SizeOverLife on curves of range 0 keys over 1M particles at every point
+// of their lives (lifetimes 0.1 to 3.9 s, half a second in): up to 8 keys a curve is
+// evaluated a segment at a time, past that searched per particle.
+void OverLifeCurves(benchmark::State& state) {
+  const auto keys = int(state.range(0));
+  constexpr std::size_t n = 1 << 20;
+  ContextOptions o;
+  o.threads = threads();
+  o.dt = 1.0 / 60.0;
+  Context ctx(o);
+  Group& g = ctx.createGroup("particles", n);
+  g.require({Attribute::Color, Attribute::Size});
+  Emitter e;
+  e.shape = Domain::box(Vec3(-4.0f), Vec3(4.0f));
+  e.types[0].lifetime = Fuzzy(2.0f, 1.9f);
+  e.bursts = {{0.0, std::uint32_t(n), 0.0, 1}};
+  g.addEmitter(e);
+  std::vector<ColorOverLife::Key> color;
+  std::vector<SizeOverLife::Key> size;
+  for (int k = 0; k < keys; ++k) {
+    const float t = float(k) / float(keys - 1), w = float(k % 3) / 2.0f;
+    color.push_back({t, Vec4(w, 1.0f - w, t, 1.0f - t)});
+    size.push_back({t, 0.1f + w});
+  }
+  g.setActions({ColorOverLife{color, OverLifeMode::Replace},
+                SizeOverLife{size, OverLifeMode::Replace}, Move{}});
+  ctx.run(30);
+  for (auto _ : state) ctx.step();
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(n));
+}
+
 // Births along the shape's normal (Emitter::normalSpeed): 65,536 a step from a sphere's
 // surface (range 0: 0) or a mesh sphere of about range 0 triangles, each dying in its birth
 // step. Reports ns a newborn, to set beside Emission's.
@@ -678,6 +709,13 @@ BENCHMARK_CAPTURE(UpdatePass, unfused, false)
     ->UseRealTime();
 BENCHMARK(FountainStep)->Arg(1 << 20)->Arg(1 << 22)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(Emission)->Arg(1 << 18)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(OverLifeCurves)
+    ->ArgName("keys")
+    ->Arg(4)
+    ->Arg(16)
+    ->Arg(64)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(EmissionTypes)
     ->ArgName("types")
     ->Arg(1)

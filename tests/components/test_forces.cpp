@@ -314,7 +314,7 @@ TEST(OverLife, CurvesMultiplyTheBirthColorAndSizeByDefault) {
 // The CPU evaluates a curve of a few keys a segment at a time over many particles; the device
 // walks the keys per particle (kernels/forces.h fl_curve_lookup). Both give the same bits: at
 // the keys, between them, before the first and past the last, on two keys at one time, for a
-// particle without a lifetime, with one key, and for a curve long enough to be walked.
+// particle without a lifetime, with one key, and for curves long enough to be searched.
 TEST(OverLife, CurvesGiveTheKernelsValuesBitForBit) {
   using ColorKeys = std::vector<ColorOverLife::Key>;
   using SizeKeys = std::vector<SizeOverLife::Key>;
@@ -327,11 +327,16 @@ TEST(OverLife, CurvesGiveTheKernelsValuesBitForBit) {
        {{0.1f, 1.0f}, {0.3f, 3.0f}, {0.3f, 0.5f}, {0.9f, 2.0f}}},
       {{{0.4f, Vec4(0.3f, 0.6f, 0.9f, 1.0f)}}, {{0.4f, 7.0f}}},  // one key
   };
-  {
-    ColorKeys longColor;  // past kMostSegmentedKeys: walked per particle
+  // Longer curves: 9 and 12 keys (still a segment at a time), and past kMostSegmentedKeys
+  // (16; searched per particle) 33 in threes at one time (jumps) and 200 spaced unevenly.
+  for (const int keys : {9, 12, 33, 200}) {
+    ColorKeys longColor;
     SizeKeys longSize;
-    for (int k = 0; k < 12; ++k) {
-      const float t = float(k) / 11.0f, w = float(k % 3) / 2.0f;
+    for (int k = 0; k < keys; ++k) {
+      float t = float(k) / float(keys - 1);
+      if (keys == 33) t = float(k - k % 3) / 32.0f;  // three keys at each time
+      if (keys == 200) t = t * t;                    // spaced unevenly
+      const float w = float(k % 3) / 2.0f;
       longColor.push_back({t, Vec4(w, 1.0f - w, t, 1.0f - t)});
       longSize.push_back({t, 1.0f + w});
     }
