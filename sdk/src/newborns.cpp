@@ -128,6 +128,28 @@ void normalVelocity(float* __restrict vx, float* __restrict vy, float* __restric
   }
 }
 
+// chooseType for n newborns from their draws u: FL_CHOOSE_TYPE's walk over the weights (the
+// same subtractions in the same order, so the same choices) with the newborns inside, a
+// vector loop per type, rather than a walk per newborn.
+void chooseTypes(const std::vector<ParticleType>& types, const float* __restrict u, std::size_t n,
+                 float* __restrict left, std::uint32_t* __restrict type) {
+  float total = 0;
+  for (const auto& t : types) total += t.weight;
+  const auto last = std::uint32_t(types.size() - 1);
+  for (std::size_t i = 0; i < n; ++i) {
+    left[i] = u[i] * total;
+    type[i] = ~0u;  // not chosen yet
+  }
+  for (std::uint32_t k = 0; k < last; ++k) {
+    const float w = types[k].weight;
+    for (std::size_t i = 0; i < n; ++i) {
+      type[i] = type[i] == ~0u && left[i] < w ? k : type[i];
+      left[i] -= w;
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) type[i] = type[i] == ~0u ? last : type[i];
+}
+
 // A batch's values before they are placed and stored: one row of kBatch per value and
 // component, in this order (rows kNormalSpeed and after are shaping's own scratch).
 enum Row : int {
@@ -204,6 +226,7 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
     double time[kBatch];  // birth times
     // Several types: each newborn's type, one type's newborns, their draws and values.
     std::uint32_t type[kBatch];
+    float left[kBatch];
     std::uint16_t of[kBatch];
     float gathered[kMaxDraws][kBatch];
     Values typed;
@@ -237,8 +260,7 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
     for (const ParticleType& t : em.types) most = std::max(most, int(newbornDraws(L, em, t).total));
     draw(most);
     // (kernels/newborn.h: the type's draw is a newborn's first)
-    for (std::size_t k = 0; k < m; ++k)
-      sc.type[k] = std::uint32_t(chooseType(em.types, rows[0][k]));
+    chooseTypes(em.types, rows[0], m, sc.left, sc.type);
     const float* gathered[kMaxDraws];
     for (int d = 0; d < kMaxDraws; ++d) gathered[d] = sc.gathered[d];
     for (std::size_t t = 0; t < em.types.size(); ++t) {
