@@ -17,8 +17,28 @@ Domain octahedron(Vec3 c = Vec3(0.0f), float r = 1.0f) {
       v, {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}});
 }
 
+// A lat-long sphere of 2·rings·(segments - 1) triangles: a mesh whose triangle search takes
+// several steps (unequal areas).
+Domain latLongSphere(int rings, int segments) {
+  std::vector<Vec3> v;
+  std::vector<glm::uvec3> t;
+  for (int r = 0; r <= rings; ++r)
+    for (int s = 0; s < segments; ++s) {
+      const float th = 3.14159265f * float(r) / float(rings),
+                  ph = 6.2831853f * float(s) / float(segments);
+      v.emplace_back(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph));
+    }
+  for (int r = 0; r < rings; ++r)
+    for (int s = 0; s < segments; ++s) {
+      const auto a = unsigned(r * segments + s), b = unsigned(r * segments + (s + 1) % segments);
+      if (r > 0) t.emplace_back(a, b, a + unsigned(segments));
+      if (r + 1 < rings) t.emplace_back(b, b + unsigned(segments), a + unsigned(segments));
+    }
+  return Domain::mesh(v, t);
+}
+
 // A union of unequal parts, one of them a union itself with a mesh in it: sampling picks a
-// part by measure at each level, the normal is that of the nearest leaf.
+// part by measure at each level, and a newborn's normal is that of the leaf it picked.
 Domain nestedUnion() {
   return Domain::unite(
       {Domain::box(Vec3(-1.0f), Vec3(0.0f, 0.5f, 1.0f)), Domain::sphere(Vec3(2.0f, 0, 0), 0.7f),
@@ -137,8 +157,8 @@ TEST(OpenCLEmission, LongPath) {
 }
 
 // Emitter::normalSpeed on every shape: the normal where each particle is born (faces, the
-// nearest face of a box or a mesh, the axial frames of cylinders and cones, a union's
-// nearest leaf), uniform and normal speeds, one type (the CPU's batch path) and several.
+// nearest face of a box, the face of a mesh it was born on, the axial frames of cylinders and
+// cones, the leaf of a union it was born on), uniform and normal speeds, one type and several.
 TEST(OpenCLEmission, NormalSpeedOnEveryShape) {
   const Domain shapes[] = {
       Domain::point(Vec3(0.1f, 0.2f, 0.3f)),
@@ -159,6 +179,11 @@ TEST(OpenCLEmission, NormalSpeedOnEveryShape) {
       Domain::cone(Vec3(0.0f), Vec3(1.0f, 3.0f, 0.0f), 1.0f, 1.0f),
       Domain::blob(Vec3(0.0f, 1.0f, 0.0f), 0.5f),
       octahedron(),
+      latLongSphere(6, 9),
+      // A two-sided square: each side's newborns along their own side's normal, where the
+      // nearest face (the first of equals) would send nearly all of them up.
+      Domain::mesh({{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}},
+                   {{0, 3, 2}, {0, 2, 1}, {0, 2, 3}, {0, 1, 2}}),
       nestedUnion(),
   };
   checkParity(
