@@ -115,13 +115,39 @@ std::size_t upperBound(const double* sums, std::size_t n, double x) {
   return std::size_t(base - sums) + (*base <= x);
 }
 
-// The triangle of a mesh, and the part of a union, that a uniform u picks in proportion to
-// area or measure (kernels/domain.cl fl_pick: the same search and clamp).
-std::size_t meshTriangle(const MeshData& m, float u) {
-  const std::vector<double>& sums = m.cumulativeArea;
-  const std::size_t k = upperBound(sums.data(), sums.size(), double(u) * sums.back());
-  return std::min(k, m.triangles.size() - 1);
+// The triangles of a mesh that n <= kChunk draws u0 pick in proportion to area, into k
+// (upperBound's search and fl_pick's clamp): the searches' halving steps (as many for each)
+// in lockstep, a vector loop a step with the sums gathered, rather than a search per draw.
+constexpr std::size_t kChunk = 256;
+void meshTriangles(const MeshData& m, C u0, std::size_t n, std::uint32_t* __restrict k) {
+  const double* __restrict sums = m.cumulativeArea.data();
+  const std::size_t count = m.cumulativeArea.size();
+  const double total = sums[count - 1];
+  for (std::size_t i = 0; i < n; ++i) k[i] = 0;
+  for (std::size_t w = count; w > 1; w -= w / 2) {
+    const auto half = std::uint32_t(w / 2);
+    for (std::size_t i = 0; i < n; ++i)
+      k[i] = sums[k[i] + half] <= double(u0[i]) * total ? k[i] + half : k[i];
+  }
+  const auto last = std::uint32_t(m.triangles.size() - 1);
+  for (std::size_t i = 0; i < n; ++i)
+    k[i] = std::min(k[i] + std::uint32_t(sums[k[i]] <= double(u0[i]) * total), last);
 }
+
+// Points on the triangles k[0, n) of a mesh from u1, u2.
+void onTriangles(const MeshData& m, const std::uint32_t* __restrict k, C u1, C u2, F x, F y, F z,
+                 std::size_t n) {
+  const glm::uvec3* __restrict tri = m.triangles.data();
+  const Vec3* __restrict vert = m.vertices.data();
+  for (std::size_t i = 0; i < n; ++i) {
+    const glm::uvec3 t = tri[k[i]];
+    const Vec3 a = vert[t.x];
+    store(x, y, z, i, k::fl_triangle_at(a, vert[t.y] - a, vert[t.z] - a, u1[i], u2[i]));
+  }
+}
+
+// The part of a union that a uniform u picks in proportion to measure (kernels/domain.cl
+// fl_pick: the same search and clamp).
 std::size_t unionPart(const UnionData& un, float u) {
   const std::vector<double>& sums = un.cumulativeMeasure;
   const std::size_t k = upperBound(sums.data(), sums.size(), double(u) * sums.back());
@@ -188,11 +214,11 @@ void sampleBatch(const Domain& d, const float* const* u, std::size_t n, float* x
         } else if constexpr (std::is_same_v<S, MeshDomain>) {
           // A triangle in proportion to its area, then a point uniform on it.
           const MeshData& m = *s.mesh;
-          for (std::size_t i = 0; i < n; ++i) {
-            const glm::uvec3 t = m.triangles[meshTriangle(m, u[0][i])];
-            const Vec3 a = m.vertices[t.x];
-            store(x, y, z, i,
-                  k::fl_triangle_at(a, m.vertices[t.y] - a, m.vertices[t.z] - a, u[1][i], u[2][i]));
+          std::uint32_t tri[kChunk];
+          for (std::size_t c0 = 0; c0 < n; c0 += kChunk) {
+            const std::size_t c = std::min(kChunk, n - c0);
+            meshTriangles(m, u[0] + c0, c, tri);
+            onTriangles(m, tri, u[1] + c0, u[2] + c0, x + c0, y + c0, z + c0, c);
           }
         } else if constexpr (std::is_same_v<S, UnionDomain>) {
           // A part in proportion to its measure; the part's draws follow (a fixed count per
@@ -219,8 +245,13 @@ void sampledNormals(const Domain& d, const float* const* u, std::size_t n, const
         using S = std::decay_t<decltype(s)>;
         if constexpr (std::is_same_v<S, MeshDomain>) {
           const MeshData& m = *s.mesh;
-          for (std::size_t i = 0; i < n; ++i)
-            store(nx, ny, nz, i, m.normals[meshTriangle(m, u[0][i])]);
+          std::uint32_t tri[kChunk];
+          for (std::size_t c0 = 0; c0 < n; c0 += kChunk) {
+            const std::size_t c = std::min(kChunk, n - c0);
+            meshTriangles(m, u[0] + c0, c, tri);
+            for (std::size_t i = 0; i < c; ++i)
+              store(nx + c0, ny + c0, nz + c0, i, m.normals[tri[i]]);
+          }
         } else if constexpr (std::is_same_v<S, UnionDomain>) {
           // The part sampleBatch picked, with the draws it gave the part.
           const UnionData& un = *s.parts;
