@@ -109,14 +109,9 @@ void FountainStep(benchmark::State& state) {
   state.counters["B/particle"] = g.attributes().bytesPerParticle();
 }
 
-// Births and deaths alone (nearly): n are born per step and every one dies in its birth
-// step (it lives what is left of the step after its birth, longer than its lifetime).
-void Emission(benchmark::State& state) {
-  const auto n = std::size_t(state.range(0));
-  ContextOptions o;
-  o.threads = threads();
-  Context ctx(o);
-  Group& g = samples::buildFountain(ctx, n, double(n) / o.dt, 1e-6f);
+// Steps a group whose newborns all die in their birth step (Move, KillOld), timing the
+// steps after three, and reports the births a second and ns a newborn per thread.
+void timeBirths(benchmark::State& state, Context& ctx, Group& g) {
   g.setActions({Move{}, KillOld{}});
   ctx.run(3);
   const std::uint64_t before = g.stats().emitted;
@@ -125,6 +120,17 @@ void Emission(benchmark::State& state) {
   state.SetItemsProcessed(std::int64_t(born));
   state.counters["ns/newborn/core"] = benchmark::Counter(
       born / threads() * 1e-9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+// Births and deaths alone (nearly): n are born per step and every one dies in its birth
+// step (it lives what is left of the step after its birth, longer than its lifetime).
+void Emission(benchmark::State& state) {
+  const auto n = std::size_t(state.range(0));
+  ContextOptions o;
+  o.threads = threads();
+  Context ctx(o);
+  Group& g = samples::buildFountain(ctx, n, double(n) / o.dt, 1e-6f);
+  timeBirths(state, ctx, g);
 }
 
 // A closed lat-long sphere of about `triangles` faces (2·rings·segments), radius 1.
@@ -181,47 +187,38 @@ void OverLifeCurves(benchmark::State& state) {
   state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(n));
 }
 
-// Births along the shape's normal (Emitter::normalSpeed): 65,536 a step from a sphere's
-// surface (range 0: 0) or a mesh sphere of about range 0 triangles, each dying in its birth
-// step. Reports ns a newborn, to set beside Emission's.
-void EmissionAlongNormals(benchmark::State& state) {
-  const auto triangles = std::size_t(state.range(0));
+// 65,536 births a step from `e` (its rate set to that), each dying in its birth step, the
+// group storing `stored` too (timeBirths).
+void timeEmitter(benchmark::State& state, Emitter e, AttributeSet stored = {}) {
   constexpr std::size_t n = 1 << 16;
   ContextOptions o;
   o.threads = threads();
   Context ctx(o);
-  Group& g = ctx.createGroup("skin", n + n / 4);
+  Group& g = ctx.createGroup("newborns", n + n / 4);
+  g.require(stored);
+  e.rate = double(n) / o.dt;
+  g.addEmitter(e);
+  timeBirths(state, ctx, g);
+}
+
+// Births along the shape's normal (Emitter::normalSpeed) from a sphere's surface (range 0:
+// 0) or a mesh sphere of about range 0 triangles (timeEmitter), to set beside Emission's.
+void EmissionAlongNormals(benchmark::State& state) {
+  const auto triangles = std::size_t(state.range(0));
   Emitter e;
   e.shape = triangles == 0 ? Domain::sphere(Vec3(0.0f), 1.0f, 1.0f) : latLongSphere(triangles);
   e.normalSpeed = Fuzzy(1.0f, 0.2f);
-  e.rate = double(n) / o.dt;
   e.types[0].velocity = Domain::point(Vec3(0.0f));
   e.types[0].lifetime = 1e-6f;
-  g.addEmitter(e);
-  g.setActions({Move{}, KillOld{}});
-  ctx.run(3);
-  const std::uint64_t before = g.stats().emitted;
-  for (auto _ : state) ctx.step();
-  const double born = double(g.stats().emitted - before);
-  state.SetItemsProcessed(std::int64_t(born));
-  state.counters["ns/newborn/core"] = benchmark::Counter(
-      born / threads() * 1e-9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  timeEmitter(state, e);
 }
 
-// Births from an emitter with range 0 particle types of equal weight (each its own velocity
-// and lifetime; colour and size stored, drawn per type), 65,536 a step, each dying in its
-// birth step. Reports ns a newborn.
+// Births from an emitter with range 0 particle types of equal weight, each its own velocity,
+// lifetime, colour and size (stored; timeEmitter).
 void EmissionTypes(benchmark::State& state) {
   const auto types = std::size_t(state.range(0));
-  constexpr std::size_t n = 1 << 16;
-  ContextOptions o;
-  o.threads = threads();
-  Context ctx(o);
-  Group& g = ctx.createGroup("sparks", n + n / 4);
-  g.require({Attribute::Color, Attribute::Size});
   Emitter e;
   e.shape = Domain::disc(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f), 1.0f);
-  e.rate = double(n) / o.dt;
   e.types.clear();
   for (std::size_t k = 0; k < types; ++k) {
     ParticleType t;
@@ -231,15 +228,7 @@ void EmissionTypes(benchmark::State& state) {
     t.size = Fuzzy(0.05f, 0.01f);
     e.types.push_back(t);
   }
-  g.addEmitter(e);
-  g.setActions({Move{}, KillOld{}});
-  ctx.run(3);
-  const std::uint64_t before = g.stats().emitted;
-  for (auto _ : state) ctx.step();
-  const double born = double(g.stats().emitted - before);
-  state.SetItemsProcessed(std::int64_t(born));
-  state.counters["ns/newborn/core"] = benchmark::Counter(
-      born / threads() * 1e-9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  timeEmitter(state, e, {Attribute::Color, Attribute::Size});
 }
 
 using flurry::bench::kSmallLive;

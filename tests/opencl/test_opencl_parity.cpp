@@ -6,6 +6,7 @@
 #include <map>
 #include <optional>
 
+#include "../leaf_shapes.hpp"
 #include "builtin.hpp"
 #include "effect/descriptors.hpp"
 #include "parity.hpp"
@@ -94,21 +95,7 @@ TEST(OpenCLParity, MoveStoresPreviousPosition) {
 // Every domain as an emitter shape and as a velocity, with every attribute stored and every
 // fuzzy value drawn (uniform and normal).
 TEST(OpenCLParity, EmissionFromEveryDomain) {
-  const Domain shapes[] = {
-      Domain::point(Vec3(0.1f, 0.2f, 0.3f)),
-      Domain::line(Vec3(-1.0f, 0.0f, 0.0f), Vec3(1.0f, 0.5f, 0.0f)),
-      Domain::triangle(Vec3(0.0f), Vec3(1.0f, 0.0f, 0.0f), Vec3(0.0f, 1.0f, 1.0f)),
-      Domain::plane(Vec3(0.0f, 0.5f, 0.0f), Vec3(0.0f, 1.0f, 0.0f)),
-      Domain::rectangle(Vec3(0.0f), Vec3(1.0f, 0.0f, 0.0f), Vec3(0.2f, 0.0f, 1.0f)),
-      Domain::disc(Vec3(0.0f), Vec3(0.3f, 1.0f, 0.0f), 1.0f, 0.4f),
-      Domain::box(Vec3(-1.0f), Vec3(1.0f, 2.0f, 3.0f)),
-      Domain::sphere(Vec3(0.0f, 1.0f, 0.0f), 1.0f, 0.5f),
-      Domain::sphere(Vec3(0.0f), 2.0f, 2.0f),
-      Domain::cylinder(Vec3(0.0f), Vec3(0.0f, 2.0f, 1.0f), 0.5f, 0.2f),
-      Domain::cone(Vec3(0.0f), Vec3(0.0f, 3.0f, 0.0f), 1.0f, 0.5f),
-      Domain::cone(Vec3(0.0f), Vec3(1.0f, 3.0f, 0.0f), 1.0f, 1.0f),
-      Domain::blob(Vec3(0.0f, 1.0f, 0.0f), 0.5f),
-  };
+  const std::vector<Domain> shapes = leafShapes();
   for (const Domain& shape : shapes) {
     SCOPED_TRACE(shape.name());
     checkParity(
