@@ -213,6 +213,21 @@ void EmissionAlongNormals(benchmark::State& state) {
   timeEmitter(state, e);
 }
 
+// Births from a union of range 0 spheres along a spiral (the galaxy sample's arms are such a
+// union; timeEmitter).
+void EmissionUnion(benchmark::State& state) {
+  std::vector<Domain> parts;
+  for (int k = 0; k < int(state.range(0)); ++k) {
+    const float a = 0.3f * float(k), r = 1.0f + 0.05f * float(k);
+    parts.push_back(Domain::sphere(Vec3(r * std::cos(a), 0.0f, r * std::sin(a)), 0.2f));
+  }
+  Emitter e;
+  e.shape = Domain::unite(parts);
+  e.types[0].velocity = Domain::sphere(Vec3(0.0f), 0.1f);
+  e.types[0].lifetime = 1e-6f;
+  timeEmitter(state, e);
+}
+
 // Births from an emitter with range 0 particle types of equal weight, each its own velocity,
 // lifetime, colour and size (stored; timeEmitter).
 void EmissionTypes(benchmark::State& state) {
@@ -709,6 +724,12 @@ BENCHMARK(EmissionTypes)
     ->ArgName("types")
     ->Arg(1)
     ->Arg(3)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(EmissionUnion)
+    ->ArgName("parts")
+    ->Arg(8)
+    ->Arg(60)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(EmissionAlongNormals)

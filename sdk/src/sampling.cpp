@@ -115,13 +115,15 @@ std::size_t upperBound(const double* sums, std::size_t n, double x) {
   return std::size_t(base - sums) + (*base <= x);
 }
 
-// The triangles of a mesh that n <= kChunk draws u0 pick in proportion to area, into k
-// (upperBound's search and fl_pick's clamp): the searches' halving steps (as many for each)
-// in lockstep, a vector loop a step with the sums gathered, rather than a search per draw.
+// The entries of running sums[0, count) that n <= kChunk draws u0 pick in proportion to their
+// steps, into k (upperBound's search, then clamped below `entries` as fl_pick clamps): the
+// searches' halving steps (as many for each) in lockstep, a vector loop a step with the sums
+// gathered, rather than a search per draw.
 constexpr std::size_t kChunk = 256;
-void meshTriangles(const MeshData& m, C u0, std::size_t n, std::uint32_t* __restrict k) {
-  const double* __restrict sums = m.cumulativeArea.data();
-  const std::size_t count = m.cumulativeArea.size();
+void pickAll(const std::vector<double>& running, std::size_t entries, C u0, std::size_t n,
+             std::uint32_t* __restrict k) {
+  const double* __restrict sums = running.data();
+  const std::size_t count = running.size();
   const double total = sums[count - 1];
   for (std::size_t i = 0; i < n; ++i) k[i] = 0;
   for (std::size_t w = count; w > 1; w -= w / 2) {
@@ -129,9 +131,12 @@ void meshTriangles(const MeshData& m, C u0, std::size_t n, std::uint32_t* __rest
     for (std::size_t i = 0; i < n; ++i)
       k[i] = sums[k[i] + half] <= double(u0[i]) * total ? k[i] + half : k[i];
   }
-  const auto last = std::uint32_t(m.triangles.size() - 1);
+  const auto last = std::uint32_t(entries - 1);
   for (std::size_t i = 0; i < n; ++i)
     k[i] = std::min(k[i] + std::uint32_t(sums[k[i]] <= double(u0[i]) * total), last);
+}
+void meshTriangles(const MeshData& m, C u0, std::size_t n, std::uint32_t* __restrict k) {
+  pickAll(m.cumulativeArea, m.triangles.size(), u0, n, k);
 }
 
 // Points on the triangles k[0, n) of a mesh from u1, u2.
@@ -152,6 +157,50 @@ std::size_t unionPart(const UnionData& un, float u) {
   const std::vector<double>& sums = un.cumulativeMeasure;
   const std::size_t k = upperBound(sums.data(), sums.size(), double(u) * sums.back());
   return std::min(k, un.parts.size() - 1);
+}
+
+// Calls f(part, rows, count, of, c0) for each part of a union that samples [0, n) picked with
+// their first draws u[0]: the samples c0 + of[0 .. count) (ascending), `rows` their draws for
+// the part (u[1 ..], gathered). A chunk at a time: the picks in lockstep, then the samples
+// grouped by part (a counting sort), so that each part samples its share as one batch; a
+// union of more parts than a chunk takes its samples one by one.
+constexpr std::size_t kMostGroupedParts = kChunk;
+template <class F>
+void forEachPart(const UnionData& un, const float* const* u, std::size_t n, F f) {
+  const std::size_t parts = un.parts.size();
+  if (parts > kMostGroupedParts) {
+    const std::uint16_t first = 0;
+    const float* rest[kMaxDomainDraws];
+    for (std::size_t i = 0; i < n; ++i) {
+      const Domain& part = un.parts[unionPart(un, u[0][i])];
+      const int draws = drawCount(part);
+      for (int j = 0; j < draws; ++j) rest[j] = u[1 + j] + i;
+      f(part, rest, std::size_t(1), &first, i);
+    }
+    return;
+  }
+  std::uint32_t picked[kChunk];
+  std::uint16_t of[kChunk], start[kMostGroupedParts + 1], at[kMostGroupedParts];
+  float gathered[kMaxDomainDraws][kChunk];
+  const float* rows[kMaxDomainDraws];
+  for (int j = 0; j < kMaxDomainDraws; ++j) rows[j] = gathered[j];
+  for (std::size_t c0 = 0; c0 < n; c0 += kChunk) {
+    const std::size_t c = std::min(kChunk, n - c0);
+    pickAll(un.cumulativeMeasure, parts, u[0] + c0, c, picked);
+    for (std::size_t p = 0; p <= parts; ++p) start[p] = 0;
+    for (std::size_t i = 0; i < c; ++i) ++start[picked[i] + 1];
+    for (std::size_t p = 0; p < parts; ++p) start[p + 1] = std::uint16_t(start[p + 1] + start[p]);
+    for (std::size_t p = 0; p < parts; ++p) at[p] = start[p];
+    for (std::size_t i = 0; i < c; ++i) of[at[picked[i]]++] = std::uint16_t(i);
+    for (std::size_t p = 0; p < parts; ++p) {
+      const std::size_t first = start[p], count = std::size_t(start[p + 1]) - first;
+      if (count == 0) continue;
+      const int draws = drawCount(un.parts[p]);
+      for (int j = 0; j < draws; ++j)
+        for (std::size_t q = 0; q < count; ++q) gathered[j][q] = u[1 + j][c0 + of[first + q]];
+      f(un.parts[p], rows, count, of + first, c0);
+    }
+  }
 }
 
 }  // namespace
@@ -223,14 +272,14 @@ void sampleBatch(const Domain& d, const float* const* u, std::size_t n, float* x
         } else if constexpr (std::is_same_v<S, UnionDomain>) {
           // A part in proportion to its measure; the part's draws follow (a fixed count per
           // sample: 1 + the most any part needs).
-          const UnionData& un = *s.parts;
-          const float* rest[kMaxDomainDraws];
-          for (std::size_t i = 0; i < n; ++i) {
-            const std::size_t k = unionPart(un, u[0][i]);
-            const int draws = drawCount(un.parts[k]);
-            for (int j = 0; j < draws; ++j) rest[j] = u[1 + j] + i;
-            sampleBatch(un.parts[k], rest, 1, x + i, y + i, z + i);
-          }
+          forEachPart(*s.parts, u, n,
+                      [&](const Domain& part, const float* const* rows, std::size_t count,
+                          const std::uint16_t* of, std::size_t c0) {
+                        float px[kChunk], py[kChunk], pz[kChunk];
+                        sampleBatch(part, rows, count, px, py, pz);
+                        for (std::size_t q = 0; q < count; ++q)
+                          store(x + c0, y + c0, z + c0, of[q], Vec3(px[q], py[q], pz[q]));
+                      });
         } else if constexpr (std::is_same_v<S, BlobDomain>) {
           blob(u[0], u[1], u[2], u[3], x, y, z, n, s.center, s.stddev);
         }
@@ -254,14 +303,17 @@ void sampledNormals(const Domain& d, const float* const* u, std::size_t n, const
           }
         } else if constexpr (std::is_same_v<S, UnionDomain>) {
           // The part sampleBatch picked, with the draws it gave the part.
-          const UnionData& un = *s.parts;
-          const float* rest[kMaxDomainDraws];
-          for (std::size_t i = 0; i < n; ++i) {
-            const Domain& part = un.parts[unionPart(un, u[0][i])];
-            const int draws = drawCount(part);
-            for (int j = 0; j < draws; ++j) rest[j] = u[1 + j] + i;
-            sampledNormals(part, rest, 1, x + i, y + i, z + i, nx + i, ny + i, nz + i);
-          }
+          forEachPart(*s.parts, u, n,
+                      [&](const Domain& part, const float* const* rows, std::size_t count,
+                          const std::uint16_t* of, std::size_t c0) {
+                        float px[kChunk], py[kChunk], pz[kChunk], qx[kChunk], qy[kChunk],
+                            qz[kChunk];
+                        for (std::size_t q = 0; q < count; ++q)
+                          px[q] = x[c0 + of[q]], py[q] = y[c0 + of[q]], pz[q] = z[c0 + of[q]];
+                        sampledNormals(part, rows, count, px, py, pz, qx, qy, qz);
+                        for (std::size_t q = 0; q < count; ++q)
+                          store(nx + c0, ny + c0, nz + c0, of[q], Vec3(qx[q], qy[q], qz[q]));
+                      });
         } else {
           normals(s, x, y, z, nx, ny, nz, n);
         }
