@@ -102,23 +102,11 @@ FL_LOOP void normals(const Shape& s, C x, C y, C z, F nx, F ny, F nz, std::size_
 
 #undef FL_LOOP
 
-// std::upper_bound over sums[0, n) (n > 0, non-decreasing): the first entry above x, or n.
-// Halving by a conditional move rather than a branch: the branch of a search by a uniform
-// draw is mispredicted half the time, ~5 ns a level (a mesh of 2,000 triangles: 11 levels).
-std::size_t upperBound(const double* sums, std::size_t n, double x) {
-  const double* base = sums;
-  while (n > 1) {
-    const std::size_t half = n / 2;
-    base = base[half] <= x ? base + half : base;
-    n -= half;
-  }
-  return std::size_t(base - sums) + (*base <= x);
-}
-
 // The entries of running sums[0, count) that n <= kChunk draws u0 pick in proportion to their
-// steps, into k (upperBound's search, then clamped below `entries` as fl_pick clamps): the
-// searches' halving steps (as many for each) in lockstep, a vector loop a step with the sums
-// gathered, rather than a search per draw.
+// steps, into k: std::upper_bound's index, clamped below `entries` (kernels/domain.cl fl_pick:
+// the same search and clamp). The searches' halving steps (as many for each) run in lockstep,
+// a vector loop a step with the sums gathered, and halve by a select rather than a branch
+// (mispredicted half the time, ~5 ns a level: a mesh of 2,000 triangles takes 11).
 constexpr std::size_t kChunk = 256;
 void pickAll(const std::vector<double>& running, std::size_t entries, C u0, std::size_t n,
              std::uint32_t* __restrict k) {
@@ -151,14 +139,6 @@ void onTriangles(const MeshData& m, const std::uint32_t* __restrict k, C u1, C u
   }
 }
 
-// The part of a union that a uniform u picks in proportion to measure (kernels/domain.cl
-// fl_pick: the same search and clamp).
-std::size_t unionPart(const UnionData& un, float u) {
-  const std::vector<double>& sums = un.cumulativeMeasure;
-  const std::size_t k = upperBound(sums.data(), sums.size(), double(u) * sums.back());
-  return std::min(k, un.parts.size() - 1);
-}
-
 // Calls f(part, rows, count, of, c0) for each part of a union that samples [0, n) picked with
 // their first draws u[0]: the samples c0 + of[0 .. count) (ascending), `rows` their draws for
 // the part (u[1 ..], gathered). A chunk at a time: the picks in lockstep, then the samples
@@ -172,7 +152,9 @@ void forEachPart(const UnionData& un, const float* const* u, std::size_t n, F f)
     const std::uint16_t first = 0;
     const float* rest[kMaxDomainDraws];
     for (std::size_t i = 0; i < n; ++i) {
-      const Domain& part = un.parts[unionPart(un, u[0][i])];
+      std::uint32_t k;
+      pickAll(un.cumulativeMeasure, parts, u[0] + i, 1, &k);
+      const Domain& part = un.parts[k];
       const int draws = drawCount(part);
       for (int j = 0; j < draws; ++j) rest[j] = u[1 + j] + i;
       f(part, rest, std::size_t(1), &first, i);
