@@ -33,12 +33,38 @@ extern char** environ;
 
 namespace {
 
+/// Removes the process's scratch folders after its tests when all of them passed (a failure
+/// keeps them to look at): runs of the suite do not fill the temporary folder.
+class ScratchFolders : public ::testing::Environment {
+ public:
+  static ScratchFolders& get() {
+    static ScratchFolders* const folders = [] {
+      auto* f = new ScratchFolders;  // (gtest owns and deletes it)
+      ::testing::AddGlobalTestEnvironment(f);
+      return f;
+    }();
+    return *folders;
+  }
+  void add(const fs::path& dir) { dirs_.push_back(dir); }
+  void TearDown() override {
+    if (!::testing::UnitTest::GetInstance()->Passed()) return;
+    std::error_code ignored;
+    for (const fs::path& dir : dirs_) fs::remove_all(dir, ignored);
+  }
+
+ private:
+  std::vector<fs::path> dirs_;
+};
+// Made before the tests run, so that gtest calls its TearDown.
+[[maybe_unused]] const ScratchFolders& kScratchFolders = ScratchFolders::get();
+
 /// A fresh, empty folder per test.
 fs::path scratch(const std::string& name) {
   const fs::path dir =
       fs::temp_directory_path() / ("flurry_vdb_" + std::to_string(::getpid()) + "_" + name);
   fs::remove_all(dir);
   fs::create_directories(dir);
+  ScratchFolders::get().add(dir);
   return dir;
 }
 
