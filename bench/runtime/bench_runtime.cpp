@@ -15,6 +15,7 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -77,6 +78,28 @@ std::vector<EffectInstance> instances(Context& ctx, std::size_t count) {
   return all;
 }
 
+// The CPU backend's seconds in each part of a step (GroupStats::stepSeconds), summed over
+// the instances' groups: where the instances' extra time goes against one group's.
+GroupStats::StepSeconds phaseSeconds(const std::vector<EffectInstance>& all) {
+  GroupStats::StepSeconds s;
+  for (const EffectInstance& i : all)
+    for (const Group* g : i.groups()) {
+      s.emit += g->stats().stepSeconds.emit;
+      s.act += g->stats().stepSeconds.act;
+      s.compact += g->stats().stepSeconds.compact;
+    }
+  return s;
+}
+
+// The parts' milliseconds a step as counters (summed over the threads' groups).
+void phaseCounters(benchmark::State& state, const GroupStats::StepSeconds& before,
+                   const GroupStats::StepSeconds& after) {
+  const double steps = double(state.iterations());
+  state.counters["emit ms"] = (after.emit - before.emit) * 1e3 / steps;
+  state.counters["act ms"] = (after.act - before.act) * 1e3 / steps;
+  state.counters["compact ms"] = (after.compact - before.compact) * 1e3 / steps;
+}
+
 // `count` instances of the 100-particle effect (range 0), on `threads` (range 1); each step
 // is Context::step() of them all, and with bounds (range 2) every instance's bounds, as an
 // engine culls them.
@@ -89,6 +112,7 @@ void Instances(benchmark::State& state) {
   double live = 0;
   const bool bounds = state.range(2) != 0;
   float sink = 0.0f;
+  const GroupStats::StepSeconds before = phaseSeconds(all);
   for (auto _ : state) {
     ctx.step();
     if (bounds)
@@ -97,6 +121,7 @@ void Instances(benchmark::State& state) {
     for (const EffectInstance& i : all) live += double(i.groups()[0]->size());
     state.ResumeTiming();
   }
+  phaseCounters(state, before, phaseSeconds(all));
   benchmark::DoNotOptimize(sink);
   state.SetItemsProcessed(std::int64_t(live));
   state.counters["live"] = live / double(state.iterations());
@@ -163,11 +188,14 @@ void OneGroup(benchmark::State& state) {
   const bool bounds = state.range(2) != 0;
   float sink = 0.0f;
   double live = 0;
+  const std::vector<EffectInstance> ones{one};
+  const GroupStats::StepSeconds before = phaseSeconds(ones);
   for (auto _ : state) {
     ctx.step();
     if (bounds) sink += one.bounds().max.y;
     live += double(one.groups()[0]->size());
   }
+  phaseCounters(state, before, phaseSeconds(ones));
   benchmark::DoNotOptimize(sink);
   state.SetItemsProcessed(std::int64_t(live));
   state.counters["live"] = live / double(state.iterations());
@@ -313,7 +341,12 @@ class RatioReporter : public benchmark::ConsoleReporter {
       const bool median = r.run_type == Run::RT_Aggregate && r.aggregate_name == "median";
       if (r.run_type == Run::RT_Iteration && r.repetitions > 1) continue;
       if (r.run_type == Run::RT_Aggregate && !median) continue;
-      ms_[r.run_name.function_name + "/" + r.run_name.args] = r.GetAdjustedRealTime();
+      const std::string name = r.run_name.function_name + "/" + r.run_name.args;
+      ms_[name] = r.GetAdjustedRealTime();
+      const auto emit = r.counters.find("emit ms");
+      if (emit != r.counters.end())
+        phases_[name] = {emit->second.value, r.counters.at("act ms").value,
+                         r.counters.at("compact ms").value};
     }
   }
   void Finalize() override {
@@ -327,6 +360,15 @@ class RatioReporter : public benchmark::ConsoleReporter {
       std::printf(
           "  %s: %.2f ms a step, the same particles as one group %.2f ms: %.2fx (goal <= 1.5)\n",
           args.c_str(), ms, one->second, ms / one->second);
+      // Where the time goes (the parts summed over the threads; the rest is Context::step's
+      // own: scheduling, asking the memory ahead, timing).
+      const auto pi = phases_.find(name), po = phases_.find("OneGroup/" + args);
+      if (pi != phases_.end() && po != phases_.end())
+        std::printf(
+            "    emit / act / compact ms a step: instances %.2f / %.2f / %.2f, one group %.2f / "
+            "%.2f / %.2f\n",
+            pi->second[0], pi->second[1], pi->second[2], po->second[0], po->second[1],
+            po->second[2]);
     }
     for (const auto& [name, ms] : ms_) {
       const std::string lod = "OutOfSight/interval:4/threads:";
@@ -402,6 +444,7 @@ class RatioReporter : public benchmark::ConsoleReporter {
 
  private:
   std::map<std::string, double> ms_;
+  std::map<std::string, std::array<double, 3>> phases_;  // emit, act, compact ms a step
 };
 
 }  // namespace
