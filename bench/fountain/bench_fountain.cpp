@@ -730,6 +730,7 @@ BENCHMARK(EmissionUnion)
     ->ArgName("parts")
     ->Arg(8)
     ->Arg(60)
+    ->Arg(1000)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(EmissionAlongNormals)

@@ -142,45 +142,41 @@ void onTriangles(const MeshData& m, const std::uint32_t* __restrict k, C u1, C u
 // Calls f(part, rows, count, of, c0) for each part of a union that samples [0, n) picked with
 // their first draws u[0]: the samples c0 + of[0 .. count) (ascending), `rows` their draws for
 // the part (u[1 ..], gathered). A chunk at a time: the picks in lockstep, then the samples
-// grouped by part (a counting sort), so that each part samples its share as one batch; a
-// union of more parts than a chunk takes its samples one by one.
-constexpr std::size_t kMostGroupedParts = kChunk;
+// grouped by part, so that each part samples its share as one batch: sorted by the part's
+// index a byte at a time (a stable radix sort; one pass up to 256 parts, a counting sort), the
+// parts in ascending order.
 template <class F>
 void forEachPart(const UnionData& un, const float* const* u, std::size_t n, F f) {
   const std::size_t parts = un.parts.size();
-  if (parts > kMostGroupedParts) {
-    const std::uint16_t first = 0;
-    const float* rest[kMaxDomainDraws];
-    for (std::size_t i = 0; i < n; ++i) {
-      std::uint32_t k;
-      pickAll(un.cumulativeMeasure, parts, u[0] + i, 1, &k);
-      const Domain& part = un.parts[k];
-      const int draws = drawCount(part);
-      for (int j = 0; j < draws; ++j) rest[j] = u[1 + j] + i;
-      f(part, rest, std::size_t(1), &first, i);
-    }
-    return;
-  }
   std::uint32_t picked[kChunk];
-  std::uint16_t of[kChunk], start[kMostGroupedParts + 1], at[kMostGroupedParts];
+  std::uint16_t order[2][kChunk], count[257];
   float gathered[kMaxDomainDraws][kChunk];
   const float* rows[kMaxDomainDraws];
   for (int j = 0; j < kMaxDomainDraws; ++j) rows[j] = gathered[j];
   for (std::size_t c0 = 0; c0 < n; c0 += kChunk) {
     const std::size_t c = std::min(kChunk, n - c0);
     pickAll(un.cumulativeMeasure, parts, u[0] + c0, c, picked);
-    for (std::size_t p = 0; p <= parts; ++p) start[p] = 0;
-    for (std::size_t i = 0; i < c; ++i) ++start[picked[i] + 1];
-    for (std::size_t p = 0; p < parts; ++p) start[p + 1] = std::uint16_t(start[p + 1] + start[p]);
-    for (std::size_t p = 0; p < parts; ++p) at[p] = start[p];
-    for (std::size_t i = 0; i < c; ++i) of[at[picked[i]]++] = std::uint16_t(i);
-    for (std::size_t p = 0; p < parts; ++p) {
-      const std::size_t first = start[p], count = std::size_t(start[p + 1]) - first;
-      if (count == 0) continue;
+    std::uint16_t* of = order[0];
+    std::uint16_t* sorted = order[1];
+    for (std::size_t i = 0; i < c; ++i) of[i] = std::uint16_t(i);
+    for (unsigned shift = 0; shift == 0 || ((parts - 1) >> shift) != 0; shift += 8) {
+      for (unsigned d = 0; d <= 256; ++d) count[d] = 0;
+      for (std::size_t i = 0; i < c; ++i) ++count[(picked[of[i]] >> shift & 255u) + 1];
+      for (unsigned d = 0; d < 256; ++d) count[d + 1] = std::uint16_t(count[d + 1] + count[d]);
+      for (std::size_t i = 0; i < c; ++i) sorted[count[picked[of[i]] >> shift & 255u]++] = of[i];
+      std::swap(of, sorted);
+    }
+    // Each part's run of samples.
+    for (std::size_t first = 0; first < c;) {
+      const std::uint32_t p = picked[of[first]];
+      std::size_t last = first + 1;
+      while (last < c && picked[of[last]] == p) ++last;
+      const std::size_t share = last - first;
       const int draws = drawCount(un.parts[p]);
       for (int j = 0; j < draws; ++j)
-        for (std::size_t q = 0; q < count; ++q) gathered[j][q] = u[1 + j][c0 + of[first + q]];
-      f(un.parts[p], rows, count, of + first, c0);
+        for (std::size_t q = 0; q < share; ++q) gathered[j][q] = u[1 + j][c0 + of[first + q]];
+      f(un.parts[p], rows, share, of + first, c0);
+      first = last;
     }
   }
 }
