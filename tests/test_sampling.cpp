@@ -2,6 +2,7 @@
 // draws the same numbers in the same order).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <vector>
@@ -171,6 +172,49 @@ TEST(Sampling, UniformBatchIsScalarPhiloxBitForBit) {
           }
   }
   EXPECT_GT(checked, 0u);
+}
+
+// A union of many parts (past 256 its samples are sorted by part a byte of the part's index at
+// a time): each sample is the sample its own draws give on the part it lies in, bit for bit.
+TEST(Sampling, AUnionOfManyPartsSamplesEachOnItsPart) {
+  for (const int count : {600, 70000}) {
+    std::vector<Domain> parts;
+    for (int k = 0; k < count; ++k)  // apart: a sample names its sphere by the nearest centre
+      parts.push_back(Domain::sphere(Vec3(10.0f * float(k % 300), 10.0f * float(k / 300), 0.0f),
+                                     1.0f + 0.5f * float(k % 3)));
+    const Domain un = Domain::unite(parts);
+    constexpr std::size_t n = 1000;  // four chunks, the last a part of one
+    std::vector<float> rows[detail::kMaxDomainDraws];
+    const float* u[detail::kMaxDomainDraws];
+    for (int d = 0; d < detail::kMaxDomainDraws; ++d) {
+      rows[d].resize(n);
+      u[d] = rows[d].data();
+    }
+    for (int blk = 0; blk * 4 < detail::kMaxDomainDraws; ++blk)
+      detail::uniformBatch(7, 0, 3, 4, std::uint32_t(blk), n, rows[4 * blk].data(),
+                           rows[4 * blk + 1].data(), rows[4 * blk + 2].data(),
+                           rows[4 * blk + 3].data());
+    std::vector<float> x(n), y(n), z(n);
+    detail::sampleBatch(un, u, n, x.data(), y.data(), z.data());
+    std::vector<int> seen(std::size_t(count), 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      const int col = int(std::lround(x[i] / 10.0f)), row = int(std::lround(y[i] / 10.0f));
+      const int k = row * 300 + col;
+      ASSERT_TRUE(k >= 0 && k < count) << count << " parts, sample " << i;
+      ++seen[std::size_t(k)];
+      // The part's own sample from draws 1.. of sample i (draw 0 picked the part).
+      const float* own[detail::kMaxDomainDraws - 1];
+      for (int d = 0; d + 1 < detail::kMaxDomainDraws; ++d) own[d] = u[d + 1] + i;
+      float wx, wy, wz;
+      detail::sampleBatch(parts[std::size_t(k)], own, 1, &wx, &wy, &wz);
+      ASSERT_EQ(floatBits(x[i]), floatBits(wx)) << count << " parts, sample " << i;
+      ASSERT_EQ(floatBits(y[i]), floatBits(wy)) << count << " parts, sample " << i;
+      ASSERT_EQ(floatBits(z[i]), floatBits(wz)) << count << " parts, sample " << i;
+    }
+    // Several samples share a part (the grouping has runs to make), and many parts are hit.
+    EXPECT_GT(*std::max_element(seen.begin(), seen.end()), 1) << count;
+    EXPECT_GT(std::count_if(seen.begin(), seen.end(), [](int c) { return c > 0; }), 100) << count;
+  }
 }
 
 // The normals of a batch's newborns along Emitter::normalSpeed: on every shape but a mesh
