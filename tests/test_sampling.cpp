@@ -174,6 +174,23 @@ TEST(Sampling, UniformBatchIsScalarPhiloxBitForBit) {
   EXPECT_GT(checked, 0u);
 }
 
+// Every draw a domain may take, for n samples: rows of uniforms from the emission's stream
+// (detail::uniformBatch, ids 0 ..), and pointers to them as the samplers take them.
+struct Draws {
+  std::vector<float> rows[detail::kMaxDomainDraws];
+  const float* u[detail::kMaxDomainDraws];
+  Draws(std::size_t n, std::uint64_t seed, std::uint32_t c1, std::uint32_t c2) {
+    for (int d = 0; d < detail::kMaxDomainDraws; ++d) {
+      rows[d].resize(n);
+      u[d] = rows[d].data();
+    }
+    for (int blk = 0; blk * 4 < detail::kMaxDomainDraws; ++blk)
+      detail::uniformBatch(seed, 0, c1, c2, std::uint32_t(blk), n, rows[4 * blk].data(),
+                           rows[4 * blk + 1].data(), rows[4 * blk + 2].data(),
+                           rows[4 * blk + 3].data());
+  }
+};
+
 // A union of many parts (past 256 its samples are sorted by part a byte of the part's index at
 // a time): each sample is the sample its own draws give on the part it lies in, bit for bit.
 TEST(Sampling, AUnionOfManyPartsSamplesEachOnItsPart) {
@@ -184,16 +201,8 @@ TEST(Sampling, AUnionOfManyPartsSamplesEachOnItsPart) {
                                      1.0f + 0.5f * float(k % 3)));
     const Domain un = Domain::unite(parts);
     constexpr std::size_t n = 1000;  // four chunks, the last a part of one
-    std::vector<float> rows[detail::kMaxDomainDraws];
-    const float* u[detail::kMaxDomainDraws];
-    for (int d = 0; d < detail::kMaxDomainDraws; ++d) {
-      rows[d].resize(n);
-      u[d] = rows[d].data();
-    }
-    for (int blk = 0; blk * 4 < detail::kMaxDomainDraws; ++blk)
-      detail::uniformBatch(7, 0, 3, 4, std::uint32_t(blk), n, rows[4 * blk].data(),
-                           rows[4 * blk + 1].data(), rows[4 * blk + 2].data(),
-                           rows[4 * blk + 3].data());
+    const Draws draws(n, 7, 3, 4);
+    const float* const* u = draws.u;
     std::vector<float> x(n), y(n), z(n);
     detail::sampleBatch(un, u, n, x.data(), y.data(), z.data());
     std::vector<int> seen(std::size_t(count), 0);
@@ -228,16 +237,8 @@ TEST(Sampling, SampledNormalsAreTheShapesNormalsWhereTheSamplesLanded) {
   shapes.push_back(tetra);
   shapes.push_back(Domain::unite({Domain::sphere(Vec3(5.0f, 0.0f, 0.0f), 1.0f, 1.0f), tetra}));
   constexpr std::size_t n = 301;  // not whole vectors
-  std::vector<float> rows[detail::kMaxDomainDraws];
-  const float* u[detail::kMaxDomainDraws];
-  for (int d = 0; d < detail::kMaxDomainDraws; ++d) {
-    rows[d].resize(n);
-    u[d] = rows[d].data();
-  }
-  for (int blk = 0; blk * 4 < detail::kMaxDomainDraws; ++blk)
-    detail::uniformBatch(99, 0, 5, 6, std::uint32_t(blk), n, rows[4 * blk].data(),
-                         rows[4 * blk + 1].data(), rows[4 * blk + 2].data(),
-                         rows[4 * blk + 3].data());
+  const Draws draws(n, 99, 5, 6);
+  const float* const* u = draws.u;
   for (std::size_t s = 0; s < shapes.size(); ++s) {
     const Domain& d = shapes[s];
     std::vector<float> x(n), y(n), z(n), nx(n), ny(n), nz(n);
