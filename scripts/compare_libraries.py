@@ -67,15 +67,20 @@ def main():
                         figures[(name, which)].append(b["real_time"])
                         higher[name] = False
             print(f"round {r + 1}/{args.rounds} done", file=sys.stderr)
-    print(f"medians of {args.rounds} alternated runs; ratio above 1: the new library is faster")
+    print(f"medians of {args.rounds} alternated runs; ratio above 1: the new library is faster;"
+          " in brackets the lowest and highest of the rounds' own ratios (a round: one run of"
+          " each), the spread a difference must clear")
     for name in sorted(higher):
-        old = statistics.median(figures[(name, "old")])
-        new = statistics.median(figures[(name, "new")])
-        ratio = new / old if higher[name] else old / new
+        olds, news = figures[(name, "old")], figures[(name, "new")]
+        old = statistics.median(olds)
+        new = statistics.median(news)
+        faster = (lambda o, n: n / o) if higher[name] else (lambda o, n: o / n)
+        ratio = faster(old, new)
+        rounds = [faster(o, n) for o, n in zip(olds, news)]
         unit = "M items/s" if higher[name] else "time"
         scale = 1e-6 if higher[name] else 1.0
         print(f"  {name:55s} old {old * scale:9.2f}  new {new * scale:9.2f} ({unit})"
-              f"  ratio {ratio:.3f}")
+              f"  ratio {ratio:.3f} [{min(rounds):.3f}, {max(rounds):.3f}]")
 
 
 if __name__ == "__main__":
