@@ -179,6 +179,8 @@ TEST(Sampling, UniformBatchIsScalarPhiloxBitForBit) {
 struct Draws {
   std::vector<float> rows[detail::kMaxDomainDraws];
   const float* u[detail::kMaxDomainDraws];
+  Draws(const Draws&) = delete;  // (u points into rows)
+  Draws& operator=(const Draws&) = delete;
   Draws(std::size_t n, std::uint64_t seed, std::uint32_t c1, std::uint32_t c2) {
     for (int d = 0; d < detail::kMaxDomainDraws; ++d) {
       rows[d].resize(n);
