@@ -553,8 +553,8 @@ void detail::GroupImpl::operator delete(void* group, std::size_t bytes) noexcept
 }
 
 void detail::GroupImpl::prefetchSelf() const {
-  // Up to the lane table, which a step does not read (laneCache).
-  prefetchBytes(this, std::size_t(reinterpret_cast<const char*>(&lanes) -
+  // Up to the part a step does not read (the plan's, then the group's).
+  prefetchBytes(this, std::size_t(reinterpret_cast<const char*>(&plan.coldStart) -
                                   reinterpret_cast<const char*>(this)));
 }
 
@@ -573,9 +573,13 @@ void detail::GroupImpl::prefetchData(int part, int parts) const {
   prefetchVector(stats.emittedByGeneration);
   prefetchVector(bornRemaining);
   if (holes.capacity() > 0) prefetchBytes(holes.data(), 64);  // written: the first line
-  prefetchVector(plan.reach);
-  prefetchVector(plan.timeFree);
-  prefetchVector(plan.moves);
+  // The reach and moves are read only by a pass that culls, timeFree only for newborns run
+  // apart from their block.
+  if (plan.cullable) {
+    prefetchVector(plan.reach);
+    prefetchVector(plan.moves);
+  }
+  if (!plan.newbornsWithBlock) prefetchVector(plan.timeFree);
   prefetchVector(plan.gathered);
   prefetchVector(plan.curvedBy);
   prefetchVector(plan.records);

@@ -178,24 +178,14 @@ class DeviceMirror {
 /// (GroupImpl::actionsVersion), not every step: a small group's step is short enough that
 /// rebuilding it (and its allocations) would be a good part of the step.
 struct ActionPlan {
+  // First what a step reads; from coldStart on what only the planning reads.
   std::uint64_t version = ~std::uint64_t(0);  ///< the actionsVersion it was built for
-  /// The actionsStructure its fields other than the reach were built for (a move changes
-  /// only the actions' constants, and of the plan only where they can act).
-  std::uint64_t structure = ~std::uint64_t(0);
+  /// Per action: its record (actionParams), as the device gets it, made for steps of
+  /// `recordsDt` (actionRecords): made again only for a new list or a new step length.
+  std::vector<cl::FlActionParams> records;
+  std::uint64_t recordsVersion = ~std::uint64_t(0);
+  float recordsDt = 0.0f;
   Integrator integrator = Integrator::SemiImplicitEuler;
-  std::vector<std::uint8_t> gathered;                // a force an integrating Move evaluates
-  std::vector<std::vector<std::uint32_t>> forcesOf;  // per Move: its forces
-  std::vector<std::vector<std::uint32_t>> guardsOf;  // per Move: the Bounces before it
-  // Per planar Bounce before a Move that integrates forces with Exact, Verlet or RK4: 1 +
-  // that Move's index (it bounces on the curve the Move takes); else 0.
-  std::vector<std::uint32_t> curvedBy;
-  // Per action: its result does not depend on the step's length or time (a sink by region,
-  // KillOld, colour over life, ...), so it runs over a block of newborns as over any block.
-  std::vector<std::uint8_t> timeFree;
-  // Per action: over a batch of newborns it runs with each one's own step length
-  // (BlockContext::ownDt) in one call, as over a block; 0 where it reads the time itself
-  // (it runs per newborn, at the newborn's own time).
-  std::vector<std::uint8_t> ownDt;
   /// Every action is time-free or takes own step lengths, and none takes a factor once for
   /// a block's step (factorPerStep): a block's newborns run the list with the block's other
   /// particles in one pass (each of those with the whole sub-step as its own).
@@ -204,9 +194,16 @@ struct ActionPlan {
   /// The NaN guard must scan velocities too: not when an explicit-Euler Move follows every
   /// action that changes them, as p + v·dt is then not finite wherever v is not.
   bool guardVelocity = true;
-  bool readsNeighbours = false;      ///< the pass reads a snapshot of the step's start
-  std::uint32_t firstBlocker = ~0u;  ///< index of the list's first Block action
-  std::vector<float> fastest;        ///< scratch: per chunk, the fastest squared speed
+  bool readsNeighbours = false;        ///< the pass reads a snapshot of the step's start
+  bool cullable = false;               ///< some action has a finite reach
+  std::uint32_t firstBlocker = ~0u;    ///< index of the list's first Block action
+  std::vector<std::uint8_t> gathered;  // a force an integrating Move evaluates
+  // Per planar Bounce before a Move that integrates forces with Exact, Verlet or RK4: 1 +
+  // that Move's index (it bounces on the curve the Move takes); else 0.
+  std::vector<std::uint32_t> curvedBy;
+  // Per action: its result does not depend on the step's length or time (a sink by region,
+  // KillOld, colour over life, ...), so it runs over a block of newborns as over any block.
+  std::vector<std::uint8_t> timeFree;
   /// Per action: where it can act (planActions: actionReach). A block whose swept bounds
   /// stay out of `lo`..`hi`, widened by the margin, is left bitwise as it was by the action.
   struct Reach {
@@ -218,12 +215,18 @@ struct ActionPlan {
   std::vector<Reach> reach;
   /// Per action: it may change positions or velocities (the bounds must be taken again).
   std::vector<std::uint8_t> moves;
-  bool cullable = false;  ///< some action has a finite reach
-  /// Per action: its record (actionParams), as the device gets it, made for steps of
-  /// `recordsDt` (actionRecords): made again only for a new list or a new step length.
-  std::vector<cl::FlActionParams> records;
-  std::uint64_t recordsVersion = ~std::uint64_t(0);
-  float recordsDt = 0.0f;
+
+  char coldStart = 0;  ///< GroupImpl::prefetchSelf() asks for the plan up to here
+  /// The actionsStructure its fields other than the reach were built for (a move changes
+  /// only the actions' constants, and of the plan only where they can act).
+  std::uint64_t structure = ~std::uint64_t(0);
+  std::vector<std::vector<std::uint32_t>> forcesOf;  // per Move: its forces
+  std::vector<std::vector<std::uint32_t>> guardsOf;  // per Move: the Bounces before it
+  // Per action: over a batch of newborns it runs with each one's own step length
+  // (BlockContext::ownDt) in one call, as over a block; 0 where it reads the time itself
+  // (it runs per newborn, at the newborn's own time).
+  std::vector<std::uint8_t> ownDt;
+  std::vector<float> fastest;  ///< scratch: per chunk, the fastest squared speed
 };
 
 /// A group placed in the world (Group::setTransform): its emitters and action list as the
@@ -231,17 +234,18 @@ struct ActionPlan {
 /// images in the world, which the backends run. Absent until a transform is set, so a group
 /// never placed runs exactly as before.
 struct Frame {
-  Transform transform;
-  Space space = Space::World;
-  std::vector<Emitter> emitters;
-  std::vector<PrimeEmitter> primes;
-  ActionList actions;
+  // First what every step reads (GroupImpl::placeEmitters): one cache line of it.
   /// GroupImpl::emittersVersion when the world emitters were last derived from these.
   std::uint64_t emittersDerived = ~std::uint64_t(0);
   /// The world's actions and emitters are the images of these at `transform`: false after a
   /// move left them to the group's next step (GroupImpl::placeEmitters), which the threads
   /// take in parallel, where Group::setTransform runs on the game's one.
   bool placed = true;
+  Space space = Space::World;
+  Transform transform;
+  std::vector<Emitter> emitters;
+  std::vector<PrimeEmitter> primes;
+  ActionList actions;
   /// Whether these lists refuse some transform (a box turns only by quarter turns), as last
   /// found for the actionsStructure and emittersVersion in `probed`: a move of a group that
   /// may refuse it is placed at once, where the refusal can leave the group as it was. Found
@@ -348,7 +352,6 @@ struct GroupImpl {
   /// (ensureStorage): a step reads these 5 cache lines, not the 18 of the table.
   Lanes laneCache;
   std::uint64_t laneSlots = 0;  ///< laneCache.storedSlots()
-  std::string name;
   AttributeSet required{Attribute::Position, Attribute::Id};
   AttributeSet stored;  ///< what the lanes hold now
   ActionList actions;   ///< replace through Group::setActions, which bumps actionsVersion
@@ -363,16 +366,11 @@ struct GroupImpl {
   std::uint64_t emittersVersion = 0;
   std::vector<EmitterState> emitterState;
   std::vector<PrimeEmitter> primes;
-  std::vector<EmitterState> primeState;
   /// primes[k].child, shared with the live emitters spawned from it (a move rewrites one
   /// no live emitter holds in place).
   std::vector<std::shared_ptr<EmitterSpec>> primeSpecs;
-  std::vector<LiveEmitter> live;         ///< grown only up to the primes' maxEmitters together
-  std::vector<std::uint32_t> primeLive;  ///< live emitters of each prime emitter
-  std::uint32_t nextEmitterId = 0;
-  std::shared_ptr<const GroupOrigin> origin;  ///< null unless Effect::build made it
+  std::vector<LiveEmitter> live;  ///< grown only up to the primes' maxEmitters together
   HairOptions hair;
-  Strands strands;
   TrailOptions trail;
   BudgetPolicy budgetPolicy = BudgetPolicy::DropNewest;
   /// Set by Context::step under a particle budget (Context::Impl::shareBudget), else
@@ -407,41 +405,17 @@ struct GroupImpl {
   GroupStats stats;
   std::uint32_t nextId = 0;
 
-  /// The pass's scratch of a large group, or of any while the thread's is in use: see
-  /// PassScratchUse.
-  std::unique_ptr<PassScratch> ownScratch;
   std::size_t deathsPerStep = 0;  ///< Group::recordDeaths; 0: not recording
   /// A death emitter names this group (set by Context::step): it records every death.
   bool deathsFeed = false;
   /// The deaths a step records: deathsPerStep, or the capacity while deathsFeed.
   std::size_t deathRoom() const { return deathsFeed ? capacity : deathsPerStep; }
-  std::vector<DeathEmitter> deathEmitters;
-  /// Each death emitter's source as Context::step last found it: the group, the name it was
-  /// found by and the context's groups' version then. Found again when either changed
-  /// (DeathEmitter::source is the caller's to edit), not by name every step.
-  struct FoundSource {
-    Group* group = nullptr;
-    std::string name;
-    std::uint64_t version = ~std::uint64_t(0);
-  };
-  std::vector<FoundSource> deathSources;
-  /// The context's count of death emitters in all its groups (0: Context::step skips them).
-  std::size_t* contextDeathEmitters = nullptr;
-  /// The context's schedule version: Group::setUpdateInterval bumps it.
-  std::uint64_t* contextSchedule = nullptr;
   GroupStats::StepSeconds lastStepParts;  ///< the last step's (the CPU backend's clock)
   std::size_t collisionsPerStep = 0;      ///< Group::recordCollisions; 0: not recording
   /// A collision emitter names this group (set by Context::step): it records every collision.
   bool collisionsFeed = false;
   std::size_t collisionRoom() const { return collisionsFeed ? ~std::size_t(0) : collisionsPerStep; }
   std::vector<CollisionEvent> collisionEvents;  ///< the last step's, reserved up to the room
-  /// Each block's collisions as the pass finds them (a block's in its own order), merged in
-  /// block order after it: the same on any thread count. They only grow.
-  struct KeyedCollision {
-    std::uint64_t key;  ///< particle index, sub-step, action: the order they are kept in
-    CollisionEvent event;
-  };
-  std::vector<std::vector<KeyedCollision>> blockCollisions;
   /// Out of line here (see assignFill): the pass clears `blocks` blocks' lists, adds to one,
   /// and takes the first collisionsPerStep of them in block order after.
   void beginCollisions(std::size_t blocks);
@@ -461,35 +435,26 @@ struct GroupImpl {
   /// particle compact() would have moved there, the last from index `filledFrom`: compact()
   /// goes on from there (the same moves, in the same order, as if it made them all).
   std::uint32_t holesFilled = 0, filledFrom = 0;
-  std::uint64_t filledByPass = 0;  ///< holes the act pass ever filled (for the tests)
   /// This step's newborns, written before the act pass: [bornFirst, bornFirst + bornCount),
   /// each with the part of the step it still has to live (seconds, bornRemaining[r]), which
   /// the pass runs it through the action list for.
   std::size_t bornFirst = 0, bornCount = 0;
-  std::vector<float> bornRemaining;      ///< grows, never shrinks
-  std::vector<std::uint32_t> deadFlags;  ///< the unfused baseline's per-particle kill codes
-  std::vector<float> snapshot;           ///< positions/velocities at the step's start
-  ActionPlan plan;                       ///< the fused pass's, for actionsVersion
+  std::vector<float> bornRemaining;  ///< grows, never shrinks
 
   std::unique_ptr<DeviceMirror> mirror;  ///< null on the CPU backend
   std::unique_ptr<Frame> frame;          ///< null until Group::setTransform
   /// Steps this group runs ahead of its context's clock (Context::prewarm): its step index
   /// and time are the context's plus these steps.
   std::uint64_t stepsAhead = 0;
-  /// NaN while the context's dt is the one the steps ahead were taken with; after a change of
-  /// dt, the lead in seconds.
-  double aheadSeconds = std::numeric_limits<double>::quiet_NaN();
   /// Group::setTimeScale. Once it is not 1 (or an update interval is set) the group keeps a
   /// clock of its own, where its next step starts: clockBase + clockUnits·clockUnit, as the
   /// context keeps its own (no drift from adding a step at a time), based anew when the
   /// length of a unit (scale·dt) changes. clockBase is NaN until it starts.
   double timeScale = 1.0;
   double clockBase = std::numeric_limits<double>::quiet_NaN();
-  double clockUnit = 0.0;
-  std::uint64_t clockUnits = 0;
   /// Group::setUpdateInterval: it steps when (context step + updatePhase) % updateInterval
   /// is 0, over its skippedSteps + 1 steps' time.
-  std::uint32_t updateInterval = 1, updatePhase = 0, skippedSteps = 0;
+  std::uint32_t updateInterval = 1, skippedSteps = 0;  // (updatePhase: with the cold part)
   std::uint64_t ownSteps = 0;  ///< steps taken: a seeded group's random step key
   bool clockStarted() const { return !std::isnan(clockBase); }
   bool ownsClock() const {
@@ -577,8 +542,57 @@ struct GroupImpl {
   void write(std::size_t i, const Particle& p) { writeParticle(lanePointers(), i, p); }
   Particle read(std::size_t i) const { return readParticle(lanePointers(), i); }
 
-  /// The lanes, by attribute and component (null where not stored). Last, apart from what
-  /// a step reads (laneCache): prefetchSelf() asks for the object up to here.
+  /// The fused pass's, for actionsVersion. Last of what a step reads, as its own cold part
+  /// (from ActionPlan::coldStart on) then joins the group's.
+  ActionPlan plan;
+
+  // From here on what a step does not read (found by tracing the loads of a step of small
+  // effect instances), kept apart so that what it does read spans fewer cache lines: a
+  // game's thousands of small groups are each out of cache by their next step
+  // (bench_runtime's Instances). prefetchSelf() asks for the object up to plan.coldStart.
+  std::string name;
+  std::vector<EmitterState> primeState;
+  std::vector<std::uint32_t> primeLive;  ///< live emitters of each prime emitter
+  std::uint32_t nextEmitterId = 0;
+  std::shared_ptr<const GroupOrigin> origin;  ///< null unless Effect::build made it
+  Strands strands;
+  /// The pass's scratch of a large group, or of any while the thread's is in use: see
+  /// PassScratchUse.
+  std::unique_ptr<PassScratch> ownScratch;
+  std::vector<DeathEmitter> deathEmitters;
+  /// Each death emitter's source as Context::step last found it: the group, the name it was
+  /// found by and the context's groups' version then. Found again when either changed
+  /// (DeathEmitter::source is the caller's to edit), not by name every step.
+  struct FoundSource {
+    Group* group = nullptr;
+    std::string name;
+    std::uint64_t version = ~std::uint64_t(0);
+  };
+  std::vector<FoundSource> deathSources;
+  /// The context's count of death emitters in all its groups (0: Context::step skips them).
+  std::size_t* contextDeathEmitters = nullptr;
+  /// The context's schedule version: Group::setUpdateInterval bumps it.
+  std::uint64_t* contextSchedule = nullptr;
+  /// Each block's collisions as the pass finds them (a block's in its own order), merged in
+  /// block order after it: the same on any thread count. They only grow.
+  struct KeyedCollision {
+    std::uint64_t key;  ///< particle index, sub-step, action: the order they are kept in
+    CollisionEvent event;
+  };
+  std::vector<std::vector<KeyedCollision>> blockCollisions;
+  std::uint64_t filledByPass = 0;        ///< holes the act pass ever filled (for the tests)
+  std::vector<std::uint32_t> deadFlags;  ///< the unfused baseline's per-particle kill codes
+  std::vector<float> snapshot;           ///< positions/velocities at the step's start
+  /// NaN while the context's dt is the one the steps ahead were taken with; after a change of
+  /// dt, the lead in seconds.
+  double aheadSeconds = std::numeric_limits<double>::quiet_NaN();
+  /// The group's own clock past clockBase (see timeScale).
+  double clockUnit = 0.0;
+  std::uint64_t clockUnits = 0;
+  std::uint32_t updatePhase = 0;  ///< see updateInterval
+
+  /// The lanes, by attribute and component (null where not stored). Last: a step reads
+  /// laneCache.
   std::array<std::array<LaneBuffer, 4>, std::size_t(Attribute::Count)> lanes;
 };
 
