@@ -2,13 +2,16 @@
 # Installs every Debian and PyPI dependency Flurry uses. Idempotent: when all is
 # present it only checks (a few seconds) and installs nothing.
 # `--gallery` also installs what only scripts/gallery.sh needs (ffmpeg, for the animated
-# previews), which CI and building do not.
+# previews), which CI and building do not; `--profile` what only scripts/instance_lines.py
+# needs (valgrind).
 set -euo pipefail
 GALLERY=0
+PROFILE=0
 for arg in "$@"; do
   case "$arg" in
     --gallery) GALLERY=1 ;;
-    *) echo "setup: unknown option $arg (known: --gallery)" >&2; exit 2 ;;
+    --profile) PROFILE=1 ;;
+    *) echo "setup: unknown option $arg (known: --gallery, --profile)" >&2; exit 2 ;;
   esac
 done
 
@@ -26,6 +29,7 @@ DEB_PACKAGES=(
   qemu-user
 )
 if [ "$GALLERY" = 1 ]; then DEB_PACKAGES+=(ffmpeg); fi
+if [ "$PROFILE" = 1 ]; then DEB_PACKAGES+=(valgrind); fi
 PY_PACKAGES=(numpy matplotlib pytest nanobind scikit-build-core)
 
 SUDO=""
