@@ -35,10 +35,18 @@ FL_INLINE float3 fl_lattice_gradient(uint h) {
 FL_INLINE float fl_noise_fade(float t) { return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f); }
 FL_INLINE float fl_noise_dfade(float t) { return 30.0f * t * t * (t * (t - 2.0f) + 1.0f); }
 
+/* The lattice cell of a coordinate's floor f as an int, held within +-2^30: a float beyond
+ * int's range (or NaN) converted as it is is undefined behaviour in C++ and unspecified on a
+ * device (a particle flung 1e32 away still reads the noise). Every f inside is unchanged;
+ * that far out a float has no fraction left anyway. */
+FL_INLINE int fl_lattice_cell(float f) {
+  return (int)(f < -1073741824.0f ? -1073741824.0f : (f < 1073741824.0f ? f : 1073741824.0f));
+}
+
 /* The exact gradient of Perlin gradient noise (quintic fade) at p. */
 FL_INLINE float3 fl_noise_gradient(float px, float py, float pz, uint seed) {
   const float fx = floor(px), fy = floor(py), fz = floor(pz);
-  const int ix = (int)fx, iy = (int)fy, iz = (int)fz;
+  const int ix = fl_lattice_cell(fx), iy = fl_lattice_cell(fy), iz = fl_lattice_cell(fz);
   const float tx = px - fx, ty = py - fy, tz = pz - fz;
   const float ux = fl_noise_fade(tx), uy = fl_noise_fade(ty), uz = fl_noise_fade(tz);
   const float dux = fl_noise_dfade(tx), duy = fl_noise_dfade(ty), duz = fl_noise_dfade(tz);

@@ -155,6 +155,23 @@ TEST(Turbulence, CurlNoiseIsDivergenceFree) {
   EXPECT_LT(worstDiv, 0.01 * typicalGrad);  // ...with no divergence beyond the differences' error
 }
 
+// A particle flung far beyond int's range still reads the noise: its lattice cell is held in
+// range, not converted as it is (undefined: UBSan reported it at 3.6e32, found by
+// RandomEffects), and the field stays finite there; nearer, the cells are unchanged.
+TEST(Turbulence, IsDefinedAndFiniteFarAway) {
+  Context ctx = makeContext(0.05);
+  Group& g = ctx.createGroup("g", 8);
+  g.setActions({Turbulence{3.0f, 10.0f, 3, Vec3(0.0f)}});
+  for (const float x : {3.6e32f, -3.6e32f, 3e9f, -2.2e9f, 1.5e5f})
+    ASSERT_TRUE(g.add(at(Vec3(x, -x, 0.5f * x))));
+  ctx.step();
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const Vec3 v = g.particle(i).velocity;
+    EXPECT_TRUE(std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z)) << i;
+  }
+  EXPECT_NE(detail::curlNoise(Vec3(1.5e5f, -1.5e5f, 7.5e4f), 3), Vec3(0.0f));
+}
+
 TEST(MagneticField, DoesNoWorkAndGyratesAtTheLarmorRadius) {
   Context ctx = makeContext(0.001);
   Group& g = ctx.createGroup("g", 1);
