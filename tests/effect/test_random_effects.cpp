@@ -1,15 +1,18 @@
-// Effects made at random from the action descriptors, every field of every action drawn
+// Effects made at random: from the action descriptors, every field of every action drawn
 // anywhere in its documented range (its ends, zero, huge and tiny values, infinity where the
-// field takes it), with random domains, emitters and step lengths, then stepped on one and
-// two threads: whatever a valid file asks for, a step never crashes (the suite runs under
-// AddressSanitizer and UndefinedBehaviorSanitizer), keeps no particle that is not finite,
-// never holds more than its capacity, keeps a box that holds every particle, and gives the
-// same particles bit for bit on any thread count.
+// field takes it), with random domains, integrators and step lengths; and emission of every
+// kind (bursts, paths, several types, births by distance, prime emitters three levels deep,
+// sub-emitters on death, collision and birth). Each is stepped on one and two threads:
+// whatever a valid file asks for, a step never crashes (the suite runs under AddressSanitizer
+// and UndefinedBehaviorSanitizer), keeps no particle that is not finite, never holds more than
+// its capacity, keeps a box that holds every particle, and gives the same particles bit for
+// bit on any thread count.
 #include <gtest/gtest.h>
 
 #include <bit>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <random>
 #include <string>
 #include <vector>
@@ -87,7 +90,7 @@ class Draw {
   std::string domain() {
     switch (below(11)) {
       case 0:
-        return R"({"type": "point", "p": )" + point() + "}";
+        return R"({"type": "point", "point": )" + point() + "}";
       case 1:
         return R"({"type": "line", "p0": )" + point() + R"(, "p1": )" + point() + "}";
       case 2:
@@ -114,6 +117,90 @@ class Draw {
       default:
         return R"({"type": "triangle", "p0": [0, 0, 0], "p1": [1, 0, 0], "p2": [0, 0, 1]})";
     }
+  }
+
+  std::string fuzzy() {
+    switch (below(4)) {
+      case 0:
+        return size();
+      case 1:
+        return "[" + size() + ", " + size() + "]";
+      case 2:
+        return R"({"center": )" + size() + R"(, "percent": 40})";
+      default:
+        return R"({"center": )" + size() + R"(, "spread": 0.3, "distribution": "normal"})";
+    }
+  }
+  std::string time() {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.6g",
+                  below(5) == 0 ? between(-2.0, 0.0) : between(0.0, 3.0));
+    return text;
+  }
+  /// 1 to 3 particle types, weighed.
+  std::string types() {
+    std::string out;
+    const int n = 1 + below(3);
+    for (int k = 0; k < n; ++k) {
+      out += std::string(k ? ", " : "") + R"({"weight": )" + (k == 0 || below(4) ? size() : "0") +
+             R"(, "velocity": )" + domain() + R"(, "lifetime": )" + fuzzy();
+      if (below(2)) out += R"(, "size": )" + fuzzy() + R"(, "mass": )" + fuzzy();
+      if (below(3) == 0) out += R"(, "charge": )" + fuzzy() + R"(, "rotVelocity": )" + domain();
+      out += "}";
+    }
+    return "[" + out + "]";
+  }
+  /// Where, when and how many: a shape and a rate, and at random bursts, a path, a motion,
+  /// a start and a stop.
+  std::string counting(int most) {
+    std::string out = R"("shape": )" + domain() + R"(, "rate": )" + std::to_string(below(most));
+    if (below(3) == 0) {
+      out += R"(, "bursts": [)";
+      const int n = 1 + below(3);
+      for (int k = 0; k < n; ++k)
+        out += std::string(k ? ", " : "") + R"({"time": )" + time() + R"(, "count": )" +
+               std::to_string(below(most / 10 + 2)) + R"(, "interval": )" + size() +
+               R"(, "repeat": )" + std::to_string(1 + below(4)) + "}";
+      out += "]";
+    }
+    if (below(3) == 0) {
+      out += R"(, "path": [)";
+      const int n = 1 + below(4);
+      for (int k = 0; k < n; ++k) {
+        char t[32];
+        std::snprintf(t, sizeof t, "%.6g", 0.4 * k + between(0.0, 0.3));
+        out +=
+            std::string(k ? ", " : "") + R"({"time": )" + t + R"(, "position": )" + point() + "}";
+      }
+      out += std::string("], \"pathLoop\": ") + (n > 1 && below(2) ? "true" : "false");
+    } else if (below(2)) {
+      out += R"(, "position": )" + point() + R"(, "velocity": )" + point();
+    }
+    if (below(3) == 0) {
+      const double start = below(5) == 0 ? between(-2.0, 0.0) : between(0.0, 1.0);
+      char t[64];
+      std::snprintf(t, sizeof t, R"(, "start": %.6g, "stop": %.6g)", start,
+                    start + between(0.0, 2.0));
+      out += below(2) ? std::string(t) : std::string(R"(, "stop": "inf")");
+    }
+    return out;
+  }
+  std::string emitter(int most) {
+    std::string out = "{" + counting(most) + R"(, "types": )" + types();
+    if (below(4) == 0) out += R"(, "spacing": )" + size();
+    if (below(4) == 0) out += R"(, "normalSpeed": )" + fuzzy();
+    return out + "}";
+  }
+  /// A prime emitter's emitters, `levels` deep.
+  std::string spec(int levels) {
+    std::string out = R"({"emitter": )" + emitter(300) + R"(, "velocity": )" + domain() +
+                      R"(, "lifetime": )" + fuzzy();
+    if (below(2)) out += R"(, "acceleration": [0, -9.8, 0], "drag": )" + size();
+    if (below(2)) out += R"(, "deathBurst": )" + std::to_string(below(20));
+    if (levels > 1 && below(2))
+      out +=
+          R"(, "deathChildren": )" + std::to_string(below(4)) + R"(, "next": )" + spec(levels - 1);
+    return out + "}";
   }
 
   template <class T>
@@ -193,6 +280,48 @@ std::string randomEffect(std::uint32_t seed) {
   return fx;
 }
 
+/// Two groups whose emission is drawn at random: "a" with 1 or 2 emitters (bursts, paths,
+/// motion, start and stop, several weighed particle types, births by distance, speeds along
+/// the shape's normal) and at times a prime emitter of up to three levels; "b" fed by "a"'s
+/// deaths, collisions or births (a sub-emitter). Simple action lists, a random integrator.
+std::string randomEmission(std::uint32_t seed) {
+  Draw d(seed);
+  const char* integrators[] = {"SemiImplicitEuler", "ExplicitEuler", "VelocityVerlet", "RK4",
+                               "Exact"};
+  char dt[32];
+  std::snprintf(dt, sizeof dt, "%.6g", d.below(5) == 0 ? 1.0 : d.between(0.001, 0.1));
+  std::string fx = R"({"name": "emission", "seed": )" + std::to_string(seed) + R"(, "dt": )" + dt;
+  fx += R"(, "groups": [{"name": "a", "capacity": )" + std::to_string(50 + d.below(2000));
+  fx += R"(, "emitters": [)" + d.emitter(2000);
+  if (d.below(2)) fx += ", " + d.emitter(2000);
+  fx += "]";
+  if (d.below(3) == 0)
+    fx += R"(, "primeEmitters": [{)" + d.counting(20) + R"(, "child": )" + d.spec(3) +
+          R"(, "maxEmitters": )" + std::to_string(1 + d.below(30)) + "}]";
+  fx += std::string(R"(, "integrator": ")") + integrators[d.below(5)] + "\"";
+  fx += R"(, "actions": [{"type": "Gravity", "acceleration": [0, -9.8, 0]},
+      {"type": "Bounce", "surface": {"type": "plane", "point": [0, -1, 0], "normal": [0, 1, 0]},
+       "restitution": 0.6}, {"type": "Move"}, {"type": "KillOld"}]},
+    {"name": "b", "capacity": )" +
+        std::to_string(50 + d.below(2000));
+  const char* on[] = {"death", "collision", "birth"};
+  fx += R"(, "deathEmitters": [{"source": "a", "on": ")" + std::string(on[d.below(3)]) +
+        R"(", "count": )" + d.fuzzy() + R"(, "inheritVelocity": 0.5, "shape": )" + d.domain() +
+        R"(, "types": )" + d.types() + "}]";
+  fx += R"(, "actions": [{"type": "Move"}, {"type": "KillOld"}]}]})";
+  return fx;
+}
+
+/// The seeds a test draws: [1, count], or FLURRY_RANDOM_EFFECTS="FIRST-LAST" for a wider
+/// sweep run by hand (the loaded and stepped counts then checked in proportion).
+std::pair<std::uint32_t, std::uint32_t> seeds(std::uint32_t count) {
+  const char* v = std::getenv("FLURRY_RANDOM_EFFECTS");
+  unsigned first = 0, last = 0;
+  if (v && std::sscanf(v, "%u-%u", &first, &last) == 2 && first >= 1 && last >= first)
+    return {first, last};
+  return {1u, count};
+}
+
 /// The particles after `steps` steps on `threads` threads, checked every step; empty when a
 /// step refused the effect with an Error.
 std::vector<std::uint32_t> run(const Effect& fx, unsigned threads, int steps, bool& refused) {
@@ -248,7 +377,8 @@ std::vector<std::uint32_t> run(const Effect& fx, unsigned threads, int steps, bo
 
 TEST(RandomEffects, StepSafelyAndAlikeOnAnyThreadCount) {
   int loaded = 0, stepped = 0;
-  for (std::uint32_t seed = 1; seed <= 400; ++seed) {
+  const auto [first, last] = seeds(400);
+  for (std::uint32_t seed = first; seed <= last; ++seed) {
     const std::string text = randomEffect(seed);
     SCOPED_TRACE("seed " + std::to_string(seed) + ":\n" + text);
     Effect fx;
@@ -268,6 +398,36 @@ TEST(RandomEffects, StepSafelyAndAlikeOnAnyThreadCount) {
     if (HasFailure()) return;
   }
   // Most draws must load and step, or the test would check little.
-  EXPECT_GT(loaded, 200);
-  EXPECT_GT(stepped, 150);
+  const double drawn = double(last - first + 1);
+  EXPECT_GT(loaded, 0.5 * drawn);
+  EXPECT_GT(stepped, 0.4 * drawn);
+  std::printf("%d of %.0f drawn effects loaded, %d stepped\n", loaded, drawn, stepped);
+}
+
+TEST(RandomEffects, EmissionOfEveryKindStepsSafelyAndAlike) {
+  int loaded = 0, stepped = 0;
+  const auto [first, last] = seeds(300);
+  for (std::uint32_t seed = first; seed <= last; ++seed) {
+    const std::string text = randomEmission(seed);
+    SCOPED_TRACE("seed " + std::to_string(seed) + ":\n" + text);
+    Effect fx;
+    try {
+      fx = parseEffect(text, "emission.json");
+    } catch (const EffectError&) {
+      continue;
+    }
+    ++loaded;
+    bool refused1 = false, refused2 = false;
+    const auto one = run(fx, 1, 25, refused1);
+    const auto two = run(fx, 2, 25, refused2);
+    ASSERT_EQ(refused1, refused2);
+    if (refused1) continue;
+    ++stepped;
+    ASSERT_TRUE(one == two) << "1 thread and 2 differ";
+    if (HasFailure()) return;
+  }
+  const double drawn = double(last - first + 1);
+  EXPECT_GT(loaded, 0.5 * drawn);
+  EXPECT_GT(stepped, 0.4 * drawn);
+  std::printf("%d of %.0f drawn effects loaded, %d stepped\n", loaded, drawn, stepped);
 }
