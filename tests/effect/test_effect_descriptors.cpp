@@ -12,6 +12,7 @@
 #include "effect/descriptors.hpp"
 #include "flurry/effect.hpp"
 #include "flurry/flurry.hpp"
+#include "sample_values.hpp"
 
 using namespace flurry;
 
@@ -171,15 +172,10 @@ std::string sampleValue(const desc::Limit& l, const T& def) {
     return std::string("\"") + desc::EnumNames<T>::values[1].first + "\"";
   } else if constexpr (std::is_same_v<T, Domain>) {
     return R"({"type": "box", "min": [-1, -1, -1], "max": [1, 2, 1]})";
-  } else if constexpr (std::is_same_v<T, std::shared_ptr<const VectorField>>) {
-    return R"({"origin": [-1, 0, -1], "voxelSize": 2, "dims": [2, 1, 1],
-               "data": [[0, 1, 0], [1, 0, 0]]})";
   } else if constexpr (std::is_same_v<T, Falloff>) {
     return R"({"center": [0, 1, 0], "radius": 4, "power": 2})";
-  } else if constexpr (std::is_same_v<T, std::vector<ColorOverLife::Key>>) {
-    return R"([{"t": 0, "color": [1, 0.5, 0]}, {"t": 0.5, "color": [0, 0, 1, 0.5]}])";
-  } else if constexpr (std::is_same_v<T, std::vector<SizeOverLife::Key>>) {
-    return R"([{"t": 0.25, "size": 2}, {"t": 1, "size": 0.5}])";
+  } else if constexpr (test::kListed<T>) {
+    return test::listedSample<T>();
   } else {
     static_assert(!sizeof(T), "a field type the test does not know");
   }
