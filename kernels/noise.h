@@ -35,10 +35,10 @@ FL_INLINE float3 fl_lattice_gradient(uint h) {
 FL_INLINE float fl_noise_fade(float t) { return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f); }
 FL_INLINE float fl_noise_dfade(float t) { return 30.0f * t * t * (t * (t - 2.0f) + 1.0f); }
 
-/* The lattice cell of a coordinate's floor f as an int, held within +-2^30: a float beyond
- * int's range (or NaN) converted as it is is undefined behaviour in C++ and unspecified on a
- * device (a particle flung 1e32 away still reads the noise). Every f inside is unchanged;
- * that far out a float has no fraction left anyway. */
+/* The lattice cell of a coordinate's floor f as an int, f held within +-2^30 first: a float
+ * beyond int's range (or NaN) converted to int is undefined behaviour in C++ and unspecified
+ * on a device, and a particle flung 1e32 away still reads the noise. Every f inside is
+ * unchanged; that far out a float has no fraction left anyway. */
 FL_INLINE int fl_lattice_cell(float f) {
   return (int)(f < -1073741824.0f ? -1073741824.0f : (f < 1073741824.0f ? f : 1073741824.0f));
 }
