@@ -308,6 +308,14 @@ std::string randomEmission(std::uint32_t seed) {
   return fx;
 }
 
+/// randomEffect in the world's space or, every other seed, in the instance's own (its
+/// particles carried with it when it moves).
+std::string randomPlacedEffect(std::uint32_t seed) {
+  std::string fx = randomEffect(seed);
+  if (seed % 2 == 0) fx.insert(1, R"("space": "local", )");
+  return fx;
+}
+
 /// The seeds a test draws: [1, count], or FLURRY_RANDOM_EFFECTS="FIRST-LAST" for a wider
 /// sweep run by hand (the loaded and stepped counts then checked in proportion).
 std::pair<std::uint32_t, std::uint32_t> seeds(std::uint32_t count) {
@@ -320,13 +328,20 @@ std::pair<std::uint32_t, std::uint32_t> seeds(std::uint32_t count) {
 
 /// The particles after `steps` steps on `threads` threads, checked every step; empty when a
 /// step refused the effect with an Error.
-std::vector<std::uint32_t> run(const Effect& fx, unsigned threads, int steps, bool& refused) {
+std::vector<std::uint32_t> run(const Effect& fx, unsigned threads, int steps, bool& refused,
+                               bool moved) {
   Context ctx({.seed = fx.seed, .dt = fx.dt, .threads = threads, .backend = Backend::Cpu});
   detail::setPassOptions(ctx, {.blockSize = 256});  // a few hundred alive: several blocks
   refused = false;
   std::vector<Group*> groups;
+  EffectInstance instance;
   try {
-    groups = fx.build(ctx);
+    if (moved) {
+      instance = fx.instantiate(ctx, "x");
+      groups = instance.groups();
+    } else {
+      groups = fx.build(ctx);
+    }
   } catch (const Error&) {
     refused = true;
     return {};
@@ -335,6 +350,16 @@ std::vector<std::uint32_t> run(const Effect& fx, unsigned threads, int steps, bo
   std::vector<std::uint32_t> bits;
   for (int s = 0; s < steps; ++s) {
     try {
+      if (moved) {
+        // Placed anew before each step, as a game moves an effect with its owner: anywhere
+        // within 100 units, turned any way, scaled 0.5-2 (the same on every run).
+        Draw d(std::uint32_t(fx.seed) * 977u + std::uint32_t(s));
+        const Vec3 axis(float(d.between(-1, 1)), float(d.between(0.1, 1)), float(d.between(-1, 1)));
+        instance.setTransform({Vec3(float(d.between(-100, 100)), float(d.between(-100, 100)),
+                                    float(d.between(-100, 100))),
+                               glm::angleAxis(float(d.between(-3.2, 3.2)), glm::normalize(axis)),
+                               float(d.between(0.5, 2.0))});
+      }
       ctx.step();
     } catch (const Error&) {
       refused = true;
@@ -370,8 +395,9 @@ std::vector<std::uint32_t> run(const Effect& fx, unsigned threads, int steps, bo
 }
 
 /// Draws effects with `make` from the seeds (seeds(count)), and steps each that loads on one
-/// and on two threads (run: checked every step), their particles compared bit for bit.
-void stepDraws(std::string (*make)(std::uint32_t), std::uint32_t count) {
+/// and on two threads (run: checked every step; `moved`: as an instance placed anew before
+/// each step), their particles compared bit for bit.
+void stepDraws(std::string (*make)(std::uint32_t), std::uint32_t count, bool moved = false) {
   int loaded = 0, stepped = 0;
   const auto [first, last] = seeds(count);
   for (std::uint32_t seed = first; seed <= last; ++seed) {
@@ -385,8 +411,8 @@ void stepDraws(std::string (*make)(std::uint32_t), std::uint32_t count) {
     }
     ++loaded;
     bool refused1 = false, refused2 = false;
-    const auto one = run(fx, 1, 25, refused1);
-    const auto two = run(fx, 2, 25, refused2);
+    const auto one = run(fx, 1, 25, refused1, moved);
+    const auto two = run(fx, 2, 25, refused2, moved);
     ASSERT_EQ(refused1, refused2);
     if (refused1) continue;
     ++stepped;
@@ -408,4 +434,8 @@ TEST(RandomEffects, StepSafelyAndAlikeOnAnyThreadCount) {
 
 TEST(RandomEffects, EmissionOfEveryKindStepsSafelyAndAlike) {
   stepDraws(randomEmission, 300);
+}
+
+TEST(RandomEffects, InstancesMovedEveryStepStepSafelyAndAlike) {
+  stepDraws(randomPlacedEffect, 200, true);
 }
