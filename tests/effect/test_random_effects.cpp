@@ -22,6 +22,7 @@
 #include "flurry/flurry.hpp"
 #include "pass_options.hpp"
 #include "sample_values.hpp"
+#include "step_checks.hpp"
 
 using namespace flurry;
 
@@ -32,6 +33,12 @@ class Draw {
   explicit Draw(std::uint32_t seed) : rng_(seed) {}
   int below(int n) { return int(std::uniform_int_distribution<int>(0, n - 1)(rng_)); }
   double between(double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng_); }
+  /// v as JSON, to `digits` significant digits.
+  static std::string text(double v, int digits = 6) {
+    char out[32];
+    std::snprintf(out, sizeof out, "%.*g", digits, v);
+    return out;
+  }
 
   /// A JSON number (or "inf") inside limit `l`: an end, zero, huge, tiny or anywhere.
   std::string number(const desc::Limit& l) {
@@ -67,27 +74,15 @@ class Draw {
       if (l.minOpen && v <= l.min) v = l.min + (hi - l.min) * 0.5;
     }
     if (l.nonZero && v == 0.0) v = 0.5;
-    char text[64];
-    std::snprintf(text, sizeof text, "%.9g", v);
-    return text;
+    return text(v, 9);
   }
   std::string vec3(const desc::Limit& l) {
     return "[" + number(l) + ", " + number(l) + ", " + number(l) + "]";
   }
   /// A small coordinate, or now and then a far one.
-  std::string coord() {
-    const double v = below(8) == 0 ? between(-1e6, 1e6) : between(-3.0, 3.0);
-    char text[32];
-    std::snprintf(text, sizeof text, "%.6g", v);
-    return text;
-  }
+  std::string coord() { return text(below(8) == 0 ? between(-1e6, 1e6) : between(-3.0, 3.0)); }
   std::string point() { return "[" + coord() + ", " + coord() + ", " + coord() + "]"; }
-  std::string size() {
-    const double v = below(6) == 0 ? (below(2) ? 1e-6 : 1e5) : between(0.01, 3.0);
-    char text[32];
-    std::snprintf(text, sizeof text, "%.6g", v);
-    return text;
-  }
+  std::string size() { return text(below(6) == 0 ? (below(2) ? 1e-6 : 1e5) : between(0.01, 3.0)); }
   std::string domain() {
     switch (below(11)) {
       case 0:
@@ -120,6 +115,11 @@ class Draw {
     }
   }
 
+  /// How the list's Move integrates, as the group's "integrator" key.
+  std::string integrator() {
+    const char* names[] = {"SemiImplicitEuler", "ExplicitEuler", "VelocityVerlet", "RK4", "Exact"};
+    return std::string(R"("integrator": ")") + names[below(5)] + "\"";
+  }
   std::string fuzzy() {
     switch (below(4)) {
       case 0:
@@ -132,12 +132,7 @@ class Draw {
         return R"({"center": )" + size() + R"(, "spread": 0.3, "distribution": "normal"})";
     }
   }
-  std::string time() {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.6g",
-                  below(5) == 0 ? between(-2.0, 0.0) : between(0.0, 3.0));
-    return text;
-  }
+  std::string time() { return text(below(5) == 0 ? between(-2.0, 0.0) : between(0.0, 3.0)); }
   /// 1 to 3 particle types, weighed.
   std::string types() {
     std::string out;
@@ -168,8 +163,7 @@ class Draw {
       out += R"(, "path": [)";
       const int n = 1 + below(4);
       for (int k = 0; k < n; ++k) {
-        char t[32];
-        std::snprintf(t, sizeof t, "%.6g", 0.4 * k + between(0.0, 0.3));
+        const std::string t = text(0.4 * k + between(0.0, 0.3));  // (drawn before the place)
         out +=
             std::string(k ? ", " : "") + R"({"time": )" + t + R"(, "position": )" + point() + "}";
       }
@@ -179,10 +173,9 @@ class Draw {
     }
     if (below(3) == 0) {
       const double start = below(5) == 0 ? between(-2.0, 0.0) : between(0.0, 1.0);
-      char t[64];
-      std::snprintf(t, sizeof t, R"(, "start": %.6g, "stop": %.6g)", start,
-                    start + between(0.0, 2.0));
-      out += below(2) ? std::string(t) : std::string(R"(, "stop": "inf")");
+      const std::string stop = text(start + between(0.0, 2.0));
+      out += below(2) ? R"(, "start": )" + text(start) + R"(, "stop": )" + stop
+                      : std::string(R"(, "stop": "inf")");
     }
     return out;
   }
@@ -255,9 +248,7 @@ std::string randomEffect(std::uint32_t seed) {
     if (k < count)
       actions += (actions.empty() ? "" : ",\n") + all[std::size_t(d.below(int(all.size())))];
   }
-  const char* integrators[] = {"SemiImplicitEuler", "ExplicitEuler", "VelocityVerlet", "RK4",
-                               "Exact"};
-  std::string list = std::string(R"("integrator": ")") + integrators[d.below(5)] + "\"";
+  std::string list = d.integrator();
   if (d.below(3) == 0)
     list += R"(, "substeps": {"maxStep": )" + d.size() + R"(, "maxSubsteps": )" +
             std::to_string(1 + d.below(8)) + "}";
@@ -265,8 +256,7 @@ std::string randomEffect(std::uint32_t seed) {
   // A third large enough that two threads share its passes (a small group steps on one; the
   // blocks are of 256), at most ~2,000 alive (some actions read every pair of particles).
   const bool large = d.below(3) == 0;
-  char dt[32];
-  std::snprintf(dt, sizeof dt, "%.6g", !large && d.below(4) == 0 ? 5.0 : d.between(0.001, 0.2));
+  const std::string dt = Draw::text(!large && d.below(4) == 0 ? 5.0 : d.between(0.001, 0.2));
   std::string fx = R"({"name": "random", "seed": )" + std::to_string(seed) + R"(, "dt": )" + dt;
   fx += R"(, "groups": [{"name": "g", "capacity": )" + std::string(large ? "40000" : "300");
   fx += R"(, "emitters": [{"shape": )" + d.domain();
@@ -282,10 +272,7 @@ std::string randomEffect(std::uint32_t seed) {
 /// deaths, collisions or births (a sub-emitter). Simple action lists, a random integrator.
 std::string randomEmission(std::uint32_t seed) {
   Draw d(seed);
-  const char* integrators[] = {"SemiImplicitEuler", "ExplicitEuler", "VelocityVerlet", "RK4",
-                               "Exact"};
-  char dt[32];
-  std::snprintf(dt, sizeof dt, "%.6g", d.below(5) == 0 ? 1.0 : d.between(0.001, 0.1));
+  const std::string dt = Draw::text(d.below(5) == 0 ? 1.0 : d.between(0.001, 0.1));
   std::string fx = R"({"name": "emission", "seed": )" + std::to_string(seed) + R"(, "dt": )" + dt;
   fx += R"(, "groups": [{"name": "a", "capacity": )" + std::to_string(50 + d.below(2000));
   fx += R"(, "emitters": [)" + d.emitter(2000);
@@ -294,7 +281,7 @@ std::string randomEmission(std::uint32_t seed) {
   if (d.below(3) == 0)
     fx += R"(, "primeEmitters": [{)" + d.counting(20) + R"(, "child": )" + d.spec(3) +
           R"(, "maxEmitters": )" + std::to_string(1 + d.below(30)) + "}]";
-  fx += std::string(R"(, "integrator": ")") + integrators[d.below(5)] + "\"";
+  fx += ", " + d.integrator();
   fx += R"(, "actions": [{"type": "Gravity", "acceleration": [0, -9.8, 0]},
       {"type": "Bounce", "surface": {"type": "plane", "point": [0, -1, 0], "normal": [0, 1, 0]},
        "restitution": 0.6}, {"type": "Move"}, {"type": "KillOld"}]},
@@ -365,22 +352,7 @@ std::vector<std::uint32_t> run(const Effect& fx, unsigned threads, int steps, bo
       refused = true;
       return {};
     }
-    for (const Group* g : groups) {
-      EXPECT_LE(g->size(), g->capacity()) << "step " << s;
-      const Bounds box = g->bounds();
-      for (std::size_t i = 0; i < g->size(); ++i) {
-        const Vec3 p = g->particle(i).position;
-        if (!(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z))) {
-          ADD_FAILURE() << "step " << s << ": particle " << i << " not finite";
-          return bits;
-        }
-        if (!(p.x >= box.min.x && p.y >= box.min.y && p.z >= box.min.z && p.x <= box.max.x &&
-              p.y <= box.max.y && p.z <= box.max.z)) {
-          ADD_FAILURE() << "step " << s << ": particle " << i << " outside the group's box";
-          return bits;
-        }
-      }
-    }
+    if (!test::stepLeftGroupsSound(groups, s)) return bits;
   }
   for (const Group* g : groups)
     for (std::size_t i = 0; i < g->size(); ++i) {
