@@ -173,6 +173,18 @@ TEST_P(OpenCLIntegrators, GravityAndDrag) {
   checkParity(spraying(list, {Attribute::PrevPosition}));
 }
 
+// A force after the last Move, or in a list without one, is its own update under every
+// integrator (only a Move that follows it evaluates it): the device once dropped it.
+TEST_P(OpenCLIntegrators, ForcesAfterTheLastMoveAreTheirOwnUpdate) {
+  ActionList after{Gravity{kDown}, Move{}, Damping{Vec3(0.3f, 0.1f, 0.6f)},
+                   Gravity{Vec3(2.0f, 0.0f, 0.0f)}, KillOld{}};
+  after.setIntegrator(GetParam());
+  checkParity(spraying(after), 60);
+  ActionList none{Gravity{kDown}, Damping{Vec3(0.5f)}, KillOld{}};
+  none.setIntegrator(GetParam());
+  checkParity(spraying(none), 60);
+}
+
 INSTANTIATE_TEST_SUITE_P(OpenCLCore, OpenCLIntegrators,
                          ::testing::Values(Integrator::ExplicitEuler, Integrator::VelocityVerlet,
                                            Integrator::RK4, Integrator::Exact));

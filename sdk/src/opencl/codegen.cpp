@@ -682,6 +682,12 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
       << "u, id, fl_hits, fl_hitRoom);\n#endif\n";
     return c.str();
   };
+  // A force is evaluated by an integrating Move only where one follows it: after the last
+  // Move (or in a list without one) it is its own update, as under semi-implicit Euler
+  // (cpu_backend.cpp planStructure).
+  std::size_t movesUpTo = 0;  // one past the last Move
+  for (std::size_t k = 0; k < acts.size(); ++k)
+    if (std::holds_alternative<Move>(acts[k])) movesUpTo = k + 1;
   for (std::size_t k = 0; k < acts.size(); ++k) {
     const Action& act = acts[k];
     ActionSource& src = sources[k];
@@ -689,7 +695,7 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
     reads.insert(src.reads);
     writes.insert(src.writes);
     body << "    /* " << k << ": " << actionName(act) << " */\n";
-    if (integrator != Integrator::SemiImplicitEuler) {
+    if (integrator != Integrator::SemiImplicitEuler && k < movesUpTo) {
       // Forces before a Move are evaluated by its integrator (fused_pass.cpp makePlan).
       if (isForce(act)) {
         if (src.accel.empty()) notOnDevice(actionName(act) + " under an integrator");
