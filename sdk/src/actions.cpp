@@ -1,5 +1,7 @@
+#include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <type_traits>
 
@@ -274,8 +276,18 @@ cl::FlActionParams actionParams(const Action& act, float dt) {
     own.electric = {xyz(ef->field)};
     falloff(ef->falloff);
   } else if (const auto* m = std::get_if<MagneticField>(&act)) {
-    const float B = glm::length(m->field);
-    own.magnetic = {xyz(B > 0.0f ? m->field / B : Vec3(0.0f)), B, xyz(m->field)};
+    const Vec3 f = m->field;
+    float B = glm::length(f);
+    Vec3 direction = B > 0.0f ? f / B : Vec3(0.0f);
+    if (std::isinf(B)) {
+      // Its square overflowed (past ~1.8e19): |B| from the field scaled by its largest
+      // component. (An infinite strength turned an uncharged particle by 0 * inf, a NaN.)
+      const float big = std::max({std::abs(f.x), std::abs(f.y), std::abs(f.z)});
+      const float l = glm::length(f / big);
+      direction = f / big / l;
+      B = std::min(big * l, std::numeric_limits<float>::max());
+    }
+    own.magnetic = {xyz(direction), B, xyz(f)};
     falloff(m->falloff);
   } else if (const auto* sf = std::get_if<SampledField>(&act)) {
     // (where the grid is, `first`, is the device's: its packer places the grid)

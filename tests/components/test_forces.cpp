@@ -196,6 +196,35 @@ TEST(MagneticField, DoesNoWorkAndGyratesAtTheLarmorRadius) {
   EXPECT_NEAR(ymax - ymin, 2 * radius, 0.01f);
 }
 
+// A field past ~1.8e19, whose square overflows a float: its strength was infinite, and an
+// uncharged particle turned by 0 * inf (a NaN: killed).
+TEST(MagneticField, AFieldWhoseSquareOverflowsTurnsAsItsDirectionSays) {
+  Context ctx = makeContext(0.001);
+  Group& g = ctx.createGroup("g", 2);
+  const Vec3 field(3e19f, 4e19f, 0.0f), axis(0.6f, 0.8f, 0.0f);  // |B| = 5e19
+  g.setActions({MagneticField{field}, Move{}});
+  Particle charged = at(Vec3(0), Vec3(1, 2, 3)), uncharged = charged;
+  charged.charge = 2e-20f;  // q/m |B| = 1 radian a second
+  uncharged.charge = 0.0f;
+  g.add(charged);
+  g.add(uncharged);
+  ctx.run(500);
+  ASSERT_EQ(g.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    const Particle p = g.particle(i);
+    if (p.charge == 0.0f) {
+      EXPECT_EQ(p.velocity, Vec3(1, 2, 3));
+      continue;
+    }
+    // Half a radian about the field: the speed and the part along the field stay.
+    EXPECT_NEAR(glm::length(p.velocity), std::sqrt(14.0f), 1e-5f);
+    EXPECT_NEAR(glm::dot(p.velocity, axis), glm::dot(Vec3(1, 2, 3), axis), 1e-5f);
+    const Vec3 across = Vec3(1, 2, 3) - glm::dot(Vec3(1, 2, 3), axis) * axis;
+    const Vec3 now = p.velocity - glm::dot(p.velocity, axis) * axis;
+    EXPECT_NEAR(glm::dot(glm::normalize(across), glm::normalize(now)), std::cos(0.5f), 1e-4f);
+  }
+}
+
 TEST(ElectricField, AcceleratesByChargeOverMassAndIgnoresZeroMass) {
   Context ctx = makeContext(0.1);
   Group& g = ctx.createGroup("g", 2);
