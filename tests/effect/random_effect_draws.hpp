@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "effect/descriptors.hpp"
+#include "flurry/transform.hpp"
 #include "sample_values.hpp"
 
 namespace flurry::test {
@@ -294,6 +295,32 @@ inline std::string randomPlacedEffect(std::uint32_t seed) {
   std::string fx = randomEffect(seed);
   if (seed % 2 == 0) fx.insert(1, R"("space": "local", )");
   return fx;
+}
+
+/// randomEffect drawn for a renderer: in hair mode (a strand every 1-3 steps, of at most
+/// 2-41 vertices) or with a trail of 1-20 positions, one or the other at random.
+inline std::string randomLookEffect(std::uint32_t seed) {
+  std::string fx = randomEffect(seed);
+  Draw d(seed * 131u + 7u);  // (its own draws: the effect is randomEffect's)
+  const std::string look =
+      d.below(2) ? R"("hair": {"every": )" + std::to_string(1 + d.below(3)) +
+                       R"(, "maxVertices": )" + std::to_string(2 + d.below(40)) + "}, "
+                 : R"("trail": {"length": )" + std::to_string(1 + d.below(20)) + "}, ";
+  const std::string group = R"({"name": "g", )";
+  fx.insert(fx.find(group) + group.size(), look);
+  return fx;
+}
+
+/// Where an instance of the effect drawn from `seed` stands before step `step`, placed anew
+/// before each as a game moves an effect with its owner: anywhere within 100 units, turned
+/// any way, scaled 0.5-2 (the same on every run).
+inline Transform randomPlacement(std::uint64_t seed, int step) {
+  Draw d(std::uint32_t(seed) * 977u + std::uint32_t(step));
+  const Vec3 axis(float(d.between(-1, 1)), float(d.between(0.1, 1)), float(d.between(-1, 1)));
+  return {
+      Vec3(float(d.between(-100, 100)), float(d.between(-100, 100)), float(d.between(-100, 100))),
+      glm::angleAxis(float(d.between(-3.2, 3.2)), glm::normalize(axis)),
+      float(d.between(0.5, 2.0))};
 }
 
 /// The seeds a test draws: [1, count], or FLURRY_RANDOM_EFFECTS="FIRST-LAST" for a wider

@@ -21,7 +21,6 @@
 #include "step_checks.hpp"
 
 using namespace flurry;
-using test::Draw;
 
 namespace {
 
@@ -50,14 +49,7 @@ std::vector<std::uint32_t> run(const Effect& fx, unsigned threads, int steps, bo
   for (int s = 0; s < steps; ++s) {
     try {
       if (moved) {
-        // Placed anew before each step, as a game moves an effect with its owner: anywhere
-        // within 100 units, turned any way, scaled 0.5-2 (the same on every run).
-        Draw d(std::uint32_t(fx.seed) * 977u + std::uint32_t(s));
-        const Vec3 axis(float(d.between(-1, 1)), float(d.between(0.1, 1)), float(d.between(-1, 1)));
-        instance.setTransform({Vec3(float(d.between(-100, 100)), float(d.between(-100, 100)),
-                                    float(d.between(-100, 100))),
-                               glm::angleAxis(float(d.between(-3.2, 3.2)), glm::normalize(axis)),
-                               float(d.between(0.5, 2.0))});
+        instance.setTransform(test::randomPlacement(fx.seed, s));
       }
       ctx.step();
     } catch (const Error&) {
