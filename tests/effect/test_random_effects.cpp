@@ -2,11 +2,12 @@
 // anywhere in its documented range (its ends, zero, huge and tiny values, infinity where the
 // field takes it), with random domains, integrators and step lengths; and emission of every
 // kind (bursts, paths, several types, births by distance, prime emitters three levels deep,
-// sub-emitters on death, collision and birth). Each is stepped on one and two threads:
-// whatever a valid file asks for, a step never crashes (the suite runs under AddressSanitizer
-// and UndefinedBehaviorSanitizer), keeps no particle that is not finite, never holds more than
-// its capacity, keeps a box that holds every particle, and gives the same particles bit for
-// bit on any thread count.
+// sub-emitters on death, collision and birth); as instances moved every step; in hair mode or
+// with trails. Each is stepped on one and two threads: whatever a valid file asks for, a step
+// never crashes (the suite runs under AddressSanitizer and UndefinedBehaviorSanitizer), keeps
+// no particle that is not finite, never holds more than its capacity, keeps a box that holds
+// every particle, and gives the same particles (and strands and trails) bit for bit on any
+// thread count.
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -48,9 +49,7 @@ std::vector<std::uint32_t> run(const Effect& fx, unsigned threads, int steps, bo
   std::vector<std::uint32_t> bits;
   for (int s = 0; s < steps; ++s) {
     try {
-      if (moved) {
-        instance.setTransform(test::randomPlacement(fx.seed, s));
-      }
+      if (moved) instance.setTransform(test::randomPlacement(fx.seed, s));
       ctx.step();
     } catch (const Error&) {
       refused = true;
@@ -58,15 +57,22 @@ std::vector<std::uint32_t> run(const Effect& fx, unsigned threads, int steps, bo
     }
     if (!test::stepLeftGroupsSound(groups, s)) return bits;
   }
-  for (const Group* g : groups)
+  auto put = [&](Vec3 v) {
+    for (int c = 0; c < 3; ++c) bits.push_back(std::bit_cast<std::uint32_t>(v[c]));
+  };
+  for (const Group* g : groups) {
+    std::vector<Vec3> trail(g->trail().length);
     for (std::size_t i = 0; i < g->size(); ++i) {
       const Particle p = g->particle(i);
       bits.push_back(p.id);
-      for (int c = 0; c < 3; ++c) {
-        bits.push_back(std::bit_cast<std::uint32_t>(p.position[c]));
-        bits.push_back(std::bit_cast<std::uint32_t>(p.velocity[c]));
-      }
+      put(p.position);
+      put(p.velocity);
+      if (!trail.empty())
+        for (std::size_t j = 0, n = g->trail(i, trail); j < n; ++j) put(trail[j]);
     }
+    for (const Vec3& v : g->strands().position) put(v);  // (hair mode)
+    bits.insert(bits.end(), g->strands().start.begin(), g->strands().start.end());
+  }
   return bits;
 }
 
@@ -114,4 +120,8 @@ TEST(RandomEffects, EmissionOfEveryKindStepsSafelyAndAlike) {
 
 TEST(RandomEffects, InstancesMovedEveryStepStepSafelyAndAlike) {
   stepDraws(test::randomPlacedEffect, 200, true);
+}
+
+TEST(RandomEffects, HairAndTrailsStepSafelyAndAlike) {
+  stepDraws(test::randomLookEffect, 200);
 }
