@@ -125,3 +125,40 @@ TEST(RandomEffects, InstancesMovedEveryStepStepSafelyAndAlike) {
 TEST(RandomEffects, HairAndTrailsStepSafelyAndAlike) {
   stepDraws(test::randomLookEffect, 200);
 }
+
+// saveEffect writes what parseEffect reads back to the same effect, for every kind drawn:
+// the text once more the same, and the same particles (and strands and trails) bit for bit.
+TEST(RandomEffects, SaveAndLoadGiveTheSameEffect) {
+  int saved = 0;
+  for (auto make : {test::randomEffect, test::randomEmission, test::randomPlacedEffect,
+                    test::randomLookEffect}) {
+    const auto [first, last] = test::seeds(100);
+    for (std::uint32_t seed = first; seed <= last; ++seed) {
+      const std::string text = make(seed);
+      SCOPED_TRACE("seed " + std::to_string(seed) + ":\n" + text);
+      Effect fx;
+      try {
+        fx = parseEffect(text, "random.json");
+      } catch (const EffectError&) {
+        continue;
+      }
+      const std::string once = saveEffect(fx);
+      Effect back;
+      try {
+        back = parseEffect(once, "saved.json");
+      } catch (const EffectError& e) {
+        FAIL() << "the saved effect does not load: " << e.what() << "\n" << once;
+      }
+      ASSERT_EQ(saveEffect(back), once);
+      bool refusedA = false, refusedB = false;
+      const bool moved = make == test::randomPlacedEffect;
+      ASSERT_TRUE(run(fx, 1, 10, refusedA, moved) == run(back, 1, 10, refusedB, moved))
+          << "the saved effect steps otherwise\n"
+          << once;
+      ASSERT_EQ(refusedA, refusedB);
+      ++saved;
+    }
+  }
+  EXPECT_GT(saved, 200);
+  std::printf("%d drawn effects saved, loaded back and stepped alike\n", saved);
+}
