@@ -162,3 +162,52 @@ TEST(RandomEffects, SaveAndLoadGiveTheSameEffect) {
   EXPECT_GT(saved, 200);
   std::printf("%d drawn effects saved, loaded back and stepped alike\n", saved);
 }
+
+// Context::prewarm's promise, for every kind drawn: an instance prewarmed by n steps' time
+// holds the particles of one stepped n times by hand, bit for bit, and goes on alike.
+TEST(RandomEffects, PrewarmIsSteppingByHand) {
+  int compared = 0;
+  auto bitsOf = [](const std::vector<Group*>& groups) {
+    std::vector<std::uint32_t> bits;
+    for (const Group* g : groups)
+      for (std::size_t i = 0; i < g->size(); ++i) {
+        const Particle p = g->particle(i);
+        bits.push_back(p.id);
+        for (int c = 0; c < 3; ++c) {
+          bits.push_back(std::bit_cast<std::uint32_t>(p.position[c]));
+          bits.push_back(std::bit_cast<std::uint32_t>(p.velocity[c]));
+        }
+      }
+    return bits;
+  };
+  for (auto make : {test::randomEffect, test::randomEmission}) {
+    const auto [first, last] = test::seeds(100);
+    for (std::uint32_t seed = first; seed <= last; ++seed) {
+      const std::string text = make(seed);
+      SCOPED_TRACE("seed " + std::to_string(seed) + ":\n" + text);
+      Effect fx;
+      try {
+        fx = parseEffect(text, "random.json");
+      } catch (const EffectError&) {
+        continue;
+      }
+      const int n = 1 + int(seed % 12);
+      try {
+        Context byHand({.seed = fx.seed, .dt = fx.dt, .threads = 1}),
+            warm({.seed = fx.seed, .dt = fx.dt, .threads = 1});
+        EffectInstance a = fx.instantiate(byHand, "a"), b = fx.instantiate(warm, "a");
+        byHand.run(std::size_t(n));
+        ASSERT_EQ(b.prewarm(double(n) * fx.dt), std::uint64_t(n));
+        ASSERT_TRUE(bitsOf(a.groups()) == bitsOf(b.groups())) << "after the prewarm";
+        byHand.run(5);
+        warm.run(5);
+        ASSERT_TRUE(bitsOf(a.groups()) == bitsOf(b.groups())) << "five steps later";
+        ++compared;
+      } catch (const Error&) {
+        continue;  // a step refused it (the other tests check that it is refused alike)
+      }
+    }
+  }
+  EXPECT_GT(compared, 100);
+  std::printf("%d drawn effects prewarmed as stepped by hand\n", compared);
+}
