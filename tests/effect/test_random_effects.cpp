@@ -211,3 +211,81 @@ TEST(RandomEffects, PrewarmIsSteppingByHand) {
   EXPECT_GT(compared, 100);
   std::printf("%d drawn effects prewarmed as stepped by hand\n", compared);
 }
+
+// A game's budget over random effects (actions, emission, hair and trails): three instances
+// of each drawn effect share a context budget (50-549 particles), each group under a policy
+// drawn at random. After every step the groups together hold at most the budget, every group
+// accounts for each particle it emitted (GroupStats: emitted == size + killedByAge + absorbed
+// + droppedAtCapacity + droppedAtBudget + killedByBudget + killedNonFinite), and the
+// particles are bitwise the same on 1 and 2 threads.
+TEST(RandomEffects, UnderABudgetEveryParticleIsAccountedFor) {
+  int stepped = 0;
+  const auto [first, last] = test::seeds(100);
+  for (auto make : {test::randomEffect, test::randomEmission, test::randomLookEffect}) {
+    for (std::uint32_t seed = first; seed <= last; ++seed) {
+      const std::string text = make(seed);
+      SCOPED_TRACE("seed " + std::to_string(seed) + ":\n" + text);
+      Effect fx;
+      try {
+        fx = parseEffect(text, "random.json");
+      } catch (const EffectError&) {
+        continue;
+      }
+      test::Draw d(seed * 7919u + 3u);
+      const std::size_t budget = 50 + std::size_t(d.below(500));
+      std::vector<BudgetPolicy> policies;
+      for (int k = 0; k < 3 * int(fx.groups.size()); ++k)
+        policies.push_back(BudgetPolicy(d.below(3)));
+      auto run = [&](unsigned threads, bool& refused) {
+        std::vector<std::uint32_t> bits;
+        refused = false;
+        try {
+          Context ctx({.seed = fx.seed, .dt = fx.dt, .threads = threads});
+          ctx.setParticleBudget(budget);
+          std::vector<Group*> groups;
+          for (int k = 0; k < 3; ++k) {
+            const EffectInstance instance = fx.instantiate(ctx, std::to_string(k));
+            for (Group* g : instance.groups()) {
+              g->setBudgetPolicy(policies[groups.size()]);
+              groups.push_back(g);
+            }
+          }
+          for (int s = 0; s < 15; ++s) {
+            ctx.step();
+            std::size_t alive = 0;
+            for (const Group* g : groups) {
+              alive += g->size();
+              const GroupStats& st = g->stats();
+              EXPECT_EQ(st.emitted, g->size() + st.killedByAge + st.absorbed +
+                                        st.droppedAtCapacity + st.droppedAtBudget +
+                                        st.killedByBudget + st.killedNonFinite)
+                  << g->name() << ", step " << s;
+            }
+            EXPECT_LE(alive, budget) << "step " << s;
+            if (::testing::Test::HasFailure()) return bits;
+          }
+          for (const Group* g : groups)
+            for (std::size_t i = 0; i < g->size(); ++i) {
+              const Particle p = g->particle(i);
+              bits.push_back(p.id);
+              for (int c = 0; c < 3; ++c)
+                bits.push_back(std::bit_cast<std::uint32_t>(p.position[c]));
+            }
+        } catch (const Error&) {
+          refused = true;
+        }
+        return bits;
+      };
+      bool refused1 = false, refused2 = false;
+      const auto one = run(1, refused1);
+      if (::testing::Test::HasFailure()) return;
+      const auto two = run(2, refused2);
+      if (::testing::Test::HasFailure()) return;
+      ASSERT_EQ(refused1, refused2);
+      ASSERT_TRUE(one == two) << "1 thread and 2 differ";
+      stepped += !refused1;
+    }
+  }
+  EXPECT_GT(stepped, 100);
+  std::printf("%d drawn effects stepped under a budget\n", stepped);
+}
