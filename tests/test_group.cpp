@@ -1998,6 +1998,31 @@ TEST(Instance, StopKillAndDone) {
   }
 }
 
+// A burst begun before its emitter starts, killed between the two: none of its occurrences
+// fires after (the one at the start did: the emitter's stop became its start), and the
+// instance is done (a stop that fell between two occurrences kept done() false for ever).
+TEST(Instance, AKilledBurstNeverFiresAndItsInstanceIsDone) {
+  const Effect fx = parseEffect(R"({"name": "late", "dt": 0.1,
+    "groups": [{"name": "g", "capacity": 100,
+      "emitters": [{"start": 1, "bursts": [{"time": -1, "count": 5, "interval": 1, "repeat": 5}],
+                    "types": [{"lifetime": 0.5}]}],
+      "actions": [{"type": "Move"}, {"type": "KillOld"}]}]})");
+  Context ctx(fx.contextOptions());
+  EffectInstance a = fx.instantiate(ctx, "a"), b = fx.instantiate(ctx, "b");
+  ctx.run(5);  // 0.5 s: neither has emitted (the first occurrence due is at its start, 1 s)
+  a.kill();
+  b.stop();
+  EXPECT_TRUE(a.done());
+  EXPECT_TRUE(b.done());
+  ctx.run(30);
+  EXPECT_EQ(a.groups()[0]->stats().emitted, 0u);
+  EXPECT_EQ(b.groups()[0]->stats().emitted, 0u);
+  // Not stopped, it fires at 1, 2 and 3 s.
+  EffectInstance c = fx.instantiate(ctx, "c");
+  ctx.run(35);
+  EXPECT_EQ(c.groups()[0]->stats().emitted, 15u);
+}
+
 // restart() starts an instance over: everything removed, its emitters and Explosion as built
 // (the stop undone), their times from now: it emits step for step as an instance made then.
 TEST(Instance, RestartStartsItOverFromNow) {

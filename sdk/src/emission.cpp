@@ -321,11 +321,16 @@ bool mayFire(double rate, const std::vector<Burst>& bursts, double start, double
   }
   const double lo = std::max(t0, start);
   for (const Burst& b : bursts) {
-    if (b.count == 0 || b.repeat == 0) continue;
-    const double last = b.time + double(b.repeat - 1) * b.interval;
-    if (!(std::max(b.time, last) < lo) && !(std::min(b.time, last) >= t1) && !(lo > stop) &&
-        !(std::min(b.time, last) > stop))
-      return true;
+    if (b.count == 0) continue;
+    // planEmitter's occurrences: those in [lo, t1) and not after the stop. (Whether the
+    // burst's first and last occurrences bracket them is not enough: a burst begun before a
+    // stop() that fell between two of its occurrences kept its instance from ever being
+    // done().)
+    const auto at = [&](std::uint64_t r) { return b.time + double(r) * b.interval; };
+    const std::uint64_t r0 = firstWhere(b.repeat, [&](std::uint64_t r) { return at(r) >= lo; });
+    const std::uint64_t r1 =
+        firstWhere(b.repeat, [&](std::uint64_t r) { return at(r) >= t1 || at(r) > stop; });
+    if (r0 < r1) return true;
   }
   return spacing > 0 && std::min(t1, stop) > lo;
 }
@@ -355,11 +360,17 @@ bool mayEverEmit(const GroupImpl& g, double at) {
 
 void stopEmitting(GroupImpl& g, double at, bool showers) {
   // Just before `at`, as a burst at `stop` itself still fires (one an instance made this
-  // frame has at `at`); never before the start, and bursts not yet begun are dropped.
+  // frame has at `at`); never before the start, and burst occurrences not yet due are
+  // dropped.
   const double before = std::nextafter(at, -std::numeric_limits<double>::infinity());
   auto stop = [&](auto& e) {
     e.stop = std::max(e.start, std::min(e.stop, before));
-    std::erase_if(e.bursts, [&](const Burst& b) { return b.time >= at; });
+    // A burst keeps only its occurrences before `at`: one begun before an emitter that has
+    // not started (its stop then is its start) still fired at the start.
+    for (Burst& b : e.bursts)
+      b.repeat = std::uint32_t(firstWhere(
+          b.repeat, [&](std::uint64_t r) { return b.time + double(r) * b.interval >= at; }));
+    std::erase_if(e.bursts, [](const Burst& b) { return b.repeat == 0; });
   };
   for (Emitter& e : g.emitters) stop(e);
   for (PrimeEmitter& p : g.primes) stop(p);

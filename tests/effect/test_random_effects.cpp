@@ -289,3 +289,62 @@ TEST(RandomEffects, UnderABudgetEveryParticleIsAccountedFor) {
   EXPECT_GT(stepped, 100);
   std::printf("%d drawn effects stepped under a budget\n", stepped);
 }
+
+// What a game relies on to retire one-shot effects, for random effects of every kind: an
+// instance killed has nothing alive and nothing born after (showers and sub-emitters
+// included); one stopped lives out its particles, and once done() it stays empty and never
+// emits again.
+TEST(RandomEffects, KilledAndStoppedInstancesStayDone) {
+  int killed = 0, finished = 0;
+  const auto [first, last] = test::seeds(100);
+  for (auto make : {test::randomEffect, test::randomEmission, test::randomLookEffect}) {
+    for (std::uint32_t seed = first; seed <= last; ++seed) {
+      const std::string text = make(seed);
+      SCOPED_TRACE("seed " + std::to_string(seed) + ":\n" + text);
+      Effect fx;
+      try {
+        fx = parseEffect(text, "random.json");
+      } catch (const EffectError&) {
+        continue;
+      }
+      auto emitted = [](const EffectInstance& fxi) {
+        std::uint64_t n = 0;
+        for (const Group* g : fxi.groups()) n += g->stats().emitted;
+        return n;
+      };
+      auto alive = [](const EffectInstance& fxi) {
+        std::size_t n = 0;
+        for (const Group* g : fxi.groups()) n += g->size();
+        return n;
+      };
+      try {
+        Context ctx({.seed = fx.seed, .dt = fx.dt, .threads = 1});
+        EffectInstance a = fx.instantiate(ctx, "a"), b = fx.instantiate(ctx, "b");
+        ctx.run(1 + seed % 10);
+        a.kill();
+        EXPECT_EQ(alive(a), 0u);
+        const std::uint64_t was = emitted(a);
+        ctx.run(3);
+        EXPECT_EQ(alive(a), 0u) << "after kill()";
+        EXPECT_EQ(emitted(a), was) << "born after kill()";
+        EXPECT_TRUE(a.done());
+        ++killed;
+        b.stop();
+        for (int s = 0; s < 300 && !b.done(); ++s) ctx.step();
+        if (!b.done()) continue;  // (long lives)
+        const std::uint64_t at = emitted(b);
+        ctx.run(20);
+        EXPECT_EQ(alive(b), 0u) << "alive again after done()";
+        EXPECT_EQ(emitted(b), at) << "born after done()";
+        EXPECT_TRUE(b.done());
+        ++finished;
+      } catch (const Error&) {
+        continue;  // a step refused it (the other tests check that it is refused alike)
+      }
+      if (::testing::Test::HasFailure()) return;
+    }
+  }
+  EXPECT_GT(killed, 100);
+  EXPECT_GT(finished, 50);
+  std::printf("%d drawn effects killed, %d stopped and done, and stayed so\n", killed, finished);
+}
