@@ -149,3 +149,61 @@ TEST(OpenCLRandomEffects, InstancesMovedEveryStepStepSafelyAndLikeTheCpu) {
 TEST(OpenCLRandomEffects, HairAndTrailsLikeTheCpu) {
   stepDraws(test::randomLookEffect, 8, false, 24);
 }
+
+// A game's one-shot effects on the device: of two instances of each drawn effect, one killed
+// and one stopped a few steps in, then stepped on until both are done (at most 40 steps):
+// done() at the same steps, and the same particles and counts, as on the CPU.
+TEST(OpenCLRandomEffects, KilledAndStoppedLikeTheCpu) {
+  FLURRY_REQUIRE_OPENCL();
+  int compared = 0;
+  for (auto make : {test::randomEffect, test::randomEmission}) {
+    const auto [first, last] = test::seeds(8);
+    for (std::uint32_t seed = first; seed <= last; ++seed) {
+      const std::string text = make(seed);
+      SCOPED_TRACE("seed " + std::to_string(seed) + ":\n" + text);
+      Effect fx;
+      try {
+        fx = parseEffect(text, "random.json");
+      } catch (const EffectError&) {
+        continue;
+      }
+      struct Run {
+        bool refused = false;
+        std::vector<int> done;  // per step: 1 + 2 * b.done() when a.done()
+        std::vector<test::RunResult> groups;
+      };
+      auto run = [&](Backend backend) {
+        Run out;
+        try {
+          Context ctx({.seed = fx.seed, .dt = fx.dt, .threads = 2, .backend = backend});
+          EffectInstance a = fx.instantiate(ctx, "a"), b = fx.instantiate(ctx, "b");
+          ctx.run(1 + seed % 5);
+          a.kill();
+          b.stop();
+          for (int s = 0; s < 40; ++s) {
+            out.done.push_back(int(a.done()) + 2 * int(b.done()));
+            if (a.done() && b.done()) break;
+            ctx.step();
+          }
+          for (const EffectInstance* fxi : {&a, &b})
+            for (const Group* g : fxi->groups()) out.groups.push_back(test::resultOf(*g));
+        } catch (const Error&) {
+          out.refused = true;
+        }
+        return out;
+      };
+      const Run cpu = run(Backend::Cpu);
+      if (cpu.refused) continue;
+      const Run cl = run(Backend::OpenCL);
+      ASSERT_FALSE(cl.refused);
+      EXPECT_EQ(cpu.done, cl.done);
+      ASSERT_EQ(cpu.groups.size(), cl.groups.size());
+      for (std::size_t k = 0; k < cpu.groups.size(); ++k)
+        test::expectSame(cpu.groups[k], cl.groups[k]);
+      if (::testing::Test::HasFailure()) return;
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 0);
+  std::printf("%d drawn effects killed and stopped alike on both backends\n", compared);
+}
