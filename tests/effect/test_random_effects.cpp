@@ -404,3 +404,143 @@ TEST(RandomEffects, DestroyingAnInstanceLeavesTheOthersAsTheyWere) {
   EXPECT_GT(compared, 100);
   std::printf("%d drawn effects: the others untouched by a destroyed instance\n", compared);
 }
+
+// A game edits its effects between steps: each step, now and then, one edit drawn at random
+// (another action list, an emitter removed, added or edited through its span, a time scale,
+// an update interval, a seed, a transform, a space, a clear, events recorded, a trail, more
+// attributes stored, a particle added). Whatever the edits, every step is sound
+// (stepLeftGroupsSound) and the particles, strands and trails are bitwise the same on 1 and
+// 2 threads. An edit a group refuses throws InvalidArgument, which is fine.
+TEST(RandomEffects, EditsBetweenStepsStaySafeAndAlike) {
+  int stepped = 0;
+  const auto [first, last] = test::seeds(100);
+  for (auto make : {test::randomEffect, test::randomEmission, test::randomLookEffect}) {
+    for (std::uint32_t seed = first; seed <= last; ++seed) {
+      const std::string text = make(seed);
+      SCOPED_TRACE("seed " + std::to_string(seed) + ":\n" + text);
+      Effect fx, other, source;
+      try {
+        fx = parseEffect(text, "random.json");
+      } catch (const EffectError&) {
+        continue;
+      }
+      // What the edits put in: another draw's action list (none that reads every pair of
+      // particles: put on a group that holds thousands, it would take minutes) and emitter.
+      for (std::uint32_t k = 1; k < 50 && other.groups.empty(); ++k) try {
+          other = parseEffect(test::randomEffect(seed + 7919u * k), "other.json");
+          if (other.groups[0].actions.readsNeighbours()) other = {};
+        } catch (const EffectError&) {
+        }
+      for (std::uint32_t k = 1; k < 50 && source.groups.empty(); ++k) try {
+          source = parseEffect(test::randomEmission(seed + 104729u * k), "source.json");
+        } catch (const EffectError&) {
+        }
+      ASSERT_FALSE(other.groups.empty() || source.groups.empty());
+      // (At most ~2,000 alive, as the draws keep: some actions read every pair.)
+      Emitter added = source.groups[0].emitters.at(0);
+      added.rate = std::min(added.rate, 100.0);
+      for (ParticleType& t : added.types) t.lifetime = Fuzzy(0.3f);
+      auto run = [&](unsigned threads, bool& refused) {
+        std::vector<std::uint32_t> bits;
+        refused = false;
+        try {
+          Context ctx({.seed = fx.seed, .dt = fx.dt, .threads = threads});
+          EffectInstance instance = fx.instantiate(ctx, "x");
+          const std::vector<Group*>& groups = instance.groups();
+          test::Draw d(seed * 31u + 11u);
+          for (int s = 0; s < 20; ++s) {
+            Group& g = *groups[std::size_t(d.below(int(groups.size())))];
+            try {
+              switch (d.below(26)) {  // an edit about every other step
+                case 0:
+                  g.setActions(other.groups[0].actions);
+                  break;
+                case 1:
+                  if (!g.emitters().empty()) g.removeEmitter(0);
+                  break;
+                case 2:
+                  g.addEmitter(added);
+                  break;
+                case 3:
+                  if (!g.emitters().empty()) g.emitters()[0].rate *= 2.0f;
+                  break;
+                case 4: {
+                  const double scales[] = {0.0, 0.5, 2.0, 1.0};
+                  instance.setTimeScale(scales[d.below(4)]);
+                  break;
+                }
+                case 5:
+                  instance.setUpdateInterval(std::uint32_t(1 + d.below(4)));
+                  break;
+                case 6:
+                  instance.setSeed(std::uint64_t(d.below(1000)));
+                  break;
+                case 7:
+                  instance.setTransform(test::randomPlacement(seed, s));
+                  break;
+                case 8:
+                  g.setSpace(d.below(2) ? Space::Local : Space::World);
+                  break;
+                case 9:
+                  g.clear();
+                  break;
+                case 10:
+                  g.recordDeaths(std::size_t(d.below(16)));
+                  g.recordCollisions(std::size_t(d.below(16)));
+                  break;
+                case 11:
+                  g.setTrail({std::uint32_t(d.below(6))});
+                  break;
+                case 12:
+                  g.require({Attribute::Color, Attribute::Size, Attribute::Age});
+                  break;
+                case 13: {
+                  Particle p;
+                  p.position = Vec3(float(d.between(-5, 5)), float(d.between(-5, 5)), 0.0f);
+                  p.velocity = Vec3(0.0f, float(d.between(-5, 5)), 0.0f);
+                  g.add(p);
+                  break;
+                }
+                default:
+                  break;
+              }
+            } catch (const InvalidArgument&) {
+            }
+            ctx.step();
+            if (!test::stepLeftGroupsSound(groups, s)) return bits;
+          }
+          for (const Group* g : groups) {
+            std::vector<Vec3> trail(g->trail().length);
+            for (std::size_t i = 0; i < g->size(); ++i) {
+              const Particle p = g->particle(i);
+              bits.push_back(p.id);
+              for (int c = 0; c < 3; ++c) {
+                bits.push_back(std::bit_cast<std::uint32_t>(p.position[c]));
+                bits.push_back(std::bit_cast<std::uint32_t>(p.velocity[c]));
+              }
+              if (!trail.empty())
+                for (std::size_t j = 0, n = g->trail(i, trail); j < n; ++j)
+                  for (int c = 0; c < 3; ++c)
+                    bits.push_back(std::bit_cast<std::uint32_t>(trail[j][c]));
+            }
+            for (const Vec3& v : g->strands().position)
+              for (int c = 0; c < 3; ++c) bits.push_back(std::bit_cast<std::uint32_t>(v[c]));
+          }
+        } catch (const Error&) {
+          refused = true;
+        }
+        return bits;
+      };
+      bool refused1 = false, refused2 = false;
+      const auto one = run(1, refused1);
+      if (::testing::Test::HasFailure()) return;
+      const auto two = run(2, refused2);
+      if (::testing::Test::HasFailure()) return;
+      ASSERT_EQ(refused1, refused2);
+      ASSERT_TRUE(one == two) << "1 thread and 2 differ";
+      stepped += !refused1;
+    }
+  }
+  EXPECT_GT(stepped, 0.8 * double(last - first + 1));
+  std::printf("%d drawn effects edited between steps, alike on 1 and 2 threads\n", stepped);
+}
