@@ -7,9 +7,12 @@
 // (tests/opencl/test_opencl_random.cpp).
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <initializer_list>
 #include <random>
 #include <string>
 #include <type_traits>
@@ -17,6 +20,7 @@
 #include <vector>
 
 #include "effect/descriptors.hpp"
+#include "flurry/effect.hpp"
 #include "flurry/transform.hpp"
 #include "sample_values.hpp"
 
@@ -331,6 +335,36 @@ inline std::pair<std::uint32_t, std::uint32_t> seeds(std::uint32_t count) {
   if (v && std::sscanf(v, "%u-%u", &first, &last) == 2 && first >= 1 && last >= first)
     return {first, last};
   return {1u, count};
+}
+
+/// A drawing function: randomEffect, randomEmission, randomPlacedEffect, randomLookEffect.
+using DrawEffect = std::string (*)(std::uint32_t);
+
+/// Calls fn(seed, draw, effect) for each seed of seeds(count), of each drawing function in
+/// `kinds`, whose effect loads (a combination the loader refuses is skipped: its tests check
+/// that), under a trace naming the seed and the text; returns at the first failure.
+template <class Fn>
+void forEachDrawnEffect(std::initializer_list<DrawEffect> kinds, std::uint32_t count, Fn fn) {
+  const auto [first, last] = seeds(count);
+  for (DrawEffect draw : kinds)
+    for (std::uint32_t seed = first; seed <= last; ++seed) {
+      const std::string text = draw(seed);
+      SCOPED_TRACE("seed " + std::to_string(seed) + ":\n" + text);
+      Effect fx;
+      try {
+        fx = parseEffect(text, "random.json");
+      } catch (const EffectError&) {
+        continue;
+      }
+      fn(seed, draw, fx);
+      if (::testing::Test::HasFailure()) return;
+    }
+}
+
+/// How many seeds a test draws of each kind: seeds(count)'s.
+inline double seedCount(std::uint32_t count) {
+  const auto [first, last] = seeds(count);
+  return double(last - first + 1);
 }
 
 }  // namespace flurry::test

@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include "flurry/flurry.hpp"
@@ -33,6 +35,29 @@ inline bool stepLeftGroupsSound(const std::vector<Group*>& groups, int step) {
     }
   }
   return true;
+}
+
+/// The groups' particles (id, position, velocity, trail), then their strands, as words: what
+/// the tests compare bit for bit.
+inline std::vector<std::uint32_t> bitsOf(const std::vector<Group*>& groups) {
+  std::vector<std::uint32_t> bits;
+  auto put = [&](Vec3 v) {
+    for (int c = 0; c < 3; ++c) bits.push_back(std::bit_cast<std::uint32_t>(v[c]));
+  };
+  for (const Group* g : groups) {
+    std::vector<Vec3> trail(g->trail().length);
+    for (std::size_t i = 0; i < g->size(); ++i) {
+      const Particle p = g->particle(i);
+      bits.push_back(p.id);
+      put(p.position);
+      put(p.velocity);
+      if (!trail.empty())
+        for (std::size_t j = 0, n = g->trail(i, trail); j < n; ++j) put(trail[j]);
+    }
+    for (const Vec3& v : g->strands().position) put(v);  // (hair mode)
+    bits.insert(bits.end(), g->strands().start.begin(), g->strands().start.end());
+  }
+  return bits;
 }
 
 }  // namespace flurry::test

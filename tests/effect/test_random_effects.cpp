@@ -10,7 +10,6 @@
 // thread count.
 #include <gtest/gtest.h>
 
-#include <bit>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -46,7 +45,6 @@ std::vector<std::uint32_t> run(const Effect& fx, unsigned threads, int steps, bo
     return {};
   }
   for (Group* g : groups) (void)g->bounds();  // kept by the passes from now on
-  std::vector<std::uint32_t> bits;
   for (int s = 0; s < steps; ++s) {
     try {
       if (moved) instance.setTransform(test::randomPlacement(fx.seed, s));
@@ -55,54 +53,28 @@ std::vector<std::uint32_t> run(const Effect& fx, unsigned threads, int steps, bo
       refused = true;
       return {};
     }
-    if (!test::stepLeftGroupsSound(groups, s)) return bits;
+    if (!test::stepLeftGroupsSound(groups, s)) return {};
   }
-  auto put = [&](Vec3 v) {
-    for (int c = 0; c < 3; ++c) bits.push_back(std::bit_cast<std::uint32_t>(v[c]));
-  };
-  for (const Group* g : groups) {
-    std::vector<Vec3> trail(g->trail().length);
-    for (std::size_t i = 0; i < g->size(); ++i) {
-      const Particle p = g->particle(i);
-      bits.push_back(p.id);
-      put(p.position);
-      put(p.velocity);
-      if (!trail.empty())
-        for (std::size_t j = 0, n = g->trail(i, trail); j < n; ++j) put(trail[j]);
-    }
-    for (const Vec3& v : g->strands().position) put(v);  // (hair mode)
-    bits.insert(bits.end(), g->strands().start.begin(), g->strands().start.end());
-  }
-  return bits;
+  return test::bitsOf(groups);
 }
 
 /// Draws effects with `make` from the seeds (seeds(count)), and steps each that loads on one
 /// and on two threads (run: checked every step; `moved`: as an instance placed anew before
 /// each step), their particles compared bit for bit.
-void stepDraws(std::string (*make)(std::uint32_t), std::uint32_t count, bool moved = false) {
+void stepDraws(test::DrawEffect draw, std::uint32_t count, bool moved = false) {
   int loaded = 0, stepped = 0;
-  const auto [first, last] = test::seeds(count);
-  for (std::uint32_t seed = first; seed <= last; ++seed) {
-    const std::string text = make(seed);
-    SCOPED_TRACE("seed " + std::to_string(seed) + ":\n" + text);
-    Effect fx;
-    try {
-      fx = parseEffect(text, "random.json");
-    } catch (const EffectError&) {
-      continue;  // a combination the loader refuses (named: the loader's tests check that)
-    }
+  test::forEachDrawnEffect({draw}, count, [&](std::uint32_t, test::DrawEffect, const Effect& fx) {
     ++loaded;
     bool refused1 = false, refused2 = false;
     const auto one = run(fx, 1, 25, refused1, moved);
     const auto two = run(fx, 2, 25, refused2, moved);
     ASSERT_EQ(refused1, refused2);
-    if (refused1) continue;
+    if (refused1) return;
     ++stepped;
     ASSERT_TRUE(one == two) << "1 thread and 2 differ";
-    if (::testing::Test::HasFailure()) return;
-  }
+  });
   // Most draws must load and step, or the test would check little.
-  const double drawn = double(last - first + 1);
+  const double drawn = test::seedCount(count);
   EXPECT_GT(loaded, 0.5 * drawn);
   EXPECT_GT(stepped, 0.4 * drawn);
   std::printf("%d of %.0f drawn effects loaded, %d stepped\n", loaded, drawn, stepped);
@@ -130,36 +102,26 @@ TEST(RandomEffects, HairAndTrailsStepSafelyAndAlike) {
 // the text once more the same, and the same particles (and strands and trails) bit for bit.
 TEST(RandomEffects, SaveAndLoadGiveTheSameEffect) {
   int saved = 0;
-  const auto [first, last] = test::seeds(100);
-  for (auto make : {test::randomEffect, test::randomEmission, test::randomPlacedEffect,
-                    test::randomLookEffect}) {
-    for (std::uint32_t seed = first; seed <= last; ++seed) {
-      const std::string text = make(seed);
-      SCOPED_TRACE("seed " + std::to_string(seed) + ":\n" + text);
-      Effect fx;
-      try {
-        fx = parseEffect(text, "random.json");
-      } catch (const EffectError&) {
-        continue;
-      }
-      const std::string once = saveEffect(fx);
-      Effect back;
-      try {
-        back = parseEffect(once, "saved.json");
-      } catch (const EffectError& e) {
-        FAIL() << "the saved effect does not load: " << e.what() << "\n" << once;
-      }
-      ASSERT_EQ(saveEffect(back), once);
-      bool refusedA = false, refusedB = false;
-      const bool moved = make == test::randomPlacedEffect;
-      ASSERT_TRUE(run(fx, 1, 10, refusedA, moved) == run(back, 1, 10, refusedB, moved))
-          << "the saved effect steps otherwise\n"
-          << once;
-      ASSERT_EQ(refusedA, refusedB);
-      ++saved;
-    }
-  }
-  EXPECT_GT(saved, 2.0 * double(last - first + 1));
+  test::forEachDrawnEffect(
+      {test::randomEffect, test::randomEmission, test::randomPlacedEffect, test::randomLookEffect},
+      100, [&](std::uint32_t, test::DrawEffect draw, const Effect& fx) {
+        const std::string once = saveEffect(fx);
+        Effect back;
+        try {
+          back = parseEffect(once, "saved.json");
+        } catch (const EffectError& e) {
+          FAIL() << "the saved effect does not load: " << e.what() << "\n" << once;
+        }
+        ASSERT_EQ(saveEffect(back), once);
+        bool refusedA = false, refusedB = false;
+        const bool moved = draw == test::randomPlacedEffect;
+        ASSERT_TRUE(run(fx, 1, 10, refusedA, moved) == run(back, 1, 10, refusedB, moved))
+            << "the saved effect steps otherwise\n"
+            << once;
+        ASSERT_EQ(refusedA, refusedB);
+        ++saved;
+      });
+  EXPECT_GT(saved, 2.0 * test::seedCount(100));
   std::printf("%d drawn effects saved, loaded back and stepped alike\n", saved);
 }
 
@@ -167,48 +129,26 @@ TEST(RandomEffects, SaveAndLoadGiveTheSameEffect) {
 // holds the particles of one stepped n times by hand, bit for bit, and goes on alike.
 TEST(RandomEffects, PrewarmIsSteppingByHand) {
   int compared = 0;
-  auto bitsOf = [](const std::vector<Group*>& groups) {
-    std::vector<std::uint32_t> bits;
-    for (const Group* g : groups)
-      for (std::size_t i = 0; i < g->size(); ++i) {
-        const Particle p = g->particle(i);
-        bits.push_back(p.id);
-        for (int c = 0; c < 3; ++c) {
-          bits.push_back(std::bit_cast<std::uint32_t>(p.position[c]));
-          bits.push_back(std::bit_cast<std::uint32_t>(p.velocity[c]));
+  test::forEachDrawnEffect(
+      {test::randomEffect, test::randomEmission}, 100,
+      [&](std::uint32_t seed, test::DrawEffect, const Effect& fx) {
+        const int n = 1 + int(seed % 12);
+        try {
+          Context byHand({.seed = fx.seed, .dt = fx.dt, .threads = 1}),
+              warm({.seed = fx.seed, .dt = fx.dt, .threads = 1});
+          EffectInstance a = fx.instantiate(byHand, "a"), b = fx.instantiate(warm, "a");
+          byHand.run(std::size_t(n));
+          ASSERT_EQ(b.prewarm(double(n) * fx.dt), std::uint64_t(n));
+          ASSERT_TRUE(test::bitsOf(a.groups()) == test::bitsOf(b.groups())) << "after the prewarm";
+          byHand.run(5);
+          warm.run(5);
+          ASSERT_TRUE(test::bitsOf(a.groups()) == test::bitsOf(b.groups())) << "five steps later";
+          ++compared;
+        } catch (const Error&) {
+          // a step refused it (the other tests check that it is refused alike)
         }
-      }
-    return bits;
-  };
-  const auto [first, last] = test::seeds(100);
-  for (auto make : {test::randomEffect, test::randomEmission}) {
-    for (std::uint32_t seed = first; seed <= last; ++seed) {
-      const std::string text = make(seed);
-      SCOPED_TRACE("seed " + std::to_string(seed) + ":\n" + text);
-      Effect fx;
-      try {
-        fx = parseEffect(text, "random.json");
-      } catch (const EffectError&) {
-        continue;
-      }
-      const int n = 1 + int(seed % 12);
-      try {
-        Context byHand({.seed = fx.seed, .dt = fx.dt, .threads = 1}),
-            warm({.seed = fx.seed, .dt = fx.dt, .threads = 1});
-        EffectInstance a = fx.instantiate(byHand, "a"), b = fx.instantiate(warm, "a");
-        byHand.run(std::size_t(n));
-        ASSERT_EQ(b.prewarm(double(n) * fx.dt), std::uint64_t(n));
-        ASSERT_TRUE(bitsOf(a.groups()) == bitsOf(b.groups())) << "after the prewarm";
-        byHand.run(5);
-        warm.run(5);
-        ASSERT_TRUE(bitsOf(a.groups()) == bitsOf(b.groups())) << "five steps later";
-        ++compared;
-      } catch (const Error&) {
-        continue;  // a step refused it (the other tests check that it is refused alike)
-      }
-    }
-  }
-  EXPECT_GT(compared, double(last - first + 1));
+      });
+  EXPECT_GT(compared, test::seedCount(100));
   std::printf("%d drawn effects prewarmed as stepped by hand\n", compared);
 }
 
@@ -220,73 +160,56 @@ TEST(RandomEffects, PrewarmIsSteppingByHand) {
 // particles are bitwise the same on 1 and 2 threads.
 TEST(RandomEffects, UnderABudgetEveryParticleIsAccountedFor) {
   int stepped = 0;
-  const auto [first, last] = test::seeds(60);
-  for (auto make : {test::randomEffect, test::randomEmission, test::randomLookEffect}) {
-    for (std::uint32_t seed = first; seed <= last; ++seed) {
-      const std::string text = make(seed);
-      SCOPED_TRACE("seed " + std::to_string(seed) + ":\n" + text);
-      Effect fx;
-      try {
-        fx = parseEffect(text, "random.json");
-      } catch (const EffectError&) {
-        continue;
-      }
-      test::Draw d(seed * 7919u + 3u);
-      const std::size_t budget = 50 + std::size_t(d.below(500));
-      std::vector<BudgetPolicy> policies;
-      for (int k = 0; k < 3 * int(fx.groups.size()); ++k)
-        policies.push_back(BudgetPolicy(d.below(3)));
-      auto run = [&](unsigned threads, bool& refused) {
-        std::vector<std::uint32_t> bits;
-        refused = false;
-        try {
-          Context ctx({.seed = fx.seed, .dt = fx.dt, .threads = threads});
-          ctx.setParticleBudget(budget);
-          std::vector<Group*> groups;
-          for (int k = 0; k < 3; ++k) {
-            const EffectInstance instance = fx.instantiate(ctx, std::to_string(k));
-            for (Group* g : instance.groups()) {
-              g->setBudgetPolicy(policies[groups.size()]);
-              groups.push_back(g);
+  test::forEachDrawnEffect(
+      {test::randomEffect, test::randomEmission, test::randomLookEffect}, 60,
+      [&](std::uint32_t seed, test::DrawEffect, const Effect& fx) {
+        test::Draw d(seed * 7919u + 3u);
+        const std::size_t budget = 50 + std::size_t(d.below(500));
+        std::vector<BudgetPolicy> policies;
+        for (int k = 0; k < 3 * int(fx.groups.size()); ++k)
+          policies.push_back(BudgetPolicy(d.below(3)));
+        auto run = [&](unsigned threads, bool& refused) -> std::vector<std::uint32_t> {
+          refused = false;
+          try {
+            Context ctx({.seed = fx.seed, .dt = fx.dt, .threads = threads});
+            ctx.setParticleBudget(budget);
+            std::vector<Group*> groups;
+            for (int k = 0; k < 3; ++k) {
+              const EffectInstance instance = fx.instantiate(ctx, std::to_string(k));
+              for (Group* g : instance.groups()) {
+                g->setBudgetPolicy(policies[groups.size()]);
+                groups.push_back(g);
+              }
             }
+            for (int s = 0; s < 15; ++s) {
+              ctx.step();
+              std::size_t alive = 0;
+              for (const Group* g : groups) {
+                alive += g->size();
+                const GroupStats& st = g->stats();
+                EXPECT_EQ(st.emitted, g->size() + st.killedByAge + st.absorbed +
+                                          st.droppedAtCapacity + st.droppedAtBudget +
+                                          st.killedByBudget + st.killedNonFinite)
+                    << g->name() << ", step " << s;
+              }
+              EXPECT_LE(alive, budget) << "step " << s;
+              if (::testing::Test::HasFailure()) return {};
+            }
+            return test::bitsOf(groups);
+          } catch (const Error&) {
+            refused = true;
           }
-          for (int s = 0; s < 15; ++s) {
-            ctx.step();
-            std::size_t alive = 0;
-            for (const Group* g : groups) {
-              alive += g->size();
-              const GroupStats& st = g->stats();
-              EXPECT_EQ(st.emitted, g->size() + st.killedByAge + st.absorbed +
-                                        st.droppedAtCapacity + st.droppedAtBudget +
-                                        st.killedByBudget + st.killedNonFinite)
-                  << g->name() << ", step " << s;
-            }
-            EXPECT_LE(alive, budget) << "step " << s;
-            if (::testing::Test::HasFailure()) return bits;
-          }
-          for (const Group* g : groups)
-            for (std::size_t i = 0; i < g->size(); ++i) {
-              const Particle p = g->particle(i);
-              bits.push_back(p.id);
-              for (int c = 0; c < 3; ++c)
-                bits.push_back(std::bit_cast<std::uint32_t>(p.position[c]));
-            }
-        } catch (const Error&) {
-          refused = true;
-        }
-        return bits;
-      };
-      bool refused1 = false, refused2 = false;
-      const auto one = run(1, refused1);
-      if (::testing::Test::HasFailure()) return;
-      const auto two = run(2, refused2);
-      if (::testing::Test::HasFailure()) return;
-      ASSERT_EQ(refused1, refused2);
-      ASSERT_TRUE(one == two) << "1 thread and 2 differ";
-      stepped += !refused1;
-    }
-  }
-  EXPECT_GT(stepped, double(last - first + 1));
+          return {};
+        };
+        bool refused1 = false, refused2 = false;
+        const auto one = run(1, refused1);
+        if (::testing::Test::HasFailure()) return;
+        const auto two = run(2, refused2);
+        ASSERT_EQ(refused1, refused2);
+        ASSERT_TRUE(one == two) << "1 thread and 2 differ";
+        stepped += !refused1;
+      });
+  EXPECT_GT(stepped, test::seedCount(60));
   std::printf("%d drawn effects stepped under a budget\n", stepped);
 }
 
@@ -296,56 +219,46 @@ TEST(RandomEffects, UnderABudgetEveryParticleIsAccountedFor) {
 // emits again.
 TEST(RandomEffects, KilledAndStoppedInstancesStayDone) {
   int killed = 0, finished = 0;
-  const auto [first, last] = test::seeds(60);
-  for (auto make : {test::randomEffect, test::randomEmission, test::randomLookEffect}) {
-    for (std::uint32_t seed = first; seed <= last; ++seed) {
-      const std::string text = make(seed);
-      SCOPED_TRACE("seed " + std::to_string(seed) + ":\n" + text);
-      Effect fx;
-      try {
-        fx = parseEffect(text, "random.json");
-      } catch (const EffectError&) {
-        continue;
-      }
-      auto emitted = [](const EffectInstance& fxi) {
-        std::uint64_t n = 0;
-        for (const Group* g : fxi.groups()) n += g->stats().emitted;
-        return n;
-      };
-      auto alive = [](const EffectInstance& fxi) {
-        std::size_t n = 0;
-        for (const Group* g : fxi.groups()) n += g->size();
-        return n;
-      };
-      try {
-        Context ctx({.seed = fx.seed, .dt = fx.dt, .threads = 1});
-        EffectInstance a = fx.instantiate(ctx, "a"), b = fx.instantiate(ctx, "b");
-        ctx.run(1 + seed % 10);
-        a.kill();
-        EXPECT_EQ(alive(a), 0u);
-        const std::uint64_t was = emitted(a);
-        ctx.run(3);
-        EXPECT_EQ(alive(a), 0u) << "after kill()";
-        EXPECT_EQ(emitted(a), was) << "born after kill()";
-        EXPECT_TRUE(a.done());
-        ++killed;
-        b.stop();
-        for (int s = 0; s < 300 && !b.done(); ++s) ctx.step();
-        if (!b.done()) continue;  // (long lives)
-        const std::uint64_t at = emitted(b);
-        ctx.run(20);
-        EXPECT_EQ(alive(b), 0u) << "alive again after done()";
-        EXPECT_EQ(emitted(b), at) << "born after done()";
-        EXPECT_TRUE(b.done());
-        ++finished;
-      } catch (const Error&) {
-        continue;  // a step refused it (the other tests check that it is refused alike)
-      }
-      if (::testing::Test::HasFailure()) return;
-    }
-  }
-  EXPECT_GT(killed, double(last - first + 1));
-  EXPECT_GT(finished, 0.5 * double(last - first + 1));
+  auto emitted = [](const EffectInstance& fxi) {
+    std::uint64_t n = 0;
+    for (const Group* g : fxi.groups()) n += g->stats().emitted;
+    return n;
+  };
+  auto alive = [](const EffectInstance& fxi) {
+    std::size_t n = 0;
+    for (const Group* g : fxi.groups()) n += g->size();
+    return n;
+  };
+  test::forEachDrawnEffect({test::randomEffect, test::randomEmission, test::randomLookEffect}, 60,
+                           [&](std::uint32_t seed, test::DrawEffect, const Effect& fx) {
+                             try {
+                               Context ctx({.seed = fx.seed, .dt = fx.dt, .threads = 1});
+                               EffectInstance a = fx.instantiate(ctx, "a"),
+                                              b = fx.instantiate(ctx, "b");
+                               ctx.run(1 + seed % 10);
+                               a.kill();
+                               EXPECT_EQ(alive(a), 0u);
+                               const std::uint64_t was = emitted(a);
+                               ctx.run(3);
+                               EXPECT_EQ(alive(a), 0u) << "after kill()";
+                               EXPECT_EQ(emitted(a), was) << "born after kill()";
+                               EXPECT_TRUE(a.done());
+                               ++killed;
+                               b.stop();
+                               for (int s = 0; s < 300 && !b.done(); ++s) ctx.step();
+                               if (!b.done()) return;  // (long lives)
+                               const std::uint64_t at = emitted(b);
+                               ctx.run(20);
+                               EXPECT_EQ(alive(b), 0u) << "alive again after done()";
+                               EXPECT_EQ(emitted(b), at) << "born after done()";
+                               EXPECT_TRUE(b.done());
+                               ++finished;
+                             } catch (const Error&) {
+                               // a step refused it (the other tests check that it is refused alike)
+                             }
+                           });
+  EXPECT_GT(killed, test::seedCount(60));
+  EXPECT_GT(finished, 0.5 * test::seedCount(60));
   std::printf("%d drawn effects killed, %d stopped and done, and stayed so\n", killed, finished);
 }
 
@@ -354,54 +267,34 @@ TEST(RandomEffects, KilledAndStoppedInstancesStayDone) {
 // on 1 and 2 threads.
 TEST(RandomEffects, DestroyingAnInstanceLeavesTheOthersAsTheyWere) {
   int compared = 0;
-  const auto [first, last] = test::seeds(50);
-  for (auto make : {test::randomEffect, test::randomEmission, test::randomLookEffect}) {
-    for (std::uint32_t seed = first; seed <= last; ++seed) {
-      const std::string text = make(seed);
-      SCOPED_TRACE("seed " + std::to_string(seed) + ":\n" + text);
-      Effect fx;
-      try {
-        fx = parseEffect(text, "random.json");
-      } catch (const EffectError&) {
-        continue;
-      }
-      auto bitsOf = [](const EffectInstance& fxi) {
-        std::vector<std::uint32_t> bits;
-        for (const Group* g : fxi.groups()) {
-          for (std::size_t i = 0; i < g->size(); ++i) {
-            const Particle p = g->particle(i);
-            bits.push_back(p.id);
-            for (int c = 0; c < 3; ++c) bits.push_back(std::bit_cast<std::uint32_t>(p.position[c]));
-          }
-          for (const Vec3& v : g->strands().position)
-            for (int c = 0; c < 3; ++c) bits.push_back(std::bit_cast<std::uint32_t>(v[c]));
+  test::forEachDrawnEffect(
+      {test::randomEffect, test::randomEmission, test::randomLookEffect}, 50,
+      [&](std::uint32_t seed, test::DrawEffect, const Effect& fx) {
+        const unsigned threads = 1 + seed % 2;
+        const std::size_t before = 1 + seed % 7, after = 6;
+        try {
+          Context kept({.seed = fx.seed, .dt = fx.dt, .threads = threads}),
+              gone({.seed = fx.seed, .dt = fx.dt, .threads = threads});
+          EffectInstance a = fx.instantiate(kept, "a"), b = fx.instantiate(kept, "b"),
+                         c = fx.instantiate(kept, "c");
+          EffectInstance a2 = fx.instantiate(gone, "a"), b2 = fx.instantiate(gone, "b"),
+                         c2 = fx.instantiate(gone, "c");
+          kept.run(before);
+          gone.run(before);
+          b2.destroy();
+          EffectInstance d2 = fx.instantiate(gone, "d");  // b's place, and its random streams
+          kept.run(after);
+          gone.run(after);
+          ASSERT_TRUE(test::bitsOf(a.groups()) == test::bitsOf(a2.groups()))
+              << "the first instance changed";
+          ASSERT_TRUE(test::bitsOf(c.groups()) == test::bitsOf(c2.groups()))
+              << "the last instance changed";
+          ++compared;
+        } catch (const Error&) {
+          // a step refused it (the other tests check that it is refused alike)
         }
-        return bits;
-      };
-      const unsigned threads = 1 + seed % 2;
-      const int before = 1 + int(seed % 7), after = 6;
-      try {
-        Context kept({.seed = fx.seed, .dt = fx.dt, .threads = threads}),
-            gone({.seed = fx.seed, .dt = fx.dt, .threads = threads});
-        EffectInstance a = fx.instantiate(kept, "a"), b = fx.instantiate(kept, "b"),
-                       c = fx.instantiate(kept, "c");
-        EffectInstance a2 = fx.instantiate(gone, "a"), b2 = fx.instantiate(gone, "b"),
-                       c2 = fx.instantiate(gone, "c");
-        kept.run(std::size_t(before));
-        gone.run(std::size_t(before));
-        b2.destroy();
-        EffectInstance d2 = fx.instantiate(gone, "d");  // b's place, and its random streams
-        kept.run(std::size_t(after));
-        gone.run(std::size_t(after));
-        ASSERT_TRUE(bitsOf(a) == bitsOf(a2)) << "the first instance changed";
-        ASSERT_TRUE(bitsOf(c) == bitsOf(c2)) << "the last instance changed";
-        ++compared;
-      } catch (const Error&) {
-        continue;  // a step refused it (the other tests check that it is refused alike)
-      }
-    }
-  }
-  EXPECT_GT(compared, double(last - first + 1));
+      });
+  EXPECT_GT(compared, test::seedCount(50));
   std::printf("%d drawn effects: the others untouched by a destroyed instance\n", compared);
 }
 
@@ -413,134 +306,108 @@ TEST(RandomEffects, DestroyingAnInstanceLeavesTheOthersAsTheyWere) {
 // 2 threads. An edit a group refuses throws InvalidArgument, which is fine.
 TEST(RandomEffects, EditsBetweenStepsStaySafeAndAlike) {
   int stepped = 0;
-  const auto [first, last] = test::seeds(60);
-  for (auto make : {test::randomEffect, test::randomEmission, test::randomLookEffect}) {
-    for (std::uint32_t seed = first; seed <= last; ++seed) {
-      const std::string text = make(seed);
-      SCOPED_TRACE("seed " + std::to_string(seed) + ":\n" + text);
-      Effect fx, other, source;
-      try {
-        fx = parseEffect(text, "random.json");
-      } catch (const EffectError&) {
-        continue;
-      }
-      // What the edits put in: another draw's action list (none that reads every pair of
-      // particles: put on a group that holds thousands, it would take minutes) and emitter.
-      for (std::uint32_t k = 1; k < 50 && other.groups.empty(); ++k) try {
-          other = parseEffect(test::randomEffect(seed + 7919u * k), "other.json");
-          if (other.groups[0].actions.readsNeighbours()) other = {};
-        } catch (const EffectError&) {
-        }
-      for (std::uint32_t k = 1; k < 50 && source.groups.empty(); ++k) try {
-          source = parseEffect(test::randomEmission(seed + 104729u * k), "source.json");
-        } catch (const EffectError&) {
-        }
-      ASSERT_FALSE(other.groups.empty() || source.groups.empty());
-      // (At most ~2,000 alive, as the draws keep: some actions read every pair.)
-      Emitter added = source.groups[0].emitters.at(0);
-      added.rate = std::min(added.rate, 100.0);
-      for (ParticleType& t : added.types) t.lifetime = Fuzzy(0.3f);
-      auto run = [&](unsigned threads, bool& refused) {
-        std::vector<std::uint32_t> bits;
-        refused = false;
-        try {
-          Context ctx({.seed = fx.seed, .dt = fx.dt, .threads = threads});
-          EffectInstance instance = fx.instantiate(ctx, "x");
-          const std::vector<Group*>& groups = instance.groups();
-          test::Draw d(seed * 31u + 11u);
-          for (int s = 0; s < 20; ++s) {
-            Group& g = *groups[std::size_t(d.below(int(groups.size())))];
-            try {
-              switch (d.below(26)) {  // an edit about every other step
-                case 0:
-                  g.setActions(other.groups[0].actions);
-                  break;
-                case 1:
-                  if (!g.emitters().empty()) g.removeEmitter(0);
-                  break;
-                case 2:
-                  g.addEmitter(added);
-                  break;
-                case 3:
-                  if (!g.emitters().empty()) g.emitters()[0].rate *= 2.0f;
-                  break;
-                case 4: {
-                  const double scales[] = {0.0, 0.5, 2.0, 1.0};
-                  instance.setTimeScale(scales[d.below(4)]);
-                  break;
-                }
-                case 5:
-                  instance.setUpdateInterval(std::uint32_t(1 + d.below(4)));
-                  break;
-                case 6:
-                  instance.setSeed(std::uint64_t(d.below(1000)));
-                  break;
-                case 7:
-                  instance.setTransform(test::randomPlacement(seed, s));
-                  break;
-                case 8:
-                  g.setSpace(d.below(2) ? Space::Local : Space::World);
-                  break;
-                case 9:
-                  g.clear();
-                  break;
-                case 10:
-                  g.recordDeaths(std::size_t(d.below(16)));
-                  g.recordCollisions(std::size_t(d.below(16)));
-                  break;
-                case 11:
-                  g.setTrail({std::uint32_t(d.below(6))});
-                  break;
-                case 12:
-                  g.require({Attribute::Color, Attribute::Size, Attribute::Age});
-                  break;
-                case 13: {
-                  Particle p;
-                  p.position = Vec3(float(d.between(-5, 5)), float(d.between(-5, 5)), 0.0f);
-                  p.velocity = Vec3(0.0f, float(d.between(-5, 5)), 0.0f);
-                  g.add(p);
-                  break;
-                }
-                default:
-                  break;
-              }
-            } catch (const InvalidArgument&) {
-            }
-            ctx.step();
-            if (!test::stepLeftGroupsSound(groups, s)) return bits;
+  test::forEachDrawnEffect(
+      {test::randomEffect, test::randomEmission, test::randomLookEffect}, 60,
+      [&](std::uint32_t seed, test::DrawEffect, const Effect& fx) {
+        Effect other, source;
+        // What the edits put in: another draw's action list (none that reads every pair of
+        // particles: put on a group that holds thousands, it would take minutes) and emitter.
+        for (std::uint32_t k = 1; k < 50 && other.groups.empty(); ++k) try {
+            other = parseEffect(test::randomEffect(seed + 7919u * k), "other.json");
+            if (other.groups[0].actions.readsNeighbours()) other = {};
+          } catch (const EffectError&) {
           }
-          for (const Group* g : groups) {
-            std::vector<Vec3> trail(g->trail().length);
-            for (std::size_t i = 0; i < g->size(); ++i) {
-              const Particle p = g->particle(i);
-              bits.push_back(p.id);
-              for (int c = 0; c < 3; ++c) {
-                bits.push_back(std::bit_cast<std::uint32_t>(p.position[c]));
-                bits.push_back(std::bit_cast<std::uint32_t>(p.velocity[c]));
-              }
-              if (!trail.empty())
-                for (std::size_t j = 0, n = g->trail(i, trail); j < n; ++j)
-                  for (int c = 0; c < 3; ++c)
-                    bits.push_back(std::bit_cast<std::uint32_t>(trail[j][c]));
-            }
-            for (const Vec3& v : g->strands().position)
-              for (int c = 0; c < 3; ++c) bits.push_back(std::bit_cast<std::uint32_t>(v[c]));
+        for (std::uint32_t k = 1; k < 50 && source.groups.empty(); ++k) try {
+            source = parseEffect(test::randomEmission(seed + 104729u * k), "source.json");
+          } catch (const EffectError&) {
           }
-        } catch (const Error&) {
-          refused = true;
-        }
-        return bits;
-      };
-      bool refused1 = false, refused2 = false;
-      const auto one = run(1, refused1);
-      if (::testing::Test::HasFailure()) return;
-      const auto two = run(2, refused2);
-      if (::testing::Test::HasFailure()) return;
-      ASSERT_EQ(refused1, refused2);
-      ASSERT_TRUE(one == two) << "1 thread and 2 differ";
-      stepped += !refused1;
-    }
-  }
-  EXPECT_GT(stepped, double(last - first + 1));
+        ASSERT_FALSE(other.groups.empty() || source.groups.empty());
+        // (At most ~2,000 alive, as the draws keep: some actions read every pair.)
+        Emitter added = source.groups[0].emitters.at(0);
+        added.rate = std::min(added.rate, 100.0);
+        for (ParticleType& t : added.types) t.lifetime = Fuzzy(0.3f);
+        auto run = [&](unsigned threads, bool& refused) -> std::vector<std::uint32_t> {
+          refused = false;
+          try {
+            Context ctx({.seed = fx.seed, .dt = fx.dt, .threads = threads});
+            EffectInstance instance = fx.instantiate(ctx, "x");
+            const std::vector<Group*>& groups = instance.groups();
+            test::Draw d(seed * 31u + 11u);
+            for (int s = 0; s < 20; ++s) {
+              Group& g = *groups[std::size_t(d.below(int(groups.size())))];
+              try {
+                switch (d.below(26)) {  // an edit about every other step
+                  case 0:
+                    g.setActions(other.groups[0].actions);
+                    break;
+                  case 1:
+                    if (!g.emitters().empty()) g.removeEmitter(0);
+                    break;
+                  case 2:
+                    g.addEmitter(added);
+                    break;
+                  case 3:
+                    if (!g.emitters().empty()) g.emitters()[0].rate *= 2.0f;
+                    break;
+                  case 4: {
+                    const double scales[] = {0.0, 0.5, 2.0, 1.0};
+                    instance.setTimeScale(scales[d.below(4)]);
+                    break;
+                  }
+                  case 5:
+                    instance.setUpdateInterval(std::uint32_t(1 + d.below(4)));
+                    break;
+                  case 6:
+                    instance.setSeed(std::uint64_t(d.below(1000)));
+                    break;
+                  case 7:
+                    instance.setTransform(test::randomPlacement(seed, s));
+                    break;
+                  case 8:
+                    g.setSpace(d.below(2) ? Space::Local : Space::World);
+                    break;
+                  case 9:
+                    g.clear();
+                    break;
+                  case 10:
+                    g.recordDeaths(std::size_t(d.below(16)));
+                    g.recordCollisions(std::size_t(d.below(16)));
+                    break;
+                  case 11:
+                    g.setTrail({std::uint32_t(d.below(6))});
+                    break;
+                  case 12:
+                    g.require({Attribute::Color, Attribute::Size, Attribute::Age});
+                    break;
+                  case 13: {
+                    Particle p;
+                    p.position = Vec3(float(d.between(-5, 5)), float(d.between(-5, 5)), 0.0f);
+                    p.velocity = Vec3(0.0f, float(d.between(-5, 5)), 0.0f);
+                    g.add(p);
+                    break;
+                  }
+                  default:
+                    break;
+                }
+              } catch (const InvalidArgument&) {
+              }
+              ctx.step();
+              if (!test::stepLeftGroupsSound(groups, s)) return {};
+            }
+            return test::bitsOf(groups);
+          } catch (const Error&) {
+            refused = true;
+          }
+          return {};
+        };
+        bool refused1 = false, refused2 = false;
+        const auto one = run(1, refused1);
+        if (::testing::Test::HasFailure()) return;
+        const auto two = run(2, refused2);
+        ASSERT_EQ(refused1, refused2);
+        ASSERT_TRUE(one == two) << "1 thread and 2 differ";
+        stepped += !refused1;
+      });
+  EXPECT_GT(stepped, test::seedCount(60));
   std::printf("%d drawn effects edited between steps, alike on 1 and 2 threads\n", stepped);
 }

@@ -75,30 +75,20 @@ Stepped run(const Effect& fx, Backend backend, bool moved, int steps) {
 /// Draws effects with `make` from the seeds (test::seeds(count)) and steps each the CPU steps
 /// on the device too: checked every step (stepLeftGroupsSound), then compared (expectSame:
 /// counts, statistics and ids exactly, every attribute within the parity tolerance).
-void stepDraws(std::string (*make)(std::uint32_t), std::uint32_t count, bool moved = false,
-               int steps = 8) {
+void stepDraws(test::DrawEffect draw, std::uint32_t count, bool moved = false, int steps = 8) {
   FLURRY_REQUIRE_OPENCL();
   int stepped = 0;
   std::size_t vertices = 0, points = 0;  // strand vertices and trail points compared
-  const auto [first, last] = test::seeds(count);
-  for (std::uint32_t seed = first; seed <= last; ++seed) {
-    const std::string text = make(seed);
-    SCOPED_TRACE("seed " + std::to_string(seed) + ":\n" + text);
-    Effect fx;
-    try {
-      fx = parseEffect(text, "random.json");
-    } catch (const EffectError&) {
-      continue;  // (the CPU tests count these)
-    }
+  test::forEachDrawnEffect({draw}, count, [&](std::uint32_t, test::DrawEffect, const Effect& fx) {
     const Stepped cpu = run(fx, Backend::Cpu, moved, steps);
-    if (cpu.refused) continue;
+    if (cpu.refused) return;
     const Stepped cl = run(fx, Backend::OpenCL, moved, steps);
     // (Hair mode with neighbours or sub-steps by distance is refused there, by design.)
     if (cl.refused && fx.groups.front().hair.enabled &&
         cl.why.find("hair mode with") != std::string::npos)
-      continue;
+      return;
     ASSERT_FALSE(cl.refused) << "the device refused what the CPU steps: " << cl.why;
-    if (::testing::Test::HasFailure()) return;  // (stepLeftGroupsSound said why)
+    ASSERT_FALSE(::testing::Test::HasFailure());  // (stepLeftGroupsSound said why)
     ++stepped;
     ASSERT_EQ(cpu.groups.size(), cl.groups.size());
     for (std::size_t k = 0; k < cpu.groups.size(); ++k) {
@@ -123,13 +113,12 @@ void stepDraws(std::string (*make)(std::uint32_t), std::uint32_t count, bool mov
           for (int c = 0; c < 3; ++c) test::expectClose(trail[j][c], other[j][c], "trail", id, c);
       }
     }
-    if (::testing::Test::HasFailure()) return;
-  }
+  });
   EXPECT_GT(stepped, 0);
   std::printf(
-      "%d of %u drawn effects stepped on both backends, alike (%zu strand vertices, %zu "
+      "%d of %.0f drawn effects stepped on both backends, alike (%zu strand vertices, %zu "
       "trail points)\n",
-      stepped, last - first + 1, vertices, points);
+      stepped, test::seedCount(count), vertices, points);
 }
 
 }  // namespace
@@ -156,54 +145,44 @@ TEST(OpenCLRandomEffects, HairAndTrailsLikeTheCpu) {
 TEST(OpenCLRandomEffects, KilledAndStoppedLikeTheCpu) {
   FLURRY_REQUIRE_OPENCL();
   int compared = 0;
-  for (auto make : {test::randomEffect, test::randomEmission}) {
-    const auto [first, last] = test::seeds(8);
-    for (std::uint32_t seed = first; seed <= last; ++seed) {
-      const std::string text = make(seed);
-      SCOPED_TRACE("seed " + std::to_string(seed) + ":\n" + text);
-      Effect fx;
-      try {
-        fx = parseEffect(text, "random.json");
-      } catch (const EffectError&) {
-        continue;
-      }
-      struct Run {
-        bool refused = false;
-        std::vector<int> done;  // per step: 1 + 2 * b.done() when a.done()
-        std::vector<test::RunResult> groups;
-      };
-      auto run = [&](Backend backend) {
-        Run out;
-        try {
-          Context ctx({.seed = fx.seed, .dt = fx.dt, .threads = 2, .backend = backend});
-          EffectInstance a = fx.instantiate(ctx, "a"), b = fx.instantiate(ctx, "b");
-          ctx.run(1 + seed % 5);
-          a.kill();
-          b.stop();
-          for (int s = 0; s < 40; ++s) {
-            out.done.push_back(int(a.done()) + 2 * int(b.done()));
-            if (a.done() && b.done()) break;
-            ctx.step();
+  test::forEachDrawnEffect(
+      {test::randomEffect, test::randomEmission}, 8,
+      [&](std::uint32_t seed, test::DrawEffect, const Effect& fx) {
+        struct Run {
+          bool refused = false;
+          std::vector<int> done;  // per step: 1 + 2 * b.done() when a.done()
+          std::vector<test::RunResult> groups;
+        };
+        auto run = [&](Backend backend) {
+          Run out;
+          try {
+            Context ctx({.seed = fx.seed, .dt = fx.dt, .threads = 2, .backend = backend});
+            EffectInstance a = fx.instantiate(ctx, "a"), b = fx.instantiate(ctx, "b");
+            ctx.run(1 + seed % 5);
+            a.kill();
+            b.stop();
+            for (int s = 0; s < 40; ++s) {
+              out.done.push_back(int(a.done()) + 2 * int(b.done()));
+              if (a.done() && b.done()) break;
+              ctx.step();
+            }
+            for (const EffectInstance* fxi : {&a, &b})
+              for (const Group* g : fxi->groups()) out.groups.push_back(test::resultOf(*g));
+          } catch (const Error&) {
+            out.refused = true;
           }
-          for (const EffectInstance* fxi : {&a, &b})
-            for (const Group* g : fxi->groups()) out.groups.push_back(test::resultOf(*g));
-        } catch (const Error&) {
-          out.refused = true;
-        }
-        return out;
-      };
-      const Run cpu = run(Backend::Cpu);
-      if (cpu.refused) continue;
-      const Run cl = run(Backend::OpenCL);
-      ASSERT_FALSE(cl.refused);
-      EXPECT_EQ(cpu.done, cl.done);
-      ASSERT_EQ(cpu.groups.size(), cl.groups.size());
-      for (std::size_t k = 0; k < cpu.groups.size(); ++k)
-        test::expectSame(cpu.groups[k], cl.groups[k]);
-      if (::testing::Test::HasFailure()) return;
-      ++compared;
-    }
-  }
+          return out;
+        };
+        const Run cpu = run(Backend::Cpu);
+        if (cpu.refused) return;
+        const Run cl = run(Backend::OpenCL);
+        ASSERT_FALSE(cl.refused);
+        EXPECT_EQ(cpu.done, cl.done);
+        ASSERT_EQ(cpu.groups.size(), cl.groups.size());
+        for (std::size_t k = 0; k < cpu.groups.size(); ++k)
+          test::expectSame(cpu.groups[k], cl.groups[k]);
+        ++compared;
+      });
   EXPECT_GT(compared, 0);
   std::printf("%d drawn effects killed and stopped alike on both backends\n", compared);
 }
