@@ -87,6 +87,20 @@ std::uint64_t firstWhere(std::uint64_t n, Pred pred) {
   return lo;
 }
 
+// When occurrence r of a burst fires.
+double occurrenceTime(const Burst& b, std::uint64_t r) {
+  return b.time + double(r) * b.interval;
+}
+// The occurrences [r0, r1) of a burst that fire in [lo, t1) and not after `stop`: an
+// occurrence's time never decreases with r, so they are one range, found by bisection
+// whatever `repeat`.
+std::pair<std::uint64_t, std::uint64_t> dueOccurrences(const Burst& b, double lo, double t1,
+                                                       double stop) {
+  const auto at = [&](std::uint64_t r) { return occurrenceTime(b, r); };
+  return {firstWhere(b.repeat, [&](std::uint64_t r) { return at(r) >= lo; }),
+          firstWhere(b.repeat, [&](std::uint64_t r) { return at(r) >= t1 || at(r) > stop; })};
+}
+
 // The births of one emitter (static or live) over (t0, t1]: its rate, its bursts in
 // [t0, t1), and one birth per `spacing` of the path it travels. Returns the births counted.
 std::uint64_t planEmitter(const Emitter& em, EmitterState& state, bool live, std::uint32_t index,
@@ -121,12 +135,7 @@ std::uint64_t planEmitter(const Emitter& em, EmitterState& state, bool live, std
   const double lo = std::max(t0, em.start);
   for (const Burst& b : em.bursts) {
     if (b.count == 0) continue;
-    // Occurrence r fires at b.time + r·interval, which never decreases with r: the ones in
-    // [lo, t1) and not after the stop are one range, found by bisection whatever `repeat`.
-    const auto at = [&](std::uint64_t r) { return b.time + double(r) * b.interval; };
-    const std::uint64_t r0 = firstWhere(b.repeat, [&](std::uint64_t r) { return at(r) >= lo; });
-    const std::uint64_t r1 =
-        firstWhere(b.repeat, [&](std::uint64_t r) { return at(r) >= t1 || at(r) > em.stop; });
+    const auto [r0, r1] = dueOccurrences(b, lo, t1, em.stop);
     for (std::uint64_t r = r0; r < r1 && plan.room() > 0; ++r) {
       std::uint64_t n = std::min<std::uint64_t>(b.count, plan.room());
       if (plan.total >= plan.written) {
@@ -135,7 +144,7 @@ std::uint64_t planEmitter(const Emitter& em, EmitterState& state, bool live, std
         n = left > plan.room() / b.count ? plan.room() : left * b.count;
         r = r1 - 1;
       }
-      plan.add({BirthRun::Burst, live, index, 0, at(r), n});
+      plan.add({BirthRun::Burst, live, index, 0, occurrenceTime(b, r), n});
     }
   }
   if (em.spacing > 0) {
@@ -322,14 +331,10 @@ bool mayFire(double rate, const std::vector<Burst>& bursts, double start, double
   const double lo = std::max(t0, start);
   for (const Burst& b : bursts) {
     if (b.count == 0) continue;
-    // planEmitter's occurrences: those in [lo, t1) and not after the stop. (Whether the
-    // burst's first and last occurrences bracket them is not enough: a burst begun before a
-    // stop() that fell between two of its occurrences kept its instance from ever being
-    // done().)
-    const auto at = [&](std::uint64_t r) { return b.time + double(r) * b.interval; };
-    const std::uint64_t r0 = firstWhere(b.repeat, [&](std::uint64_t r) { return at(r) >= lo; });
-    const std::uint64_t r1 =
-        firstWhere(b.repeat, [&](std::uint64_t r) { return at(r) >= t1 || at(r) > stop; });
+    // planEmitter's occurrences. (Whether the burst's first and last occurrences bracket
+    // [lo, t1) is not enough: a burst begun before a stop() that fell between two of its
+    // occurrences kept its instance from ever being done().)
+    const auto [r0, r1] = dueOccurrences(b, lo, t1, stop);
     if (r0 < r1) return true;
   }
   return spacing > 0 && std::min(t1, stop) > lo;
@@ -367,9 +372,8 @@ void stopEmitting(GroupImpl& g, double at, bool showers) {
     e.stop = std::max(e.start, std::min(e.stop, before));
     // A burst keeps only its occurrences before `at`: one begun before an emitter that has
     // not started (its stop then is its start) still fired at the start.
-    for (Burst& b : e.bursts)
-      b.repeat = std::uint32_t(firstWhere(
-          b.repeat, [&](std::uint64_t r) { return b.time + double(r) * b.interval >= at; }));
+    const double never = std::numeric_limits<double>::infinity();
+    for (Burst& b : e.bursts) b.repeat = std::uint32_t(dueOccurrences(b, -never, at, never).second);
     std::erase_if(e.bursts, [](const Burst& b) { return b.repeat == 0; });
   };
   for (Emitter& e : g.emitters) stop(e);
