@@ -4,6 +4,10 @@
 // this program makes and counts the lines touched in each region it names here.
 //
 //   instance_lines [INSTANCES]    (10 by default; the regions are instance INSTANCES / 2's)
+//   instance_lines INSTANCES one  (the same particles as one group, stepped as many times,
+//                                  no marks: the baseline for an instruction count, e.g.
+//                                  valgrind --tool=callgrind
+//                                  --toggle-collect='flurry::Context::step()' on both)
 //
 // Prints "MARK address" (a word written just before and just after the step) and, per region,
 // "REGION name address bytes", on stderr.
@@ -42,6 +46,13 @@ int main(int argc, char** argv) {
   ContextOptions o;
   o.threads = 1;
   Context ctx(o);
+  if (argc > 2 && std::string(argv[2]) == "one") {
+    EffectInstance one =
+        parseEffect(bench::sparks(bench::kPerInstance * count)).instantiate(ctx, "one");
+    one.setTransform(bench::placeOf(0, 1));
+    ctx.run(46);  // as many steps as the instances take below
+    return 0;
+  }
   const Effect effect = parseEffect(bench::sparks(bench::kPerInstance));
   std::vector<EffectInstance> all;
   for (std::size_t k = 0; k < count; ++k) {
