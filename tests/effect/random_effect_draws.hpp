@@ -2,9 +2,11 @@
 // every action anywhere in its documented range (its ends, zero, huge and tiny values,
 // infinity where the field takes it), with random domains, integrators and step lengths
 // (randomEffect); emission of every kind (randomEmission); either in an instance's own space
-// (randomPlacedEffect). The same seed draws the same text on every machine. Shared by the
-// tests that step them on the CPU (tests/effect/test_random_effects.cpp) and on the device
-// (tests/opencl/test_opencl_random.cpp).
+// (randomPlacedEffect); in hair mode or with trails (randomLookEffect). The same seed draws
+// the same text wherever the same compiler and standard library built the tests (the
+// distributions, and the order of draws inside one expression, are theirs to choose).
+// Shared by the tests that step them on the CPU (tests/effect/test_random_effects.cpp) and
+// on the device (tests/opencl/test_opencl_random.cpp).
 #pragma once
 
 #include <gtest/gtest.h>
@@ -26,6 +28,7 @@
 
 namespace flurry::test {
 
+/// Random choices from one seed (std::mt19937), as effect-file text.
 class Draw {
  public:
   explicit Draw(std::uint32_t seed) : rng_(seed) {}
