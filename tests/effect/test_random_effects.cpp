@@ -58,9 +58,9 @@ std::vector<std::uint32_t> run(const Effect& fx, unsigned threads, int steps, bo
   return test::bitsOf(groups);
 }
 
-/// Draws effects with `make` from the seeds (seeds(count)), and steps each that loads on one
-/// and on two threads (run: checked every step; `moved`: as an instance placed anew before
-/// each step), their particles compared bit for bit.
+/// Draws effects with `draw` from the seeds (test::seeds(count)), and steps each that loads
+/// on one and on two threads (run: checked every step; `moved`: as an instance placed anew
+/// before each step), their particles compared bit for bit.
 void stepDraws(test::DrawEffect draw, std::uint32_t count, bool moved = false) {
   int loaded = 0, stepped = 0;
   test::forEachDrawnEffect({draw}, count, [&](std::uint32_t, test::DrawEffect, const Effect& fx) {

@@ -72,7 +72,7 @@ Stepped run(const Effect& fx, Backend backend, bool moved, int steps) {
   return out;
 }
 
-/// Draws effects with `make` from the seeds (test::seeds(count)) and steps each the CPU steps
+/// Draws effects with `draw` from the seeds (test::seeds(count)) and steps each the CPU steps
 /// on the device too: checked every step (stepLeftGroupsSound), then compared (expectSame:
 /// counts, statistics and ids exactly, every attribute within the parity tolerance).
 void stepDraws(test::DrawEffect draw, std::uint32_t count, bool moved = false, int steps = 8) {
