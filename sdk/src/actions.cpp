@@ -358,6 +358,41 @@ bool isForce(const Action& a) {
          std::holds_alternative<SampledField>(a) || std::holds_alternative<Follow>(a);
 }
 
+void planMoves(const ActionList& list, std::vector<std::uint8_t>& gathered,
+               std::vector<std::vector<std::uint32_t>>& forcesOf,
+               std::vector<std::vector<std::uint32_t>>& guardsOf,
+               std::vector<std::uint32_t>& curvedBy) {
+  const auto& acts = list.actions();
+  const Integrator integrator = list.integrator();
+  gathered.assign(acts.size(), 0);
+  forcesOf.resize(acts.size());
+  guardsOf.resize(acts.size());
+  for (auto& f : forcesOf) f.clear();
+  for (auto& b : guardsOf) b.clear();
+  curvedBy.assign(acts.size(), 0);
+  if (integrator == Integrator::SemiImplicitEuler) return;
+  // Explicit Euler moves on the straight line p + v·dt: the plain bounce is its own path.
+  const bool curved = integrator == Integrator::Exact || integrator == Integrator::VelocityVerlet ||
+                      integrator == Integrator::RK4;
+  thread_local std::vector<std::uint32_t> pending, bounces;
+  pending.clear();
+  bounces.clear();
+  for (std::uint32_t k = 0; k < acts.size(); ++k) {
+    if (isForce(acts[k])) pending.push_back(k);
+    if (std::holds_alternative<Bounce>(acts[k])) bounces.push_back(k);
+    if (std::holds_alternative<Move>(acts[k])) {
+      for (std::uint32_t f : pending) gathered[f] = 1;
+      for (std::uint32_t b : bounces)
+        if (curved && !pending.empty() && planarPiece(std::get<Bounce>(acts[b])) >= 0)
+          curvedBy[b] = k + 1;
+      forcesOf[k].assign(pending.begin(), pending.end());
+      guardsOf[k].assign(bounces.begin(), bounces.end());
+      pending.clear();
+      bounces.clear();
+    }
+  }
+}
+
 bool hasClosedForm(const Action& a) {
   return std::holds_alternative<Gravity>(a) || std::holds_alternative<Damping>(a) ||
          std::holds_alternative<ElectricField>(a);

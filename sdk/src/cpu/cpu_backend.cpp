@@ -179,40 +179,9 @@ namespace {
 void planStructure(GroupImpl& g, ActionPlan& plan) {
   const auto& acts = g.actions.actions();
   plan.integrator = g.actions.integrator();
-  plan.gathered.assign(acts.size(), 0);
-  // Resized and cleared, not replaced: the inner lists keep their storage.
-  plan.forcesOf.resize(acts.size());
-  plan.guardsOf.resize(acts.size());
-  for (auto& f : plan.forcesOf) f.clear();
-  for (auto& b : plan.guardsOf) b.clear();
-  plan.curvedBy.assign(acts.size(), 0);
+  planMoves(g.actions, plan.gathered, plan.forcesOf, plan.guardsOf, plan.curvedBy);
   plan.timeFree.assign(acts.size(), 0);
   for (std::size_t k = 0; k < acts.size(); ++k) plan.timeFree[k] = isTimeFree(acts[k]);
-  // Explicit Euler moves on the straight line p + v·dt: the plain bounce is its own path.
-  const bool curved = plan.integrator == Integrator::Exact ||
-                      plan.integrator == Integrator::VelocityVerlet ||
-                      plan.integrator == Integrator::RK4;
-  if (plan.integrator != Integrator::SemiImplicitEuler) {
-    thread_local std::vector<std::uint32_t> pendingStore, bouncesStore;
-    std::vector<std::uint32_t>& pending = pendingStore;
-    std::vector<std::uint32_t>& bounces = bouncesStore;
-    pending.clear();
-    bounces.clear();
-    for (std::uint32_t k = 0; k < acts.size(); ++k) {
-      if (isForce(acts[k])) pending.push_back(k);
-      if (std::holds_alternative<Bounce>(acts[k])) bounces.push_back(k);
-      if (std::holds_alternative<Move>(acts[k])) {
-        for (std::uint32_t f : pending) plan.gathered[f] = 1;
-        for (std::uint32_t b : bounces)
-          if (curved && !pending.empty() && cpu::isPlanarBounce(std::get<Bounce>(acts[b])))
-            plan.curvedBy[b] = k + 1;
-        plan.forcesOf[k].assign(pending.begin(), pending.end());
-        plan.guardsOf[k].assign(bounces.begin(), bounces.end());
-        pending.clear();
-        bounces.clear();
-      }
-    }
-  }
   plan.guarded = false;
   for (const auto& gs : plan.guardsOf) plan.guarded |= !gs.empty();
   {

@@ -651,10 +651,6 @@ inline bool withPlanarPiece(const Bounce& a, F&& f) {
   return true;
 }
 
-inline bool isPlanarBounce(const Bounce& a) {
-  return withPlanarPiece(a, [](Vec3, Vec3, auto) {});
-}
-
 inline void apply(const Bounce& a, const Lanes& L, std::size_t n, const BlockContext& c) {
   withDt(c, [&](auto dt) {
     const bool planar = withPlanarPiece(a, [&](Vec3 P, Vec3 N, auto onPiece) {

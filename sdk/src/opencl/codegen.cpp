@@ -617,9 +617,6 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   AttributeSet reads, writes;
   const Integrator integrator = actions.integrator();
   std::ostringstream body;
-  std::vector<std::string> pending;  // gathered forces' accelerations, for the next Move
-  std::vector<std::string> pendingDamping;
-  std::vector<std::size_t> pendingBounces;
   bool guarded = false;  // some Bounce is guarded: keep where each particle began the step
   const auto& acts = actions.actions();
   std::vector<ActionSource> sources(acts.size());
@@ -638,24 +635,20 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
         !generateSurfaceAction(act, src))
       notOnDevice("action '" + actionName(act) + "' (actions[" + std::to_string(k) + "])");
   }
-  // A planar Bounce before a Move that integrates with Exact, Verlet or RK4 bounces on the
-  // parabola of the acceleration that Move's integrator starts from (fused_pass.cpp
-  // curvedBy): all forces since the previous Move, evaluated at the Bounce's state.
-  std::vector<std::vector<std::string>> curveForces(acts.size());
-  if (integrator == Integrator::Exact || integrator == Integrator::VelocityVerlet ||
-      integrator == Integrator::RK4) {
-    std::vector<std::string> forces;
-    std::vector<std::size_t> bounces;
-    for (std::size_t k = 0; k < acts.size(); ++k) {
-      if (isForce(acts[k]) && !sources[k].accel.empty()) forces.push_back(sources[k].accel);
-      if (std::holds_alternative<Bounce>(acts[k])) bounces.push_back(k);
-      if (std::holds_alternative<Move>(acts[k])) {
-        for (std::size_t b : bounces) curveForces[b] = forces;
-        forces.clear();
-        bounces.clear();
-      }
-    }
-  }
+  // How each integrating Move takes the forces and Bounces before it: the CPU's plan
+  // (action_traits.hpp planMoves), read here, not derived again.
+  std::vector<std::uint8_t> gathered;
+  std::vector<std::vector<std::uint32_t>> forcesOf, guardsOf;
+  std::vector<std::uint32_t> curvedBy;
+  planMoves(actions, gathered, forcesOf, guardsOf, curvedBy);
+  for (std::size_t k = 0; k < acts.size(); ++k)
+    if (gathered[k] && sources[k].accel.empty())
+      notOnDevice(actionName(acts[k]) + " under an integrator");
+  auto accelerations = [&](const std::vector<std::uint32_t>& forces) {
+    std::vector<std::string> a;
+    for (std::uint32_t f : forces) a.push_back(sources[f].accel);
+    return a;
+  };
   // Where each action's code starts in `body`, and how it was placed there: 0 evaluated by
   // the next Move (no code), 1 its own update (src.apply), 2 other code (a Move's integrator,
   // a Bounce on the curved path).
@@ -682,12 +675,6 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
       << "u, id, fl_hits, fl_hitRoom);\n#endif\n";
     return c.str();
   };
-  // A force is evaluated by an integrating Move only where one follows it: after the last
-  // Move (or in a list without one) it is its own update, as under semi-implicit Euler
-  // (cpu_backend.cpp planStructure).
-  std::size_t movesUpTo = 0;  // one past the last Move
-  for (std::size_t k = 0; k < acts.size(); ++k)
-    if (std::holds_alternative<Move>(acts[k])) movesUpTo = k + 1;
   for (std::size_t k = 0; k < acts.size(); ++k) {
     const Action& act = acts[k];
     ActionSource& src = sources[k];
@@ -695,55 +682,48 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
     reads.insert(src.reads);
     writes.insert(src.writes);
     body << "    /* " << k << ": " << actionName(act) << " */\n";
-    if (integrator != Integrator::SemiImplicitEuler && k < movesUpTo) {
-      // Forces before a Move are evaluated by its integrator (fused_pass.cpp makePlan).
-      if (isForce(act)) {
-        if (src.accel.empty()) notOnDevice(actionName(act) + " under an integrator");
-        pending.push_back(src.accel);
-        pendingDamping.push_back(std::holds_alternative<Damping>(act) ? src.in.params : "");
-        body << "    /* (evaluated by the next Move's integrator) */\n";
-        placed[k] = 0;
-        continue;
+    if (gathered[k]) {
+      body << "    /* (evaluated by the next Move's integrator) */\n";
+      placed[k] = 0;
+      continue;
+    }
+    if (curvedBy[k]) {
+      // A planar Bounce on the parabola of the acceleration its Move's integrator starts
+      // from: the Move's forces, evaluated at the Bounce's state (fused_pass.cpp curvedBy).
+      // The state under other names: the forces' code reads px.. in its own block.
+      body << "    { const float fl_b_px = px, fl_b_py = py, fl_b_pz = pz, fl_b_vx = vx, "
+              "fl_b_vy = vy, fl_b_vz = vz;\n    float fl_bounce_ax, fl_bounce_ay, "
+              "fl_bounce_az;\n    "
+           << evaluate(accelerations(forcesOf[curvedBy[k] - 1]), "fl_b_", "time", "fl_bounce_")
+           << "    " << bounceOnCurve(std::get<Bounce>(act), src.in.params, "fl_bounce_a")
+           << (collisions ? logCollision(k, "fl_b_", "fl_bounce_ax, fl_bounce_ay, fl_bounce_az")
+                          : "")
+           << "    }\n";
+      continue;
+    }
+    if (std::holds_alternative<Move>(act) && integrator != Integrator::SemiImplicitEuler) {
+      reads.insert({Attribute::Position, Attribute::Velocity});
+      writes.insert({Attribute::Position, Attribute::Velocity});
+      const bool prev = stored.has(Attribute::PrevPosition), age = stored.has(Attribute::Age);
+      if (prev) writes.insert(Attribute::PrevPosition);
+      if (age) {
+        reads.insert(Attribute::Age);
+        writes.insert(Attribute::Age);
       }
-      if (std::holds_alternative<Bounce>(act)) {
-        pendingBounces.push_back(k);
-        const std::string call = bounceOnCurve(std::get<Bounce>(act), src.in.params, "fl_bounce_a");
-        if (!curveForces[k].empty() && !call.empty()) {
-          // The state under other names: the forces' code reads px.. in its own block.
-          body << "    { const float fl_b_px = px, fl_b_py = py, fl_b_pz = pz, fl_b_vx = vx, "
-                  "fl_b_vy = vy, fl_b_vz = vz;\n    float fl_bounce_ax, fl_bounce_ay, "
-                  "fl_bounce_az;\n    "
-               << evaluate(curveForces[k], "fl_b_", "time", "fl_bounce_") << "    " << call
-               << (collisions ? logCollision(k, "fl_b_", "fl_bounce_ax, fl_bounce_ay, fl_bounce_az")
-                              : "")
-               << "    }\n";
-          continue;
-        }
+      std::vector<std::string> damping;
+      for (std::uint32_t f : forcesOf[k])
+        damping.push_back(std::holds_alternative<Damping>(acts[f]) ? sources[f].in.params : "");
+      body << integrateMove(integrator, accelerations(forcesOf[k]), damping, prev, age);
+      // A curved step (or its bounce) that ended behind a deflector, compared with where
+      // the particle began the step, is put back (fused_pass.cpp guard).
+      for (std::uint32_t b : guardsOf[k]) {
+        const auto& bounce = std::get<Bounce>(acts[b]);
+        body << "    fl_bounce_guard((ap + " << b << "), " << bounce.surface.shape().index()
+             << "u, " << (bounce.inside ? 1 : 0)
+             << ", fl_start_x, fl_start_y, fl_start_z, &px, &py, &pz, &vx, &vy, &vz, extra);\n";
+        guarded = true;
       }
-      if (std::holds_alternative<Move>(act)) {
-        reads.insert({Attribute::Position, Attribute::Velocity});
-        writes.insert({Attribute::Position, Attribute::Velocity});
-        const bool prev = stored.has(Attribute::PrevPosition), age = stored.has(Attribute::Age);
-        if (prev) writes.insert(Attribute::PrevPosition);
-        if (age) {
-          reads.insert(Attribute::Age);
-          writes.insert(Attribute::Age);
-        }
-        body << integrateMove(integrator, pending, pendingDamping, prev, age);
-        // A curved step (or its bounce) that ended behind a deflector, compared with where
-        // the particle began the step, is put back (fused_pass.cpp guard).
-        for (std::size_t b : pendingBounces) {
-          const auto& bounce = std::get<Bounce>(acts[b]);
-          body << "    fl_bounce_guard((ap + " << b << "), " << bounce.surface.shape().index()
-               << "u, " << (bounce.inside ? 1 : 0)
-               << ", fl_start_x, fl_start_y, fl_start_z, &px, &py, &pz, &vx, &vy, &vz, extra);\n";
-          guarded = true;
-        }
-        pending.clear();
-        pendingDamping.clear();
-        pendingBounces.clear();
-        continue;
-      }
+      continue;
     }
     placed[k] = 1;
     const bool logs = collisions && std::holds_alternative<Bounce>(act);
