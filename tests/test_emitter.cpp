@@ -3,6 +3,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <vector>
 
 #include "emission_plan.hpp"
@@ -297,6 +299,10 @@ TEST(Emitter, BurstRepeatedForeverCostsTheSameEveryStep) {
 TEST(Emitter, BurstOccurrencesFallInTheStepOfTheirTime) {
   // Per step, what the bursts fire is exactly the occurrences whose times fall in the step's
   // [t0, t1) and the emitter's [start, stop], also when a time lands on a step's boundary.
+  // The steps tile the clock: a step's t1 is the next one's t0 (the context's time, steps·dt),
+  // not t0 + dt, which rounds to either side of it (1.2000000000000002 + 0.1 is past 1.3 =
+  // 13·0.1, 0.5 + 0.1 short of 0.6000000000000001): an occurrence there fired in two steps,
+  // or in none. Over the run each occurrence fires once.
   const double dt = 0.1;
   Emitter e;
   e.start = 0.3;
@@ -312,17 +318,53 @@ TEST(Emitter, BurstOccurrencesFallInTheStepOfTheirTime) {
   Context ctx(o);
   Group& g = ctx.createGroup("g", 1 << 20);
   g.addEmitter(e);
-  for (int step = 0; step < 30; ++step) {
-    const double t0 = double(step) * dt, t1 = t0 + dt;
-    std::uint64_t expected = 0;
+  auto due = [&](double t0, double t1) {
+    std::uint64_t n = 0;
     for (const Burst& b : e.bursts)
       for (std::uint32_t r = 0; r < b.repeat; ++r) {
         const double tb = b.time + r * b.interval;
-        if (tb >= t0 && tb < t1 && tb >= e.start && tb <= e.stop) expected += b.count;
+        if (tb >= t0 && tb < t1 && tb >= e.start && tb <= e.stop) n += b.count;
       }
+    return n;
+  };
+  for (int step = 0; step < 30; ++step) {
+    const double t0 = double(step) * dt, t1 = double(step + 1) * dt;
+    ASSERT_EQ(ctx.time(), t0);
     const std::uint64_t before = g.stats().emitted;
     ctx.step();
-    EXPECT_EQ(g.stats().emitted - before, expected) << "step " << step;
+    EXPECT_EQ(g.stats().emitted - before, due(t0, t1)) << "step " << step;
+  }
+  EXPECT_EQ(g.stats().emitted, due(0.0, ctx.time()));
+}
+
+TEST(Emitter, ABurstOnAStepsBoundaryFiresOnceOnEveryClock) {
+  // A burst at each multiple of dt (written as a designer writes it: 0.6, not 6 * 0.1) fires
+  // once, on the context's clock, ahead of it (prewarm) and on a group's own clock (a time
+  // scale, an update interval). Before the steps tiled the clock, a burst at 0.6 s never
+  // fired at dt = 0.1, and one at 1.3 s fired twice.
+  for (const double dt : {0.1, 1.0 / 30.0, 1.0 / 60.0, 0.7}) {
+    for (int clock = 0; clock < 4; ++clock) {
+      ContextOptions o;
+      o.dt = dt;
+      o.threads = 1;
+      Context ctx(o);
+      Group& g = ctx.createGroup("g", 1 << 16);
+      Emitter e;
+      for (int k = 1; k <= 60; ++k) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.6g", k * dt);  // as an effect file holds it
+        e.bursts.push_back({std::strtod(text, nullptr), 1, 0.0, 1});
+      }
+      g.addEmitter(e);
+      if (clock == 1) {
+        std::vector<Group*> one{&g};
+        ctx.prewarm(one, 7 * dt);
+      }
+      if (clock == 2) g.setTimeScale(0.5);
+      if (clock == 3) g.setUpdateInterval(3);
+      for (int s = 0; s < 300; ++s) ctx.step();
+      EXPECT_EQ(g.stats().emitted, 60u) << "dt " << dt << ", clock " << clock;
+    }
   }
 }
 

@@ -14,6 +14,11 @@ namespace flurry::detail {
 struct StepParams {
   double time = 0.0;  ///< at the start of the step
   double dt = 0.0;
+  /// Where the step ends: exactly where the group's next step starts, which `time + dt` is
+  /// not always (the clock is base + steps·dt, and a sum rounds either side of it: a burst at
+  /// 0.6 s with dt = 0.1 fell between two steps, one at 1.3 s fired in both). What ends the
+  /// step (emission's window, events' time, deaths' time) reads this.
+  double end = 0.0;
   std::uint64_t seed = 0;
   std::uint64_t step = 0;
   /// A group with a clock of its own (GroupImpl::ownsClock): the length of one of its units

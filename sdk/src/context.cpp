@@ -289,17 +289,29 @@ detail::StepParams groupStep(const detail::StepParams& sp, const detail::GroupIm
   const std::uint64_t ahead = gi.stepsAhead + extra;
   detail::StepParams r = sp;
   if (gi.ownSeed) r.seed = gi.seed;
+  // Each step's end (StepParams::end) is where the next starts, in the same form.
   if (ahead > 0) {
     r.step = sp.step + ahead;
-    r.time = std::isnan(gi.aheadSeconds)
-                 ? timeAtDtChange + double(stepsSinceDtChange + ahead) * sp.dt
-                 : sp.time + gi.aheadSeconds + double(extra) * sp.dt;
+    if (std::isnan(gi.aheadSeconds)) {
+      r.time = timeAtDtChange + double(stepsSinceDtChange + ahead) * sp.dt;
+      r.end = timeAtDtChange + double(stepsSinceDtChange + ahead + 1) * sp.dt;
+    } else {  // (Context::prewarm's steps end where its next one starts: it sets their end)
+      r.time = sp.time + gi.aheadSeconds + double(extra) * sp.dt;
+      r.end = sp.end + gi.aheadSeconds + double(extra) * sp.dt;
+    }
   }
   // Group::setTimeScale, setUpdateInterval: from where its clock stood when it left the
-  // context's, over the steps it skipped and this one.
+  // context's, over the steps it skipped and this one. A clock not started yet starts at
+  // this step's time (beginGroupStep).
   if (gi.ownsClock()) {
     const double unit = sp.dt * gi.timeScale;
-    if (gi.clockStarted()) r.time = gi.clockAt(unit, extra);
+    const std::uint64_t units = gi.skippedSteps + 1;
+    if (gi.clockStarted()) {
+      r.time = gi.clockAt(unit, extra);
+      r.end = gi.clockAt(unit, extra + units);
+    } else {
+      r.end = r.time + double(units) * unit;
+    }
     r.dt = unit * double(gi.skippedSteps + 1);
     r.clockUnit = unit;
   }
@@ -377,6 +389,7 @@ detail::StepParams Context::Impl::params() const {
   detail::StepParams sp;
   sp.time = time;
   sp.dt = options.dt;
+  sp.end = timeAtDtChange + double(stepsSinceDtChange + 1) * options.dt;  // (step(): time)
   sp.seed = options.seed;
   sp.step = step;
   sp.blockSize = pass.blockSize;
@@ -587,8 +600,13 @@ std::uint64_t Context::prewarm(std::span<Group* const> groups, double seconds) {
     impl_->shareBudget();
     for (Group* g : groups) {
       auto& gi = *g->impl_;
-      stepGroup(*impl_->backend, gi,
-                groupStep(sp, gi, impl_->timeAtDtChange, impl_->stepsSinceDtChange, 0));
+      detail::StepParams own =
+          groupStep(sp, gi, impl_->timeAtDtChange, impl_->stepsSinceDtChange, 0);
+      // Ahead by seconds (after a new dt), the next step starts at the context's time plus
+      // the lead this one leaves, whether it is the prewarm's or the context's.
+      if (!std::isnan(gi.aheadSeconds) && !gi.ownsClock())
+        own.end = sp.time + (gi.aheadSeconds + dt);
+      stepGroup(*impl_->backend, gi, own);
       ++gi.stepsAhead;
       if (!std::isnan(gi.aheadSeconds)) gi.aheadSeconds += dt;
     }

@@ -248,7 +248,7 @@ void countGeneration(GroupImpl& g, std::uint32_t generation, std::uint64_t n) {
 }  // namespace
 
 std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, std::vector<BirthRun>& runs) {
-  const double t0 = sp.time, t1 = sp.time + sp.dt;
+  const double t0 = sp.time, t1 = sp.end;
   Plan plan{runs, g.capacity};
   for (std::uint32_t e = 0; e < g.emitters.size(); ++e) {
     const std::uint64_t n = planEmitter(g.emitters[e], g.emitterState[e], false, e, t0, t1, plan);
@@ -342,7 +342,7 @@ bool mayFire(double rate, const std::vector<Burst>& bursts, double start, double
 }  // namespace
 
 bool mayEmit(const GroupImpl& g, const StepParams& sp) {
-  const double t0 = sp.time, t1 = sp.time + sp.dt;
+  const double t0 = sp.time, t1 = sp.end;
   if (!g.live.empty()) return true;
   for (std::size_t e = 0; e < g.emitters.size(); ++e) {
     const Emitter& em = g.emitters[e];
@@ -359,7 +359,7 @@ bool mayEmit(const GroupImpl& g, const StepParams& sp) {
 bool mayEverEmit(const GroupImpl& g, double at) {
   StepParams sp;
   sp.time = at;
-  sp.dt = std::numeric_limits<double>::infinity();
+  sp.dt = sp.end = std::numeric_limits<double>::infinity();
   return mayEmit(g, sp);
 }
 
@@ -439,7 +439,7 @@ std::size_t fitBirths(GroupImpl& g, std::uint64_t total, std::vector<BirthRun>& 
 }
 
 void emitNewborns(GroupImpl& g, const StepParams& sp) {
-  const double t1 = sp.time + sp.dt;
+  const double t1 = sp.end;
   g.bornFirst = g.size;
   g.bornCount = 0;
 

@@ -52,13 +52,15 @@ void simulateHair(GroupImpl& g, const StepParams& sp) {
     }
   };
   StepParams hs = sp;
-  hs.time = sp.time + sp.dt;
+  hs.time = sp.end;
+  hs.end = hs.time + hs.dt;  // (its own steps, after the group's)
   record();
   const std::size_t maxSteps = std::size_t(g.hair.maxVertices) * g.hair.every;
   for (std::size_t k = 1; k <= maxSteps && h.size > 0; ++k) {
     actFused(h, hs);
     compact(h, hs);
-    hs.time += hs.dt;
+    hs.time = hs.end;
+    hs.end = hs.time + hs.dt;
     ++hs.step;
     if (k % g.hair.every == 0) record();
   }

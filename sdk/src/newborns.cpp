@@ -339,7 +339,7 @@ void emitBatch(const NewbornContext& nc, const BirthRun& run, const Emitter& em,
 
 void writeNewborns(GroupImpl& g, const StepParams& sp, const BirthRun* runs,
                    const std::uint64_t* runStart, std::size_t runCount, std::size_t accepted) {
-  const double t1 = sp.time + sp.dt;
+  const double t1 = sp.end;
   NewbornContext nc{g, g.lanePointers(), sp, t1, g.nextId, g.size, g.bornRemaining.data()};
   const std::size_t tasks = (accepted + kNewbornsPerTask - 1) / kNewbornsPerTask;
   sp.pool->parallelFor(tasks, [&](std::size_t task) {

@@ -266,7 +266,7 @@ class CpuBackend final : public BackendImpl {
     emitNewborns(group, params);
     // A newborn's trail starts where it was born, inside the step.
     if (group.bornCount > 0) group.startTrails(group.bornFirst, group.bornFirst + group.bornCount);
-    if (group.birthsFeed) group.recordBirths(params.time + params.dt);
+    if (group.birthsFeed) group.recordBirths(params.end);
     lap(last, group.stats.stepSeconds.emit, group.lastStepParts.emit);
     // The rest of a later group's data, asked for here rather than with the first part
     // before this step (StepParams::ahead).

@@ -787,7 +787,7 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
   // This step's newborns are [bornFirst, n), and newborn r lives remaining[r] of it.
   const std::size_t bornFirst = g.bornCount > 0 ? g.bornFirst : n;
   const float* const remaining = g.bornRemaining.data();
-  const double t1 = sp.time + sp.dt;
+  const double t1 = sp.end;
   // Of a block starting at `first` of m particles, how many come before the newborns; and
   // where the block's newborns' remaining times are.
   auto oldIn = [&](std::size_t first, std::size_t m) {
@@ -920,7 +920,7 @@ void actFusedImpl(GroupImpl& g, const StepParams& sp) {
     const std::uint32_t* idx = pass.deadIndex.data() + b * B;
     g.holes.insert(g.holes.end(), idx, idx + pass.deadCount[b]);  // within the capacity
   }
-  if (g.deathRoom() > 0) g.recordDeaths(pass, B, blocks, sp.time + sp.dt, *sp.pool);
+  if (g.deathRoom() > 0) g.recordDeaths(pass, B, blocks, sp.end, *sp.pool);
   if (logHits) g.endCollisions(blocks);
   if (bounds) {
     Bounds& box = g.stepBounds;

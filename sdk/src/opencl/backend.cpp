@@ -712,7 +712,7 @@ void ClGroup::queueHair(GroupImpl& g, const StepParams& sp, std::size_t births) 
   setArg(k, i++, extra_.mem.get());
   setArg(k, i++, extra_.mem.get());  // no snapshot: hair refuses neighbour actions
   setArg(k, i++, cl_ulong(doubleBits(sp.dt)));
-  setArg(k, i++, cl_ulong(doubleBits(sp.time + sp.dt)));  // hair.cpp: hs.time
+  setArg(k, i++, cl_ulong(doubleBits(sp.end)));  // hair.cpp: hs.time
   setArg(k, i++, cl_uint(sp.seed));
   setArg(k, i++, cl_uint(sp.seed >> 32));
   setArg(k, i++, cl_uint(sp.step));
@@ -945,7 +945,7 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
   cl_mem state = state_.mem.get();
   const cl_uint seedLo = cl_uint(sp.seed), seedHi = cl_uint(sp.seed >> 32);
   const cl_uint cap = cl_uint(g.capacity);
-  const cl_ulong t1Bits = cl_ulong(doubleBits(sp.time + sp.dt));
+  const cl_ulong t1Bits = cl_ulong(doubleBits(sp.end));
   auto launch = [&](cl_kernel k, std::size_t global, std::size_t local, const char* what) {
     cl_event e = nullptr;
     check(clEnqueueNDRangeKernel(q, k, 1, nullptr, &global, &local, 0, nullptr,
@@ -1225,9 +1225,9 @@ void ClGroup::step(GroupImpl& g, const StepParams& sp) {
     retire(g, false);
     if (inFlight_.size() == before) break;
   }
-  if (kills && deathRoom > 0) readDeaths(g, deathRoom, sp.time + sp.dt);
+  if (kills && deathRoom > 0) readDeaths(g, deathRoom, sp.end);
   if (hits && acts) readCollisions(g);
-  if (births > 0 && g.birthsFeed) readBirths(g, sp.time + sp.dt);
+  if (births > 0 && g.birthsFeed) readBirths(g, sp.end);
 }
 
 void ClGroup::readBirths(GroupImpl& g, double t1) {

@@ -344,7 +344,7 @@ std::uint64_t planBirths(GroupImpl& g, const StepParams& sp, StepTables& t, Emit
     }
   }
   // Live emitters that died this step go after their last births are packed.
-  retireDead(g, sp.time + sp.dt);
+  retireDead(g, sp.end);
   if (t.keys.empty()) t.keys.push_back({});
   if (t.shapes.empty()) t.shapes.push_back(0.0f);
   return total;
