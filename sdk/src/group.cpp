@@ -922,7 +922,7 @@ void detail::GroupImpl::recordDeaths(PassScratch& pass, std::size_t B, std::size
   }
   deathStart[blocks] = total;
   const std::size_t kept = std::min(total, deathRoom());
-  stats.deathEventsDropped += total - kept;
+  stats.deathEventsDropped += leftOut(total, deathsPerStep);
   deathEvents.resize(kept);  // within the room reserved by Group::recordDeaths: no allocation
   if (kept == 0) return;
   const Lanes L = lanePointers();
@@ -959,6 +959,7 @@ void detail::GroupImpl::addCollision(std::size_t block, std::uint64_t key,
 
 void detail::GroupImpl::endCollisions(std::size_t blocks) {
   collisionEvents.clear();
+  std::size_t total = 0;
   for (std::size_t b = 0; b < blocks; ++b) {
     auto& found = blockCollisions[b];
     // In particle order whichever way the pass ran the block (the fused pass takes a block's
@@ -967,8 +968,9 @@ void detail::GroupImpl::endCollisions(std::size_t blocks) {
               [](const KeyedCollision& x, const KeyedCollision& y) { return x.key < y.key; });
     const std::size_t take = std::min(found.size(), collisionRoom() - collisionEvents.size());
     for (std::size_t k = 0; k < take; ++k) collisionEvents.push_back(found[k].event);
-    stats.collisionEventsDropped += found.size() - take;
+    total += found.size();
   }
+  stats.collisionEventsDropped += leftOut(total, collisionsPerStep);
 }
 
 namespace {
@@ -989,7 +991,9 @@ Group& Group::recordCollisions(std::size_t perStep) {
 }
 
 std::span<const CollisionEvent> Group::collisions() const {
-  return impl_->collisionEvents;
+  // (A collision emitter fed by the group has the step's others.)
+  const auto& all = impl_->collisionEvents;
+  return std::span(all).first(std::min(all.size(), impl_->collisionsPerStep));
 }
 
 void detail::GroupImpl::recordBirths(double t1) {
@@ -1044,7 +1048,9 @@ void Group::removeDeathEmitter(std::size_t i) {
 }
 
 std::span<const DeathEvent> Group::deaths() const {
-  return impl_->deathEvents;
+  // (A death emitter fed by the group has the step's others.)
+  const auto& all = impl_->deathEvents;
+  return std::span(all).first(std::min(all.size(), impl_->deathsPerStep));
 }
 
 Bounds Group::bounds() const {

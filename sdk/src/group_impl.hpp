@@ -410,6 +410,13 @@ struct GroupImpl {
   bool deathsFeed = false;
   /// The deaths a step records: deathsPerStep, or the capacity while deathsFeed.
   std::size_t deathRoom() const { return deathsFeed ? capacity : deathsPerStep; }
+  /// Of `total` events a step had, those the game's room (`perStep`; 0: not recording) left
+  /// out: GroupStats' dropped counts are the game's, whatever a death or collision emitter
+  /// fed by the group records beyond them (Group::deaths and collisions give the first
+  /// `perStep`).
+  static std::size_t leftOut(std::size_t total, std::size_t perStep) {
+    return perStep > 0 && total > perStep ? total - perStep : 0;
+  }
   GroupStats::StepSeconds lastStepParts;  ///< the last step's (the CPU backend's clock)
   std::size_t collisionsPerStep = 0;      ///< Group::recordCollisions; 0: not recording
   /// A collision emitter names this group (set by Context::step): it records every collision.

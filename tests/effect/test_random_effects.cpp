@@ -10,8 +10,12 @@
 // thread count.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <bit>
+#include <cmath>
 #include <cstdio>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "flurry/effect.hpp"
@@ -410,4 +414,177 @@ TEST(RandomEffects, EditsBetweenStepsStaySafeAndAlike) {
       });
   EXPECT_GT(stepped, test::seedCount(60));
   std::printf("%d drawn effects edited between steps, alike on 1 and 2 threads\n", stepped);
+}
+
+namespace {
+
+/// The stats a step's events are checked against, per group: what died by an action (or for a
+/// NaN), per action, and what the events left out.
+struct DeathCounts {
+  std::uint64_t died = 0, deathsDropped = 0, collisionsDropped = 0;
+  std::vector<std::uint64_t> byAction;
+};
+DeathCounts deathCounts(const Group& g) {
+  const GroupStats& s = g.stats();
+  return {s.killedByAge + s.absorbed + s.killedNonFinite, s.deathEventsDropped,
+          s.collisionEventsDropped, s.killedByAction};
+}
+
+/// Checks one step's events of `g` (recording at most `room` of each a step) against what the
+/// step did: `before` the counts and `alive` the ids at its start (sorted), [t0, t1] its span.
+/// Returns the events as words (for the comparison across thread counts), and adds a failure naming
+/// the step and the event where one is wrong.
+std::vector<std::uint32_t> checkEvents(const Group& g, std::size_t room, const DeathCounts& before,
+                                       const std::vector<std::uint32_t>& alive, double t0,
+                                       double t1, int step) {
+  std::vector<std::uint32_t> bits;
+  auto put = [&](Vec3 v) {
+    for (int c = 0; c < 3; ++c) bits.push_back(std::bit_cast<std::uint32_t>(v[c]));
+  };
+  auto putTime = [&](double t) {
+    const auto w = std::bit_cast<std::uint64_t>(t);
+    bits.push_back(std::uint32_t(w));
+    bits.push_back(std::uint32_t(w >> 32));
+  };
+  auto finite = [](Vec3 v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+  };
+  const DeathCounts after = deathCounts(g);
+  const auto& acts = g.actions().actions();
+  const std::string where = g.name() + ", step " + std::to_string(step);
+  std::vector<std::uint32_t> now(g.ids().begin(), g.ids().end());
+  std::sort(now.begin(), now.end());
+
+  // Deaths: each one the step made, up to the room; the rest counted as dropped.
+  const auto deaths = g.deaths();
+  EXPECT_LE(deaths.size(), room) << where;
+  EXPECT_EQ(deaths.size() + (after.deathsDropped - before.deathsDropped), after.died - before.died)
+      << where << ": deaths recorded and dropped against those counted";
+  std::vector<std::uint64_t> byAction(acts.size(), 0);
+  std::vector<std::uint32_t> dead;
+  for (std::size_t e = 0; e < deaths.size(); ++e) {
+    const DeathEvent& d = deaths[e];
+    const std::string what = where + ", death " + std::to_string(e);
+    EXPECT_EQ(d.time, t1) << what << ": not at the step's end";
+    EXPECT_FALSE(std::binary_search(now.begin(), now.end(), d.id)) << what << ": still alive";
+    dead.push_back(d.id);
+    if (d.action == DeathEvent::kNonFinite) continue;
+    EXPECT_TRUE(finite(d.position) && finite(d.velocity)) << what;
+    if (d.action >= acts.size()) {
+      ADD_FAILURE() << what << ": action " << d.action << " past the list";
+      continue;
+    }
+    ++byAction[d.action];
+    bits.push_back(d.id);
+    bits.push_back(d.action);
+    put(d.position);
+    put(d.velocity);
+    putTime(d.time);
+  }
+  std::sort(dead.begin(), dead.end());
+  EXPECT_TRUE(std::adjacent_find(dead.begin(), dead.end()) == dead.end())
+      << where << ": a particle died twice";
+  const bool allDeaths = after.deathsDropped == before.deathsDropped;
+  for (std::size_t k = 0; k < acts.size(); ++k) {
+    const std::uint64_t killed =
+        after.byAction[k] - (k < before.byAction.size() ? before.byAction[k] : 0);
+    if (allDeaths)
+      EXPECT_EQ(byAction[k], killed) << where << ": deaths by action " << k;
+    else
+      EXPECT_LE(byAction[k], killed) << where << ": deaths by action " << k;
+  }
+
+  // Collisions: by a Bounce, on a particle alive at the step's start or born in it, within
+  // the step, with a unit normal.
+  const auto hits = g.collisions();
+  EXPECT_LE(hits.size(), room) << where;
+  for (std::size_t e = 0; e < hits.size(); ++e) {
+    const CollisionEvent& c = hits[e];
+    const std::string what = where + ", collision " + std::to_string(e);
+    EXPECT_TRUE(c.action < acts.size() && std::holds_alternative<Bounce>(acts[c.action]))
+        << what << ": action " << c.action << " is not a Bounce";
+    EXPECT_TRUE(finite(c.position) && finite(c.velocity) && finite(c.normal)) << what;
+    EXPECT_NEAR(glm::length(c.normal), 1.0f, 1e-3f) << what << ": normal not of unit length";
+    // (The moment inside a step is a float fraction of the float step length: within a few
+    // of its roundings.)
+    const double slack = 1e-6 * (t1 - t0) + 1e-12 * std::abs(t1);
+    // A newborn of an emitter that started before the step (a negative start) lived the
+    // time since its birth in this step: its collisions may be earlier.
+    const bool old = std::binary_search(alive.begin(), alive.end(), c.id);
+    EXPECT_TRUE((c.time >= t0 - slack || !old) && c.time <= t1 + slack)
+        << what << ": at " << c.time << ", outside the step [" << t0 << ", " << t1 << "]";
+    EXPECT_EQ(c.reserved, 0u) << what;
+    bits.push_back(c.id);
+    bits.push_back(c.action);
+    put(c.position);
+    put(c.velocity);
+    put(c.normal);
+    putTime(c.time);
+  }
+  return bits;
+}
+
+}  // namespace
+
+// Deaths and collisions recorded as events, from effects drawn at random, with room for one,
+// a few or all of a step's: every step's deaths are those the stats count (recorded, or counted
+// as dropped where the room ran out), each by the action that killed it, at the step's end,
+// of a particle no longer alive, none twice; every collision by a Bounce, inside the step, on a
+// unit normal; and the events of 1 and 2 threads are bitwise the same.
+TEST(RandomEffects, EventsAreThoseOfTheStepAndAlike) {
+  int stepped = 0;
+  std::uint64_t deathsSeen = 0, hitsSeen = 0;
+  test::forEachDrawnEffect(
+      {test::randomEffect, test::randomEmission}, 100,
+      [&](std::uint32_t seed, test::DrawEffect, const Effect& fx) {
+        const std::size_t rooms[] = {1, 3, 40, 100000};
+        const std::size_t room = rooms[seed % 4];
+        auto run = [&](unsigned threads, bool& refused) -> std::vector<std::uint32_t> {
+          refused = false;
+          std::vector<std::uint32_t> bits;
+          try {
+            Context ctx({.seed = fx.seed, .dt = fx.dt, .threads = threads});
+            detail::setPassOptions(ctx, {.blockSize = 256});
+            const std::vector<Group*> groups = fx.build(ctx);
+            for (Group* g : groups) g->recordDeaths(room).recordCollisions(room);
+            for (int s = 0; s < 25; ++s) {
+              std::vector<DeathCounts> before;
+              std::vector<std::vector<std::uint32_t>> alive;
+              for (const Group* g : groups) {
+                before.push_back(deathCounts(*g));
+                alive.emplace_back(g->ids().begin(), g->ids().end());
+                std::sort(alive.back().begin(), alive.back().end());
+              }
+              const double t0 = ctx.time();
+              ctx.step();
+              for (std::size_t k = 0; k < groups.size(); ++k) {
+                const auto b =
+                    checkEvents(*groups[k], room, before[k], alive[k], t0, ctx.time(), s);
+                if (::testing::Test::HasFailure()) return {};
+                if (threads == 1) {
+                  deathsSeen += groups[k]->deaths().size();
+                  hitsSeen += groups[k]->collisions().size();
+                }
+                bits.insert(bits.end(), b.begin(), b.end());
+              }
+            }
+          } catch (const Error&) {
+            refused = true;
+            return {};
+          }
+          return bits;
+        };
+        bool refused1 = false, refused2 = false;
+        const auto one = run(1, refused1);
+        if (::testing::Test::HasFailure()) return;
+        const auto two = run(2, refused2);
+        ASSERT_EQ(refused1, refused2);
+        ASSERT_TRUE(one == two) << "the events of 1 thread and 2 differ";
+        stepped += !refused1;
+      });
+  EXPECT_GT(stepped, test::seedCount(100));
+  std::printf(
+      "%d drawn effects: %llu deaths and %llu collisions recorded, alike on 1 and 2 "
+      "threads\n",
+      stepped, (unsigned long long)deathsSeen, (unsigned long long)hitsSeen);
 }

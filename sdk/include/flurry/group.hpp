@@ -292,8 +292,8 @@ class Group {
   /// Records every step's deaths (by age, by an absorber, for a NaN) as DeathEvents for the
   /// game to read after the step (deaths()), at most `perStep` a step: the first in particle
   /// order, the same on any thread count; the rest are counted in
-  /// GroupStats::deathEventsDropped (while a DeathEmitter names the group, all of them are
-  /// recorded for it). 0 stops it. The room is taken here, not per step, and
+  /// GroupStats::deathEventsDropped (a DeathEmitter that names the group gets all of them,
+  /// and deaths() still the first `perStep`). 0 stops it. The room is taken here, not per step, and
   /// while off it costs nothing. Stores ids (the events carry them). Both backends record
   /// the same events; on a device the host waits for each step it records and reads its
   /// events back (what a step costs there while recording).
@@ -304,7 +304,8 @@ class Group {
   /// CollisionEvents for the game to read after the step (collisions()), at most `perStep`
   /// a step: the first in particle order (a particle's own by sub-step, then by action), the
   /// same on any thread count; the rest are counted in GroupStats::collisionEventsDropped
-  /// (while a collision emitter names the group, all of them are recorded for it). A
+  /// (a collision emitter that names the group gets all of them, and collisions() still the
+  /// first `perStep`). A
   /// particle left NaN or infinite is not reported (the step kills it). 0 stops it; while off it
   /// costs nothing. A particle resting on a floor is deflected, and reported, every step it rests
   /// (filter by the speed). Stores ids. Both backends record them; on a device the host

@@ -1289,7 +1289,7 @@ void ClGroup::readCollisions(GroupImpl& g) {
                     [](const auto& x, const auto& y) { return x.first < y.first; });
   g.collisionEvents.clear();
   for (std::size_t j = 0; j < kept; ++j) g.collisionEvents.push_back(hitsSorted_[j].second);
-  g.stats.collisionEventsDropped += total - kept;
+  g.stats.collisionEventsDropped += GroupImpl::leftOut(total, g.collisionsPerStep);
   // More than the room: this step kept an arbitrary `hitRoom_` of them; later steps have room
   // for as many.
   if (total > hitRoom_) hitRoom_ = std::min<std::size_t>(total, mostHits());
@@ -1299,7 +1299,7 @@ void ClGroup::readDeaths(GroupImpl& g, std::size_t room, double t1) {
   // A game reads the events right after the step: this step's count, then its events.
   drain(g);
   const std::size_t kept = std::min<std::size_t>(lastDead_, std::min(room, g.capacity));
-  g.stats.deathEventsDropped += lastDead_ - kept;
+  g.stats.deathEventsDropped += GroupImpl::leftOut(lastDead_, g.deathsPerStep);
   g.deathEvents.resize(kept);  // within the room Group::recordDeaths reserved
   if (kept == 0) return;
   deathWords_.resize(kept * 8);
