@@ -4,7 +4,7 @@
 // device beside the CPU backend: the device never fails where the CPU steps, keeps only
 // finite particles inside its capacity and inside the box it reports, and gives the CPU's
 // counts, statistics and ids, and its particles, strands and trails within the parity
-// tolerance. (The first sweep found two defects: forces after the last Move dropped by the
+// tolerance; where emission is drawn, its death and collision events too. (The first sweep found two defects: forces after the last Move dropped by the
 // device under an integrating Move, and a MagneticField past ~1.8e19 that killed uncharged
 // particles.)
 //
@@ -35,10 +35,27 @@ struct Stepped {
   std::vector<test::RunResult> groups;
   std::vector<Strands> strands;                                    // per group
   std::vector<std::map<std::uint32_t, std::vector<Vec3>>> trails;  // per group, by id
+  std::vector<std::vector<DeathEvent>> deaths;                     // per group, all steps'
+  std::vector<std::vector<CollisionEvent>> collisions;
 };
 
-/// `moved`: as an instance placed anew before every step (test::randomPlacement).
-Stepped run(const Effect& fx, Backend backend, bool moved, int steps) {
+/// Events are recorded (`events`) where the device's programs stay those the suite compiles
+/// anyway: deaths everywhere (read from the kill codes every program writes), collisions
+/// only on a group a collision emitter already records (a program that logs them is
+/// another program for a group that does not).
+void recordEvents(const Effect& fx, const std::vector<Group*>& groups) {
+  for (Group* g : groups) {
+    g->recordDeaths(100000);
+    for (const auto& spec : fx.groups)
+      for (const DeathEmitter& d : spec.deathEmitters)
+        if (d.on == DeathEmitter::Trigger::Collision && g->name() == d.source)
+          g->recordCollisions(100000);
+  }
+}
+
+/// `moved`: as an instance placed anew before every step (test::randomPlacement); `events`:
+/// recordEvents.
+Stepped run(const Effect& fx, Backend backend, bool moved, int steps, bool events) {
   Stepped out;
   try {
     Context ctx({.seed = fx.seed, .dt = fx.dt, .threads = 2, .backend = backend});
@@ -51,10 +68,19 @@ Stepped run(const Effect& fx, Backend backend, bool moved, int steps) {
       groups = fx.build(ctx);
     }
     for (Group* g : groups) (void)g->bounds();  // kept by the passes from now on
+    if (events) recordEvents(fx, groups);
+    out.deaths.resize(groups.size());
+    out.collisions.resize(groups.size());
     for (int s = 0; s < steps; ++s) {
       if (moved) instance.setTransform(test::randomPlacement(fx.seed, s));
       ctx.step();
       if (!test::stepLeftGroupsSound(groups, s)) return out;
+      for (std::size_t k = 0; k < groups.size(); ++k) {
+        const auto d = groups[k]->deaths();
+        const auto c = groups[k]->collisions();
+        out.deaths[k].insert(out.deaths[k].end(), d.begin(), d.end());
+        out.collisions[k].insert(out.collisions[k].end(), c.begin(), c.end());
+      }
     }
     for (const Group* g : groups) {
       out.groups.push_back(test::resultOf(*g));
@@ -75,14 +101,16 @@ Stepped run(const Effect& fx, Backend backend, bool moved, int steps) {
 /// Draws effects with `draw` from the seeds (test::seeds(count)) and steps each the CPU steps
 /// on the device too: checked every step (stepLeftGroupsSound), then compared (expectSame:
 /// counts, statistics and ids exactly, every attribute within the parity tolerance).
-void stepDraws(test::DrawEffect draw, std::uint32_t count, bool moved = false, int steps = 8) {
+void stepDraws(test::DrawEffect draw, std::uint32_t count, bool moved = false, int steps = 8,
+               bool events = false) {
   FLURRY_REQUIRE_OPENCL();
   int stepped = 0;
   std::size_t vertices = 0, points = 0;  // strand vertices and trail points compared
+  std::size_t deaths = 0, hits = 0;      // events compared
   test::forEachDrawnEffect({draw}, count, [&](std::uint32_t, test::DrawEffect, const Effect& fx) {
-    const Stepped cpu = run(fx, Backend::Cpu, moved, steps);
+    const Stepped cpu = run(fx, Backend::Cpu, moved, steps, events);
     if (cpu.refused) return;
-    const Stepped cl = run(fx, Backend::OpenCL, moved, steps);
+    const Stepped cl = run(fx, Backend::OpenCL, moved, steps, events);
     // (Hair mode with neighbours or sub-steps by distance is refused there, by design.)
     if (cl.refused && fx.groups.front().hair.enabled &&
         cl.why.find("hair mode with") != std::string::npos)
@@ -112,13 +140,41 @@ void stepDraws(test::DrawEffect draw, std::uint32_t count, bool moved = false, i
         for (std::size_t j = 0; j < trail.size(); ++j)
           for (int c = 0; c < 3; ++c) test::expectClose(trail[j][c], other[j][c], "trail", id, c);
       }
+      // The same events in the same order: ids, causes and times exactly, places and
+      // velocities within the parity tolerance.
+      ASSERT_EQ(cpu.deaths[k].size(), cl.deaths[k].size()) << "deaths recorded";
+      deaths += cpu.deaths[k].size();
+      for (std::size_t e = 0; e < cpu.deaths[k].size(); ++e) {
+        const DeathEvent &p = cpu.deaths[k][e], &q = cl.deaths[k][e];
+        ASSERT_EQ(p.id, q.id) << "death " << e;
+        EXPECT_EQ(p.action, q.action) << "death " << e;
+        EXPECT_EQ(p.time, q.time) << "death " << e;
+        if (p.action == DeathEvent::kNonFinite) continue;
+        for (int c = 0; c < 3; ++c) {
+          test::expectClose(p.position[c], q.position[c], "death position", p.id, c);
+          test::expectClose(p.velocity[c], q.velocity[c], "death velocity", p.id, c);
+        }
+      }
+      ASSERT_EQ(cpu.collisions[k].size(), cl.collisions[k].size()) << "collisions recorded";
+      hits += cpu.collisions[k].size();
+      for (std::size_t e = 0; e < cpu.collisions[k].size(); ++e) {
+        const CollisionEvent &p = cpu.collisions[k][e], &q = cl.collisions[k][e];
+        ASSERT_EQ(p.id, q.id) << "collision " << e;
+        EXPECT_EQ(p.action, q.action) << "collision " << e;
+        EXPECT_NEAR(p.time, q.time, 1e-5 * fx.dt) << "collision " << e;
+        for (int c = 0; c < 3; ++c) {
+          test::expectClose(p.position[c], q.position[c], "collision position", p.id, c);
+          test::expectClose(p.velocity[c], q.velocity[c], "collision velocity", p.id, c);
+          test::expectClose(p.normal[c], q.normal[c], "collision normal", p.id, c);
+        }
+      }
     }
   });
   EXPECT_GT(stepped, 0);
   std::printf(
       "%d of %.0f drawn effects stepped on both backends, alike (%zu strand vertices, %zu "
-      "trail points)\n",
-      stepped, test::seedCount(count), vertices, points);
+      "trail points, %zu deaths, %zu collisions)\n",
+      stepped, test::seedCount(count), vertices, points, deaths, hits);
 }
 
 }  // namespace
@@ -128,7 +184,7 @@ TEST(OpenCLRandomEffects, StepSafelyAndLikeTheCpu) {
 }
 
 TEST(OpenCLRandomEffects, EmissionOfEveryKindStepsSafelyAndLikeTheCpu) {
-  stepDraws(test::randomEmission, 8);
+  stepDraws(test::randomEmission, 8, false, 8, true);
 }
 
 TEST(OpenCLRandomEffects, InstancesMovedEveryStepStepSafelyAndLikeTheCpu) {
