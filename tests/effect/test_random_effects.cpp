@@ -305,9 +305,9 @@ TEST(RandomEffects, DestroyingAnInstanceLeavesTheOthersAsTheyWere) {
 // A game edits its effects between steps: each step, now and then, one edit drawn at random
 // (another action list, an emitter removed, added or edited through its span, a time scale,
 // an update interval, a seed, a transform, a space, a clear, events recorded, a trail, more
-// attributes stored, a particle added). Whatever the edits, every step is sound
-// (stepLeftGroupsSound) and the particles, strands and trails are bitwise the same on 1 and
-// 2 threads. An edit a group refuses throws InvalidArgument, which is fine.
+// attributes stored, a particle added, another step length, a prewarm). Whatever the edits, every
+// step is sound (stepLeftGroupsSound) and the particles, strands and trails are bitwise the same on
+// 1 and 2 threads. An edit a group refuses throws InvalidArgument, which is fine.
 TEST(RandomEffects, EditsBetweenStepsStaySafeAndAlike) {
   int stepped = 0;
   test::forEachDrawnEffect(
@@ -390,6 +390,14 @@ TEST(RandomEffects, EditsBetweenStepsStaySafeAndAlike) {
                     g.add(p);
                     break;
                   }
+                  case 14: {
+                    const double dts[] = {0.1, 1.0 / 60.0, 0.7, fx.dt};
+                    ctx.setTimeStep(dts[d.below(4)]);
+                    break;
+                  }
+                  case 15:
+                    instance.prewarm(d.between(0.0, 0.5));
+                    break;
                   default:
                     break;
                 }
