@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -19,6 +20,14 @@ namespace flurry::test {
 inline bool stepLeftGroupsSound(const std::vector<Group*>& groups, int step) {
   for (const Group* g : groups) {
     EXPECT_LE(g->size(), g->capacity()) << g->name() << ", step " << step;
+    if (g->attributes().has(Attribute::Id)) {
+      std::vector<std::uint32_t> ids(g->ids().begin(), g->ids().end());
+      std::sort(ids.begin(), ids.end());
+      if (std::adjacent_find(ids.begin(), ids.end()) != ids.end()) {
+        ADD_FAILURE() << g->name() << ", step " << step << ": two particles share an id";
+        return false;
+      }
+    }
     const Bounds box = g->bounds();
     for (std::size_t i = 0; i < g->size(); ++i) {
       const Vec3 p = g->particle(i).position;
