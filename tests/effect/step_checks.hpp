@@ -29,8 +29,15 @@ inline bool stepLeftGroupsSound(const std::vector<Group*>& groups, int step) {
       }
     }
     const Bounds box = g->bounds();
+    std::vector<Vec3> trail(g->trail().length);
     for (std::size_t i = 0; i < g->size(); ++i) {
       const Vec3 p = g->particle(i).position;
+      // A trail starts where the particle stands at the end of the step.
+      if (!trail.empty() && (g->trail(i, trail) == 0 || trail[0] != p)) {
+        ADD_FAILURE() << g->name() << ", step " << step << ": particle " << i
+                      << "'s trail does not start where it stands";
+        return false;
+      }
       if (!(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z))) {
         ADD_FAILURE() << g->name() << ", step " << step << ": particle " << i << " not finite";
         return false;
