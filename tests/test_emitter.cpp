@@ -344,10 +344,7 @@ TEST(Emitter, ABurstOnAStepsBoundaryFiresOnceOnEveryClock) {
   // fired at dt = 0.1, and one at 1.3 s fired twice.
   for (const double dt : {0.1, 1.0 / 30.0, 1.0 / 60.0, 0.7}) {
     for (int clock = 0; clock < 4; ++clock) {
-      ContextOptions o;
-      o.dt = dt;
-      o.threads = 1;
-      Context ctx(o);
+      Context ctx({.dt = dt, .threads = 1});
       Group& g = ctx.createGroup("g", 1 << 16);
       Emitter e;
       for (int k = 1; k <= 60; ++k) {
