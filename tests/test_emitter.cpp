@@ -339,11 +339,11 @@ TEST(Emitter, BurstOccurrencesFallInTheStepOfTheirTime) {
 
 TEST(Emitter, ABurstOnAStepsBoundaryFiresOnceOnEveryClock) {
   // A burst at each multiple of dt (written as a designer writes it: 0.6, not 6 * 0.1) fires
-  // once, on the context's clock, ahead of it (prewarm) and on a group's own clock (a time
-  // scale, an update interval). Before the steps tiled the clock, a burst at 0.6 s never
-  // fired at dt = 0.1, and one at 1.3 s fired twice.
+  // once, on the context's clock, ahead of it (prewarm, and a new step length after it) and
+  // on a group's own clock (a time scale, an update interval). Before the steps tiled the clock, a
+  // burst at 0.6 s never fired at dt = 0.1, and one at 1.3 s fired twice.
   for (const double dt : {0.1, 1.0 / 30.0, 1.0 / 60.0, 0.7}) {
-    for (int clock = 0; clock < 4; ++clock) {
+    for (int clock = 0; clock < 5; ++clock) {
       Context ctx({.dt = dt, .threads = 1});
       Group& g = ctx.createGroup("g", 1 << 16);
       Emitter e;
@@ -359,7 +359,14 @@ TEST(Emitter, ABurstOnAStepsBoundaryFiresOnceOnEveryClock) {
       }
       if (clock == 2) g.setTimeScale(0.5);
       if (clock == 3) g.setUpdateInterval(3);
-      for (int s = 0; s < 300; ++s) ctx.step();
+      for (int s = 0; s < 300; ++s) {
+        if (clock == 4 && s == 5) {  // ahead of the clock, then another step length
+          std::vector<Group*> one{&g};
+          ctx.prewarm(one, 7 * dt);
+          ctx.setTimeStep(dt / 3);
+        }
+        ctx.step();
+      }
       EXPECT_EQ(g.stats().emitted, 60u) << "dt " << dt << ", clock " << clock;
     }
   }

@@ -1912,6 +1912,32 @@ TEST(Instance, PrewarmIsBitwiseSteppingByHand) {
   EXPECT_EQ(b.prewarm(0.0), 0u);
 }
 
+// A group ahead of the context's clock (prewarmed) keeps its time exactly through a change of
+// the step length, and its next step starts where its last one ended: a burst on that
+// boundary neither fires twice nor falls between them.
+TEST(Instance, ANewStepLengthLeavesAPrewarmedGroupWhereItStood) {
+  for (const double dt : {0.1, 1.0 / 60.0, 0.7, 1e-3}) {
+    for (int ahead = 1; ahead < 30; ahead += 2) {  // (0.1, 2 steps, 5 ahead: an ulp off before)
+      for (int steps = 0; steps < 12; ++steps) {
+        Context ctx({.dt = dt, .threads = 1});
+        Group& g = ctx.createGroup("g", 16);
+        Group* one[] = {&g};
+        ctx.run(std::size_t(steps));
+        ctx.prewarm(one, ahead * dt);
+        const double before = ctx.time(g);
+        ctx.setTimeStep(dt * 0.37);
+        EXPECT_EQ(ctx.time(g), before) << dt << " " << ahead << " " << steps;
+        ctx.prewarm(one, 2 * dt * 0.37);  // its steps and the context's go on alike
+        ctx.run(3);
+        ctx.setTimeStep(dt);
+        const double again = ctx.time(g);
+        ctx.setTimeStep(dt * 2);
+        EXPECT_EQ(ctx.time(g), again) << dt << " " << ahead << " " << steps << " (again)";
+      }
+    }
+  }
+}
+
 // An effect's times count from its creation: an instance made 10 s into the game bursts,
 // emits and explodes as one made at the start, step for step (no burst lost, no backlog of
 // the rate); a spawned emitter's times are its own.

@@ -280,6 +280,14 @@ std::vector<Group*> Context::groups() {
 
 namespace {
 
+// Where a group `ahead` steps ahead of the context's clock (Context::prewarm) starts its step:
+// from the last change of dt, or from where the group's next step started then.
+double aheadTime(const detail::GroupImpl& gi, double timeAtDtChange,
+                 std::uint64_t stepsSinceDtChange, std::uint64_t ahead, double dt) {
+  if (std::isnan(gi.aheadFrom)) return timeAtDtChange + double(stepsSinceDtChange + ahead) * dt;
+  return gi.aheadFrom + double(stepsSinceDtChange + (ahead - gi.aheadStepsThen)) * dt;
+}
+
 // The step a group takes now, `extra` steps past its own clock: the context's, or with
 // Context::prewarm's steps ahead of it. Kept in the context's form (base + steps·dt) so that
 // a prewarmed group reads the very times a group stepped by hand would.
@@ -292,13 +300,8 @@ detail::StepParams groupStep(const detail::StepParams& sp, const detail::GroupIm
   // Each step's end (StepParams::end) is where the next starts, in the same form.
   if (ahead > 0) {
     r.step = sp.step + ahead;
-    if (std::isnan(gi.aheadSeconds)) {
-      r.time = timeAtDtChange + double(stepsSinceDtChange + ahead) * sp.dt;
-      r.end = timeAtDtChange + double(stepsSinceDtChange + ahead + 1) * sp.dt;
-    } else {  // (Context::prewarm's steps end where its next one starts: it sets their end)
-      r.time = sp.time + gi.aheadSeconds + double(extra) * sp.dt;
-      r.end = sp.end + gi.aheadSeconds + double(extra) * sp.dt;
-    }
+    r.time = aheadTime(gi, timeAtDtChange, stepsSinceDtChange, ahead, sp.dt);
+    r.end = aheadTime(gi, timeAtDtChange, stepsSinceDtChange, ahead + 1, sp.dt);
   }
   // Group::setTimeScale, setUpdateInterval: from where its clock stood when it left the
   // context's, over the steps it skipped and this one. A clock not started yet starts at
@@ -600,15 +603,9 @@ std::uint64_t Context::prewarm(std::span<Group* const> groups, double seconds) {
     impl_->shareBudget();
     for (Group* g : groups) {
       auto& gi = *g->impl_;
-      detail::StepParams own =
-          groupStep(sp, gi, impl_->timeAtDtChange, impl_->stepsSinceDtChange, 0);
-      // Ahead by seconds (after a new dt), the next step starts at the context's time plus
-      // the lead this one leaves, whether it is the prewarm's or the context's.
-      if (!std::isnan(gi.aheadSeconds) && !gi.ownsClock())
-        own.end = sp.time + (gi.aheadSeconds + dt);
-      stepGroup(*impl_->backend, gi, own);
+      stepGroup(*impl_->backend, gi,
+                groupStep(sp, gi, impl_->timeAtDtChange, impl_->stepsSinceDtChange, 0));
       ++gi.stepsAhead;
-      if (!std::isnan(gi.aheadSeconds)) gi.aheadSeconds += dt;
     }
     // Their death emitters fed by these groups' deaths (one of both sides alone would
     // leave the other side's clock: skipped).
@@ -637,13 +634,14 @@ double Context::timeStep() const {
 }
 void Context::setTimeStep(double dt) {
   checkDt(dt);
-  // Groups ahead of the clock keep their lead in seconds: their steps so far were of the old dt.
+  // Groups ahead of the clock go on from where their next step starts now: their steps so far
+  // were of the old dt.
   for (auto& g : impl_->groups) {
     auto& gi = *g->impl_;
-    if (gi.stepsAhead > 0 && std::isnan(gi.aheadSeconds))
-      gi.aheadSeconds = (impl_->timeAtDtChange +
-                         double(impl_->stepsSinceDtChange + gi.stepsAhead) * impl_->options.dt) -
-                        impl_->time;
+    if (gi.stepsAhead == 0) continue;
+    gi.aheadFrom = aheadTime(gi, impl_->timeAtDtChange, impl_->stepsSinceDtChange, gi.stepsAhead,
+                             impl_->options.dt);
+    gi.aheadStepsThen = gi.stepsAhead;
   }
   impl_->timeAtDtChange = impl_->time;
   impl_->stepsSinceDtChange = 0;

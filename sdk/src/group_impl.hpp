@@ -591,8 +591,10 @@ struct GroupImpl {
   std::vector<std::uint32_t> deadFlags;  ///< the unfused baseline's per-particle kill codes
   std::vector<float> snapshot;           ///< positions/velocities at the step's start
   /// NaN while the context's dt is the one the steps ahead were taken with; after a change of
-  /// dt, the lead in seconds.
-  double aheadSeconds = std::numeric_limits<double>::quiet_NaN();
+  /// dt, where the group's next step started then (exactly where its last one ended), and
+  /// stepsAhead then: its steps go on from there, the context's and the prewarm's alike.
+  double aheadFrom = std::numeric_limits<double>::quiet_NaN();
+  std::uint64_t aheadStepsThen = 0;
   /// The group's own clock past clockBase (see timeScale).
   double clockUnit = 0.0;
   std::uint64_t clockUnits = 0;
