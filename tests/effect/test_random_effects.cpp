@@ -596,3 +596,53 @@ TEST(RandomEffects, EventsAreThoseOfTheStepAndAlike) {
       "threads\n",
       stepped, (unsigned long long)deathsSeen, (unsigned long long)hitsSeen);
 }
+
+// A sub-emitter with a whole count gives exactly that many newborns for each death, collision
+// or birth of its source, every step (the newborns it could not place counted as dropped):
+// emission drawn at random, the second group fed by the first, its count made 1, 2 or 3.
+TEST(RandomEffects, SubEmittersSpawnTheExactCount) {
+  int checked = 0;
+  std::uint64_t spawned = 0;
+  test::forEachDrawnEffect(
+      {test::randomEmission}, 150, [&](std::uint32_t seed, test::DrawEffect, const Effect& drawn) {
+        Effect fx = drawn;
+        ASSERT_EQ(fx.groups.size(), 2u);
+        DeathEmitter& sub = fx.groups[1].deathEmitters.at(0);
+        const std::uint64_t k = 1 + seed % 3;
+        sub.count = Fuzzy(float(k));
+        try {
+          Context ctx({.seed = fx.seed, .dt = fx.dt, .threads = 1 + seed % 2});
+          const std::vector<Group*> groups = fx.build(ctx);
+          Group &a = *groups[0], &b = *groups[1];
+          a.recordDeaths(a.capacity()).recordCollisions(1u << 30);
+          for (int s = 0; s < 25; ++s) {
+            const GroupStats before = a.stats();
+            const std::uint64_t made = b.stats().emitted;
+            ctx.step();
+            const GroupStats& after = a.stats();
+            std::uint64_t events = 0;
+            switch (sub.on) {
+              case DeathEmitter::Trigger::Death:
+                events = a.deaths().size();
+                break;
+              case DeathEmitter::Trigger::Collision:
+                events = a.collisions().size();
+                break;
+              case DeathEmitter::Trigger::Birth:
+                events = (after.emitted - after.droppedAtCapacity - after.droppedAtBudget) -
+                         (before.emitted - before.droppedAtCapacity - before.droppedAtBudget);
+                break;
+            }
+            ASSERT_EQ(after.deathEventsDropped + after.collisionEventsDropped, 0u);
+            ASSERT_EQ(b.stats().emitted - made, k * events) << "step " << s << ", " << k << " each";
+            spawned += k * events;
+          }
+        } catch (const Error&) {
+          return;  // (a draw a step refuses: the other tests check those)
+        }
+        ++checked;
+      });
+  EXPECT_GT(checked, test::seedCount(150) / 2);
+  std::printf("%d drawn effects: %llu newborns of sub-emitters, each as many as asked\n", checked,
+              (unsigned long long)spawned);
+}
