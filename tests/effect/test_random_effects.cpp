@@ -28,6 +28,19 @@ using namespace flurry;
 
 namespace {
 
+/// Runs `run(threads, refused)` on 1 thread and then on 2: both refuse the effect or neither,
+/// and what they give is the same (words compared bit for bit). 1 where it stepped alike.
+template <class Run>
+int steppedAlike(Run&& run, const char* what) {
+  bool refused1 = false, refused2 = false;
+  const auto one = run(1u, refused1);
+  if (::testing::Test::HasFailure()) return 0;
+  const auto two = run(2u, refused2);
+  EXPECT_EQ(refused1, refused2);
+  EXPECT_TRUE(one == two) << what << " of 1 thread and 2 differ";
+  return !refused1 && !::testing::Test::HasFailure();
+}
+
 /// The particles after `steps` steps on `threads` threads, checked every step; empty when a
 /// step refused the effect with an Error.
 std::vector<std::uint32_t> run(const Effect& fx, unsigned threads, int steps, bool& refused,
@@ -205,13 +218,7 @@ TEST(RandomEffects, UnderABudgetEveryParticleIsAccountedFor) {
           }
           return {};
         };
-        bool refused1 = false, refused2 = false;
-        const auto one = run(1, refused1);
-        if (::testing::Test::HasFailure()) return;
-        const auto two = run(2, refused2);
-        ASSERT_EQ(refused1, refused2);
-        ASSERT_TRUE(one == two) << "1 thread and 2 differ";
-        stepped += !refused1;
+        stepped += steppedAlike(run, "the particles");
       });
   EXPECT_GT(stepped, test::seedCount(60));
   std::printf("%d drawn effects stepped under a budget\n", stepped);
@@ -412,13 +419,7 @@ TEST(RandomEffects, EditsBetweenStepsStaySafeAndAlike) {
           }
           return {};
         };
-        bool refused1 = false, refused2 = false;
-        const auto one = run(1, refused1);
-        if (::testing::Test::HasFailure()) return;
-        const auto two = run(2, refused2);
-        ASSERT_EQ(refused1, refused2);
-        ASSERT_TRUE(one == two) << "1 thread and 2 differ";
-        stepped += !refused1;
+        stepped += steppedAlike(run, "the particles");
       });
   EXPECT_GT(stepped, test::seedCount(60));
   std::printf("%d drawn effects edited between steps, alike on 1 and 2 threads\n", stepped);
@@ -582,13 +583,7 @@ TEST(RandomEffects, EventsAreThoseOfTheStepAndAlike) {
           }
           return bits;
         };
-        bool refused1 = false, refused2 = false;
-        const auto one = run(1, refused1);
-        if (::testing::Test::HasFailure()) return;
-        const auto two = run(2, refused2);
-        ASSERT_EQ(refused1, refused2);
-        ASSERT_TRUE(one == two) << "the events of 1 thread and 2 differ";
-        stepped += !refused1;
+        stepped += steppedAlike(run, "the events");
       });
   EXPECT_GT(stepped, test::seedCount(100));
   std::printf(
