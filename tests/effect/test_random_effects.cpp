@@ -71,6 +71,21 @@ std::vector<std::uint32_t> run(const Effect& fx, unsigned threads, int steps, bo
       return {};
     }
     if (!test::stepLeftGroupsSound(groups, s)) return {};
+    if (moved) {  // the instance's box holds every particle of its groups (an engine culls by it)
+      const Bounds box = instance.bounds();
+      std::size_t alive = 0;
+      for (const Group* g : groups) {
+        alive += g->size();
+        const Bounds own = g->bounds();
+        if (own.empty) continue;
+        for (int c = 0; c < 3; ++c)
+          if (box.empty || own.min[c] < box.min[c] || own.max[c] > box.max[c]) {
+            ADD_FAILURE() << "step " << s << ": the instance's box misses " << g->name() << "'s";
+            return {};
+          }
+      }
+      EXPECT_EQ(box.empty, alive == 0) << "step " << s;
+    }
   }
   return test::bitsOf(groups);
 }
