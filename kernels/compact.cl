@@ -162,7 +162,7 @@ FL_INLINE void fl_event_motion(__global uint* e, uint i, __global const float* p
 /* Birth events (a sub-emitter on birth; group.cpp recordBirths on the CPU): the step's
  * newborns where fl_birth wrote them, before the act kernel moves them on. events[0] gets
  * their count; newborn r is 8 words from events + 8 + 8r: position, velocity (zeros where
- * `velocity` is 0: vx..vz then alias px), id and the part of the step it had left (tau). */
+ * `velocity` is 0: vx..vz then alias px), id and the part of the step it had left (tau, by slot). */
 __kernel void fl_births(__global const uint* state, uint births, uint capacity,
                         __global const float* px, __global const float* py,
                         __global const float* pz, __global const float* vx,
@@ -178,7 +178,7 @@ __kernel void fl_births(__global const uint* state, uint births, uint capacity,
   __global uint* e = events + 8u + 8u * r;
   fl_event_motion(e, i, px, py, pz, vx, vy, vz, velocity);
   e[6] = id[i];
-  e[7] = as_uint(tau[r]);
+  e[7] = as_uint(tau[i]);
 }
 
 /* Death events (Group::recordDeaths; group.cpp recordDeaths on the CPU): the step's dead in

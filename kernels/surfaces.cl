@@ -33,24 +33,21 @@ FL_INLINE FlReflect fl_reflect_of(__global const FlActionParams* a) {
   return r;
 }
 
-/* deflect.h fl_on_piece on the action's record. */
-FL_INLINE int fl_bounce_on_piece(__global const FlActionParams* a, int piece, float x, float y,
-                                 float z) {
-  const FlBounceParams b = a->own.bounce;
-  return fl_on_piece(&b, piece, x, y, z);
-}
-
-/* A two-sided planar deflector (kernels/deflect.h, as on the CPU). */
+/* A two-sided planar deflector (kernels/deflect.h, as on the CPU). Every parameter is read
+ * before the test: a CPU driver that runs work-items as vector lanes then reads each once,
+ * not per vector under the test's mask (a gather). */
 FL_INLINE void fl_bounce_planar(__global const FlActionParams* a, int piece, float dt, float* px,
                                 float* py, float* pz, float* vxs, float* vys, float* vzs) {
-  const FlXyz P = a->own.bounce.point, N = a->own.bounce.normal;
-  const float Px = P.x, Py = P.y, Pz = P.z, Nx = N.x, Ny = N.y, Nz = N.z;
+  const FlBounceParams b = a->own.bounce;
+  const FlReflect rf = fl_reflect_of(a);
+  const float Px = b.point.x, Py = b.point.y, Pz = b.point.z;
+  const float Nx = b.normal.x, Ny = b.normal.y, Nz = b.normal.z;
   float side, tau, hx, hy, hz;
   const int reaches = fl_planar_hit(*px, *py, *pz, *vxs, *vys, *vzs, dt, Px, Py, Pz, Nx, Ny, Nz,
                                     &side, &tau, &hx, &hy, &hz);
-  if (!(reaches && fl_bounce_on_piece(a, piece, hx, hy, hz))) return;
-  fl_planar_bounce(fl_reflect_of(a), 1, side, tau, hx, hy, hz, dt, Px, Py, Pz, Nx, Ny, Nz, px, py,
-                   pz, vxs, vys, vzs);
+  if (!(reaches && fl_on_piece(&b, piece, hx, hy, hz))) return;
+  fl_planar_bounce(rf, 1, side, tau, hx, hy, hz, dt, Px, Py, Pz, Nx, Ny, Nz, px, py, pz, vxs, vys,
+                   vzs);
 }
 
 /* The same deflector when the following Move integrates with the acceleration (ax, ay, az)
@@ -58,15 +55,17 @@ FL_INLINE void fl_bounce_planar(__global const FlActionParams* a, int piece, flo
 FL_INLINE void fl_bounce_planar_accel(__global const FlActionParams* a, int piece, float dt,
                                       float ax, float ay, float az, float* px, float* py, float* pz,
                                       float* vxs, float* vys, float* vzs) {
-  const FlXyz P = a->own.bounce.point, N = a->own.bounce.normal;
-  const float Px = P.x, Py = P.y, Pz = P.z, Nx = N.x, Ny = N.y, Nz = N.z;
+  const FlBounceParams b = a->own.bounce; /* read before the test, as above */
+  const FlReflect rf = fl_reflect_of(a);
+  const float Px = b.point.x, Py = b.point.y, Pz = b.point.z;
+  const float Nx = b.normal.x, Ny = b.normal.y, Nz = b.normal.z;
   float side, tau, hx, hy, hz;
   const int hit = fl_planar_accel_hit(*px, *py, *pz, *vxs, *vys, *vzs, ax, ay, az, dt, Px, Py, Pz,
                                       Nx, Ny, Nz, &side, &tau, &hx, &hy, &hz) &
-                  fl_bounce_on_piece(a, piece, hx, hy, hz);
+                  fl_on_piece(&b, piece, hx, hy, hz);
   if (!hit) return;
-  fl_planar_accel_bounce(fl_reflect_of(a), side, tau, hx, hy, hz, dt, ax, ay, az, Px, Py, Pz, Nx,
-                         Ny, Nz, px, py, pz, vxs, vys, vzs);
+  fl_planar_accel_bounce(rf, side, tau, hx, hy, hz, dt, ax, ay, az, Px, Py, Pz, Nx, Ny, Nz, px, py,
+                         pz, vxs, vys, vzs);
 }
 
 /* A sphere deflecting from outside (inside == 0) or keeping particles in: kernels/deflect.h,

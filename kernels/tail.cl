@@ -3,8 +3,10 @@
  * work-group). */
 
 /* Writes the newborns (sdk/src/emission.cpp, draw for draw): newborn r into slot n0 + r,
- * where it was born, and the part of the step it still has to live into tau[r] (the act
- * kernel runs it through the list for that time). Reads the state, writes none of it. */
+ * where it was born, and the part of the step it still has to live into tau[n0 + r], by slot
+ * as the lanes (the act kernel runs it through the list for that time; its work-items read
+ * tau[i] as they read the lanes, consecutively, which a CPU driver vectorises without
+ * touching memory outside the buffer). Reads the state, writes none of it. */
 FL_INLINE void fl_birth_body(uint gid, uint gsize, FL_LANE_PARAMS, __global float* tau,
                              __global const uint* state, uint births, uint capacity,
                              __global const uchar* tables, uint offEmitters, uint offTypes,
@@ -46,7 +48,7 @@ FL_INLINE void fl_birth_body(uint gid, uint gsize, FL_LANE_PARAMS, __global floa
                (fl_real_from_bits(run->s0) + (fl_real)q * fl_real_from_bits(run->spacing)) /
                fl_real_from_bits(run->span);
     const fl_real dtb = fl_real_from_bits(t1Bits) - tb;
-    tau[r] = (float)(dtb > 0 ? dtb : (fl_real)0);
+    tau[n0 + r] = (float)(dtb > 0 ? dtb : (fl_real)0);
     const float3 at = fl_emitter_at(em, keys, tb);
     const uint id = firstId + r;
     FlRandom rng = fl_random(seedLo, seedHi, id, salt, FL_STREAM_EMISSION);

@@ -490,6 +490,41 @@ TEST(OpenCLBackend, PoclCacheLivesInFlurrysCache) {
   EXPECT_EQ(std::filesystem::path(pocl), dir / "pocl");
 }
 
+// PoCL before 6 runs a kernel's work-items as vector lanes only with LLVM's SLP vectorizer
+// off (runtime.cpp, letPoclVectorizeWorkItems; without it every act kernel ran one particle
+// at a time): the first context on such a device turns it off, through the libLLVM the
+// driver loaded, and says so in the log; another driver, a later PoCL or FLURRY_POCL_SLP=1
+// leave LLVM as it is.
+TEST(OpenCLBackend, PoclBefore6RunsWorkItemsAsVectorLanes) {
+  const std::string why = test::openclUnavailable();
+  if (!why.empty()) GTEST_SKIP() << "OpenCL test skipped: " << why;
+  if (test::openclChecks() > 1)
+    GTEST_SKIP() << "an OpenCL context was made earlier in this process";
+  std::mutex m;
+  std::vector<std::string> said;
+  const LogCallback saved = setLogCallback([&](LogLevel, std::string_view s) {
+    std::lock_guard lock(m);
+    said.emplace_back(s);
+  });
+  {
+    Context ctx(openclOptions());
+    samples::buildFountain(ctx, 1000, 200, 2.0f);
+    ctx.run(2);
+  }
+  setLogCallback(saved);
+  const detail::ocl::Device d = detail::ocl::selectDevice("");
+  const bool pocl = d.info.platform.find("Portable Computing Language") != std::string::npos;
+  const bool before6 = pocl && d.cpu && std::atoi(d.info.driver.c_str()) < 6;
+  const char* keep = std::getenv("FLURRY_POCL_SLP");
+  const bool expected = before6 && !(keep && *keep && std::string(keep) != "0");
+  bool told = false;
+  for (const std::string& s : said) told |= s.find("SLP vectorizer is off") != std::string::npos;
+  EXPECT_EQ(detail::ocl::poclSlpOff(), expected)
+      << d.info.platform << " " << d.info.driver << " (FLURRY_POCL_SLP " << (keep ? keep : "unset")
+      << ")";
+  EXPECT_EQ(told, expected);
+}
+
 // An instance moved between steps: its emitter and floor follow it on the device as on the
 // CPU, and the move reaches the device as constants, with no program rebuilt.
 TEST(OpenCLBackend, InstanceTransformsMatchTheCpuWithoutARebuild) {

@@ -319,7 +319,7 @@ class ClGroup final : public DeviceMirror {
   AttributeSet laneSet_;
   bool allocated_ = false;
   Mem codes_, tileDead_, tileOff_, holes_, tailList_;
-  Mem tau_;  // per newborn of the step: the part of the step it still has to live
+  Mem tau_;  // per newborn of the step, by slot: the part of the step it still has to live
   GrowBuffer state_, params_, extra_, snap_, tables_;
   std::size_t tiles_ = 0;
 
@@ -433,7 +433,14 @@ void ClGroup::allocate(GroupImpl& g) {
     tileOff_ = make(tiles_ * 4);
     holes_ = make(g.capacity * 4);
     tailList_ = make(g.capacity * 4);
-    tau_ = make(g.capacity * 4);
+    // By slot, and as long as the act kernels' launches: a CPU driver's vector of work-items
+    // reads it whole (masked), past the live ones too. Written once whole, so that no such
+    // read meets a page not yet there (a masked-off lane on one costs an assist per vector).
+    const std::size_t tauBytes = roundUp(g.capacity, kActLocal) * 4;
+    tau_ = make(tauBytes);
+    const float zero = 0.0f;
+    check(clEnqueueFillBuffer(queue(), tau_.get(), &zero, 4, 0, tauBytes, 0, nullptr, nullptr),
+          "clEnqueueFillBuffer (scratch)");
   }
   lanes_ = std::move(lanes);
   laneSet_ = g.stored;

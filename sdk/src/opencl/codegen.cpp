@@ -768,29 +768,35 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   for (const auto& l : all)
     if (touched.has(l.attribute)) g.actLanes.push_back(l);
   // The per-particle part, shared by fl_act and fl_small. A newborn (i >= n0) runs the list
-  // for the part of the step it still has to live, from its birth time on.
+  // for the part of the step it still has to live (tau, by slot), from its birth time on.
   // With culling (cull, and velocities for the swept bounds) fl_act and fl_small hold
-  // barriers: every work-item runs the list, those past the live particles (fl_live == 0)
-  // on zeros, storing nothing. Without (or with no action that may be culled) the program
-  // has no trace of it.
+  // barriers; without (or with no action that may be culled) the program has no trace of it.
   bool cullable = false;
   for (std::size_t k = 0; k < acts.size(); ++k) {
     std::string unused;
     cullable |= placed[k] == 1 && culledCode(acts[k], k, unused);
   }
   g.culls = cull && cullable && stored.has(Attribute::Velocity);
-  const char* live = g.culls ? "fl_live && " : "";
+  // Every work-item runs the list, those past the live particles (fl_live == 0) on zeros,
+  // storing nothing: the actions' parameters are then read under no branch, and a CPU
+  // driver's loop over the work-items vectorises (a parameter read under `if (i < n)` became
+  // a gather per vector of work-items on PoCL). Not with a user's callback, which may write
+  // memory of its own, unless culling needs it (its pieces run only for live particles).
+  bool callback = false;
+  for (const Action& a : acts) callback |= std::holds_alternative<Callback>(a);
+  const bool everyone = g.culls || !callback;
+  const char* live = everyone ? "fl_live && " : "";
   std::ostringstream one;
   one << "  fl_real fl_len = fl_real_from_bits(dtBits), fl_t0 = t0;\n"
          "  if ("
       << live
-      << "i >= n0) {\n    const fl_real left = (fl_real)tau[i - n0];\n"
+      << "i >= n0) {\n    const fl_real left = (fl_real)tau[i];\n"
          "    fl_len = left;\n    fl_t0 = t1 - left;\n  }\n";
   for (const auto& l : g.actLanes) {
     const char* type = info(l.attribute).isUint ? "uint" : "float";
     if (!reads.has(l.attribute))
       one << "  " << type << " " << l.name << ";\n";
-    else if (g.culls)
+    else if (everyone)
       one << "  " << type << " " << l.name << " = fl_live ? l_" << l.name << "[i] : 0;\n";
     else
       one << "  " << type << " " << l.name << " = l_" << l.name << "[i];\n";
@@ -800,12 +806,12 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   one << (g.culls ? stepSource(cullingBody(acts, body.str(), marks, placed), sub,
                                g.substepsByDistance, stored, guarded)
                   : stepCode);
-  const char* ind = g.culls ? "    " : "  ";
-  if (g.culls) one << "  if (fl_live) {\n";
+  const char* ind = everyone ? "    " : "  ";
+  if (everyone) one << "  if (fl_live) {\n";
   for (const auto& l : g.actLanes)
     if (writes.has(l.attribute)) one << ind << "l_" << l.name << "[i] = " << l.name << ";\n";
   one << ind << "codes[i] = (uchar)dead;\n";
-  if (g.culls) one << "  }\n";
+  if (everyone) one << "  }\n";
   const char* actArgs =
       "__global uchar* restrict codes, __global const FlActionParams* restrict ap,\n"
       "    __global uint* state, __global const float* restrict extra,\n"
@@ -831,9 +837,10 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
        "    __global uint* state, __global const float* restrict extra,\n"
        "    __global const float* restrict snap, ulong dtBits, uint seedLo, uint seedHi,\n"
        "    uint fl_step, uint streamBase, uint nsubStep, uint snapStride,\n"
-       "    __global float* restrict tau, uint i, uint n0, uint n, uint snapN, fl_real t0,\n"
+       "    __global float* restrict tau, size_t i, uint n0, uint n, uint snapN, fl_real t0,\n"
        "    fl_real t1"
-    << (g.culls ? ", uint reachOff, uint fl_live, __local int* fl_red" : "") << hitArgs
+    << (everyone ? ", uint fl_live" : "") << (g.culls ? ", uint reachOff, __local int* fl_red" : "")
+    << hitArgs
     << ") {\n"
        "  (void)state; (void)extra; (void)snap; (void)snapN; (void)snapStride; (void)seedLo;\n"
        "  (void)seedHi; (void)fl_step; (void)n;\n"
@@ -844,7 +851,8 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   call +=
       "codes, ap, state, extra, snap, dtBits, seedLo, seedHi, fl_step, streamBase, nsubStep,\n"
       "      snapStride, tau, i, n0, n, snapN, t0, t1";
-  if (g.culls) call += ", reachOff, i < n, fl_red";
+  if (everyone) call += ", i < n";
+  if (g.culls) call += ", reachOff, fl_red";
   if (collisions) call += ", fl_hits, fl_hitRoom";
   call += ");\n";
   const std::string local = g.culls ? "  __local int fl_red[FL_CULL_LOCAL + " +
@@ -855,18 +863,20 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   s << "/* ---- generated: the fused act kernel */\n__kernel " << size << "void fl_act(";
   for (const auto& l : g.actLanes) s << laneDecl(l) << ", ";
   s << actArgs << hitArgs << ") {\n"
-    << local << actPrologue << "  const uint i = get_global_id(0);\n"
-    << (g.culls ? "" : "  if (i >= n) return;\n") << "  " << call << "}\n";
+    << local << actPrologue << "  const size_t i = get_global_id(0);\n"
+    << (everyone ? "" : "  if (i >= n) return;\n") << "  " << call << "}\n";
   // A small group's whole step in one launch of one work-group: births, act,
   // count-scan-list, tail. PoCL pays several microseconds per launch; this is one instead of
   // four.
   // Not for lists that read neighbours: their snapshot, copied before the act kernel, must
   // hold the newborns where they were born, so fl_birth runs before the copy.
   g.small = !g.substepsByDistance && !hair && !g.neighbours && !collisions;
-  // With culling, in whole passes of the work-group (n is the same for all): the barriers.
-  const std::string loop = g.culls
+  // In whole passes of the work-group (n is the same for all), each ending at a barrier: the
+  // culling's, or one of its own, so that PoCL's loop over the work-items is the innermost
+  // (the one it vectorises) rather than the loop over the passes.
+  const std::string loop = everyone
                                ? "  for (uint fl_first = 0u; fl_first < n; fl_first += lsize) {\n"
-                                 "    const uint i = fl_first + lid;\n    "
+                                 "    const size_t i = fl_first + get_local_id(0);\n    "
                                : "  for (uint i = lid; i < n; i += lsize) {\n    ";
   if (g.small)
     s << "/* ---- generated: a small group's step */\n__kernel " << size
@@ -883,6 +893,7 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
          "  barrier(CLK_GLOBAL_MEM_FENCE);\n"
          "  {\n"
       << actPrologue << loop << call
+      << (everyone && !g.culls ? "    barrier(CLK_LOCAL_MEM_FENCE);\n" : "")
       << "  }\n  }\n"
          "  barrier(CLK_GLOBAL_MEM_FENCE);\n"
          "  if (lid == 0u) fl_scan_list_body(codes, tileDead, tileOff, holes, tail, state, "

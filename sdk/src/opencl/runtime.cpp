@@ -1,6 +1,10 @@
 #include "runtime.hpp"
 
+#include <dlfcn.h>
+#include <link.h>
+
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <chrono>
 #include <cstdio>
@@ -13,6 +17,7 @@
 #include <vector>
 
 #include "flurry/io.hpp"
+#include "log.hpp"
 
 namespace flurry {
 
@@ -121,6 +126,69 @@ void placePoclCache() {
   });
 }
 
+// PoCL before 6.0 runs LLVM's SLP vectorizer over a kernel's code for one work-item before
+// it wraps the work-items in a loop (PoCL's "Do not vectorize before the WILoops", 6.0). The
+// short vectors it makes there (a point's y and z, a dot product's terms) are values the loop
+// vectorizer cannot widen, so it leaves the work-item loop scalar: every act kernel ran one
+// particle at a time, at a fifth of the CPU backend's speed. LLVM's options belong to the
+// process: through the libLLVM the PoCL driver loaded, the SLP vectorizer gets a cost
+// threshold nothing passes, and the loop vectorizer runs eight or sixteen work-items at once
+// (the arithmetic of each is unchanged: no contraction, no reassociation). Only for PoCL
+// before 6 on a CPU device (its CPU drivers are the ones that vectorize work-items);
+// FLURRY_POCL_SLP=1 leaves PoCL as it is. A process that compiles with the same libLLVM
+// otherwise (a software rasteriser's shaders) shares the setting.
+std::atomic<bool> gPoclSlpOff{false};
+
+void letPoclVectorizeWorkItems(const detail::ocl::Device& d) {
+  static std::once_flag once;
+  if (!d.cpu || d.info.platform.find("Portable Computing Language") == std::string::npos) return;
+  const std::string version = platformString(d.platform, CL_PLATFORM_VERSION);
+  const std::size_t at = version.find("PoCL ");
+  if (at == std::string::npos || std::atoi(version.c_str() + at + 5) >= 6) return;
+  if (const char* e = std::getenv("FLURRY_POCL_SLP"); e && *e && std::string(e) != "0") return;
+  // The platform's version names the LLVM it compiles with ("... LLVM 15.0.6, ...").
+  const std::size_t llvmAt = version.find("LLVM ");
+  if (llvmAt == std::string::npos) return;
+  const int llvmMajor = std::atoi(version.c_str() + llvmAt + 5);
+  if (llvmMajor <= 0) return;
+  std::call_once(once, [llvmMajor] {
+    // That libLLVM, as the driver loaded it (at clGetPlatformIDs): libLLVM-15.so.1 or
+    // libLLVM.so.18.1. Never another (a process may hold two), never a new one; none when the
+    // driver links LLVM statically.
+    struct Find {
+      std::string dash, dot, path;
+    } find{"libLLVM-" + std::to_string(llvmMajor) + ".so",
+           "libLLVM.so." + std::to_string(llvmMajor) + ".",
+           {}};
+    dl_iterate_phdr(
+        [](dl_phdr_info* info, std::size_t, void* data) {
+          auto& f = *static_cast<Find*>(data);
+          const std::string name = info->dlpi_name ? info->dlpi_name : "";
+          const std::string base = name.substr(name.find_last_of('/') + 1);
+          if (base.rfind(f.dash, 0) != 0 && base.rfind(f.dot, 0) != 0) return 0;
+          f.path = name;
+          return 1;
+        },
+        &find);
+    const std::string& path = find.path;
+    if (path.empty()) return;
+    void* llvm = dlopen(path.c_str(), RTLD_LAZY | RTLD_NOLOAD);
+    if (!llvm) return;
+    using Parse = void (*)(int, const char* const*, const char*);
+    if (auto parse = reinterpret_cast<Parse>(dlsym(llvm, "LLVMParseCommandLineOptions"))) {
+      // (an option given twice would end the process: once per process, and nothing else
+      // sets this one)
+      const char* argv[] = {"flurry", "-slp-threshold=1000000"};
+      parse(2, argv, nullptr);
+      gPoclSlpOff = true;
+      detail::log(LogLevel::Info,
+                  "opencl: PoCL before 6: its SLP vectorizer is off, so that work-items "
+                  "vectorize (FLURRY_POCL_SLP=1 keeps it)");
+    }
+    dlclose(llvm);
+  });
+}
+
 std::vector<cl_platform_id> platforms() {
   placePoclCache();
   cl_uint n = 0;
@@ -212,6 +280,10 @@ Device selectDevice(const std::string& want) {
   return devices.front();
 }
 
+bool poclSlpOff() {
+  return gPoclSlpOff;
+}
+
 std::string hashKey(const std::string& a, const std::string& b, const std::string& c) {
   std::uint64_t h = 1469598103934665603ull;
   for (const std::string* s : {&a, &b, &c}) {
@@ -249,6 +321,7 @@ double since(std::chrono::steady_clock::time_point t) {
 }  // namespace
 
 Runtime::Runtime(const Device& device) : device_(device) {
+  letPoclVectorizeWorkItems(device);  // before this device compiles anything
   cl_int err = CL_SUCCESS;
   const cl_context_properties props[] = {
       CL_CONTEXT_PLATFORM, reinterpret_cast<cl_context_properties>(device.platform), 0};

@@ -68,6 +68,10 @@ struct Device {
 /// there is no platform, no device, or none matching, saying which.
 Device selectDevice(const std::string& want);
 
+/// Whether this process turned LLVM's SLP vectorizer off for PoCL before 6, so that it
+/// vectorises a kernel's work-items (runtime.cpp); done by the first Runtime on such a device.
+bool poclSlpOff();
+
 struct CacheStats {
   std::uint64_t builds = 0;      ///< programs compiled from source
   std::uint64_t memoryHits = 0;  ///< programs found in this process's cache
