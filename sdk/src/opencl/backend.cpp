@@ -397,7 +397,9 @@ class ClGroup final : public DeviceMirror {
 
 void ClGroup::allocate(GroupImpl& g) {
   const auto& dev = shared_->runtime->device();
-  const std::size_t laneBytes = g.capacity * 4;
+  // As long as the act kernels' launches (whole work-groups): their work-items past the live
+  // particles load and store their slots too (codegen.cpp).
+  const std::size_t laneBytes = roundUp(g.capacity, kActLocal) * 4;
   if (laneBytes > dev.info.maxAllocation)
     throw OpenCLError(CL_INVALID_BUFFER_SIZE,
                       "OpenCL: group '" + g.name + "' of capacity " + std::to_string(g.capacity) +
@@ -412,7 +414,7 @@ void ClGroup::allocate(GroupImpl& g) {
     if (shared_->cpu()) {
       // PoCL on the CPU: buffers over memory we allocate (aligned, huge pages) run ~30 %
       // faster than ALLOC_HOST_PTR ones (PERF-NOTES); the device uses it in place.
-      l.host = LaneBuffer(g.capacity);
+      l.host = LaneBuffer(laneBytes / 4);
       l.mem = Mem(clCreateBuffer(context(), CL_MEM_READ_WRITE | CL_MEM_USE_HOST_PTR, laneBytes,
                                  l.host.data(), &err));
     } else {

@@ -777,11 +777,15 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
     cullable |= placed[k] == 1 && culledCode(acts[k], k, unused);
   }
   g.culls = cull && cullable && stored.has(Attribute::Velocity);
-  // Every work-item runs the list, those past the live particles (fl_live == 0) on zeros,
-  // storing nothing: the actions' parameters are then read under no branch, and a CPU
-  // driver's loop over the work-items vectorises (a parameter read under `if (i < n)` became
-  // a gather per vector of work-items on PoCL). Not with a user's callback, which may write
-  // memory of its own, unless culling needs it (its pieces run only for live particles).
+  // Every work-item runs the list, those past the live particles (fl_live == 0) on zeros:
+  // the actions' parameters are then read under no branch, and a CPU driver's loop over the
+  // work-items vectorises (a parameter read under `if (i < n)` became a gather per vector of
+  // work-items on PoCL). Every work-item loads and stores its slot, unmasked (the lanes are
+  // as long as the launches: allocate, backend.cpp): a masked vector store to memory out of
+  // the cache cost Zen 4 five times the whole scalar kernel; past the live particles the
+  // slots are free, and a birth writes every lane of its slot. Not with a user's callback,
+  // which may write memory of its own, unless culling needs it (its pieces run only for live
+  // particles).
   bool callback = false;
   for (const Action& a : acts) callback |= std::holds_alternative<Callback>(a);
   const bool everyone = g.culls || !callback;
@@ -797,7 +801,8 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
     if (!reads.has(l.attribute))
       one << "  " << type << " " << l.name << ";\n";
     else if (everyone)
-      one << "  " << type << " " << l.name << " = fl_live ? l_" << l.name << "[i] : 0;\n";
+      one << "  const " << type << " fl_in_" << l.name << " = l_" << l.name << "[i];\n  " << type
+          << " " << l.name << " = fl_live ? fl_in_" << l.name << " : 0;\n";
     else
       one << "  " << type << " " << l.name << " = l_" << l.name << "[i];\n";
   }
@@ -806,12 +811,9 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   one << (g.culls ? stepSource(cullingBody(acts, body.str(), marks, placed), sub,
                                g.substepsByDistance, stored, guarded)
                   : stepCode);
-  const char* ind = everyone ? "    " : "  ";
-  if (everyone) one << "  if (fl_live) {\n";
   for (const auto& l : g.actLanes)
-    if (writes.has(l.attribute)) one << ind << "l_" << l.name << "[i] = " << l.name << ";\n";
-  one << ind << "codes[i] = (uchar)dead;\n";
-  if (everyone) one << "  }\n";
+    if (writes.has(l.attribute)) one << "  l_" << l.name << "[i] = " << l.name << ";\n";
+  one << "  codes[i] = (uchar)dead;\n";
   const char* actArgs =
       "__global uchar* restrict codes, __global const FlActionParams* restrict ap,\n"
       "    __global uint* state, __global const float* restrict extra,\n"
