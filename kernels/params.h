@@ -307,6 +307,9 @@ typedef struct FlActionParams {
 
 /* Work-items per work-group of fl_act and fl_small (their culling reduces over it). */
 #define FL_ACT_LOCAL 256
+/* Particles each work-item of fl_small acts on (one after another, without culling): its one
+ * work-group covers FL_ACT_LOCAL * FL_SMALL_RUN, every particle of a group it steps. */
+#define FL_SMALL_RUN 16
 
 /* Spatial culling: per action, FL_REACH_FLOATS floats in the list's `extra` (from the
  * argument reachOff on): its reach box lo x y z, hi x y z, the box's max |coordinate| and the

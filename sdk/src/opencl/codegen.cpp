@@ -873,13 +873,22 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   // Not for lists that read neighbours: their snapshot, copied before the act kernel, must
   // hold the newborns where they were born, so fl_birth runs before the copy.
   g.small = !g.substepsByDistance && !hair && !g.neighbours && !collisions;
-  // In whole passes of the work-group (n is the same for all), each ending at a barrier: the
-  // culling's, or one of its own, so that PoCL's loop over the work-items is the innermost
-  // (the one it vectorises) rather than the loop over the passes.
-  const std::string loop = everyone
-                               ? "  for (uint fl_first = 0u; fl_first < n; fl_first += lsize) {\n"
-                                 "    const size_t i = fl_first + get_local_id(0);\n    "
-                               : "  for (uint i = lid; i < n; i += lsize) {\n    ";
+  // Without culling, each work-item takes a run of FL_SMALL_RUN particles in a loop PoCL's
+  // vectoriser takes as its innermost (as fl_act's loop over the work-items): no barrier, and
+  // the runs past n cost a branch. (A loop of passes over the work-group ending at a barrier
+  // gathered its slots: PoCL keeps a pass counter per work-item across the barrier, so the
+  // vectors of work-items it forms cannot see their slots are consecutive.) With culling, whose
+  // decisions are the work-group's, in passes each ending at the culling's barriers. Without
+  // everyone running (a callback), each work-item its particles, strided.
+  const std::string loop =
+      everyone && !g.culls ? "  const size_t fl_from = (size_t)lid * FL_SMALL_RUN;\n"
+                             "  if (fl_from < n)\n"
+                             "#pragma clang loop vectorize(assume_safety)\n"
+                             "  for (uint fl_k = 0u; fl_k < FL_SMALL_RUN; ++fl_k) {\n"
+                             "    const size_t i = fl_from + fl_k;\n    "
+      : everyone           ? "  for (uint fl_first = 0u; fl_first < n; fl_first += lsize) {\n"
+                             "    const size_t i = fl_first + get_local_id(0);\n    "
+                           : "  for (uint i = lid; i < n; i += lsize) {\n    ";
   if (g.small)
     s << "/* ---- generated: a small group's step */\n__kernel " << size
       << "void fl_small(FL_LANE_PARAMS, " << actArgs
@@ -895,7 +904,6 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
          "  barrier(CLK_GLOBAL_MEM_FENCE);\n"
          "  {\n"
       << actPrologue << loop << call
-      << (everyone && !g.culls ? "    barrier(CLK_LOCAL_MEM_FENCE);\n" : "")
       << "  }\n  }\n"
          "  barrier(CLK_GLOBAL_MEM_FENCE);\n"
          "  if (lid == 0u) fl_scan_list_body(codes, tileDead, tileOff, holes, tail, state, "
