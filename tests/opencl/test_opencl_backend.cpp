@@ -363,6 +363,33 @@ TEST(OpenCLBackend, HostLaneAccessDoesNotRebuildTheProgram) {
   EXPECT_GT(g.size(), 0u);
 }
 
+// A small group's one launch (fl_small) gives each work-item a run of particles on a CPU
+// device and strides the work-group over them on a GPU (backend.hpp SmallLayout): each is a
+// program of its own, and both step like the CPU backend, here on the device this machine
+// has. (A group of at most 4096 particles that records nothing takes fl_small.)
+TEST(OpenCLBackend, ASmallGroupStepsAlikeInEitherLayout) {
+  FLURRY_REQUIRE_OPENCL();
+  using detail::ocl::SmallLayout;
+  using namespace flurry::test;
+  const Build build =
+      withActions({Gravity{Vec3(0.0f, -9.81f, 0.0f)},
+                   Bounce{Domain::plane(Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f)), 0.4f, 0.1f, 0.0f},
+                   Move{}, KillOld{}},
+                  spray(Vec3(0.0f, 1.0f, 0.0f), 1500), 4000);
+  const RunResult cpu = runEffect(Backend::Cpu, build, 120);
+  EXPECT_GT(cpu.size, 2000u);  // several work-items' runs, and passes of the work-group
+  for (const SmallLayout layout : {SmallLayout::Runs, SmallLayout::Strided}) {
+    SCOPED_TRACE(layout == SmallLayout::Runs ? "runs" : "strided");
+    detail::ocl::setSmallLayout(layout);
+    const auto before = detail::ocl::Runtime::cacheStats();
+    const RunResult cl = runEffect(Backend::OpenCL, build, 120);
+    const auto after = detail::ocl::Runtime::cacheStats();
+    expectSame(cpu, cl);
+    EXPECT_EQ(after.memoryHits, before.memoryHits);  // not the other layout's program
+  }
+  detail::ocl::setSmallLayout(SmallLayout::ByDevice);
+}
+
 // fl_act and fl_small share one act function: the program holds the list's body once
 // (PoCL compiles less; issue #11).
 TEST(OpenCLBackend, TheActBodyIsInTheProgramOnce) {

@@ -19,6 +19,7 @@
 #include "backend.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstdio>
@@ -94,7 +95,13 @@ void moveKey(const ActionList& list, std::vector<std::uint32_t>& out) {
   }
 }
 
+std::atomic<SmallLayout> gSmallLayout{SmallLayout::ByDevice};  // setSmallLayout
+
 }  // namespace
+
+void setSmallLayout(SmallLayout layout) {
+  gSmallLayout = layout;
+}
 
 /// What every group of one Context shares: the device's runtime and a few in-order queues.
 /// A group's commands all go to one queue, in order; groups on different queues run side by
@@ -518,7 +525,11 @@ void ClGroup::buildProgram(GroupImpl& g, bool cull, bool hits) {
       generateProgram(g.actions, g.stored, shared_->fp64(), emissionSource(emitterCodes_.variants),
                       g.hair.enabled, cull, hits);
   emitterSignature_ = emitterSignature(emitterCodes_.variants);
-  Program p(shared_->runtime->program(gen.source, gen.options));
+  const SmallLayout layout = gSmallLayout;
+  const bool runs = layout == SmallLayout::Runs ||
+                    (layout == SmallLayout::ByDevice && shared_->runtime->device().cpu);
+  const std::string options = gen.options + (runs ? " -DFL_SMALL_RUNS" : "");
+  Program p(shared_->runtime->program(gen.source, options));
   cl_int err = CL_SUCCESS;
   auto kernel = [&](const char* name) {
     Kernel k(clCreateKernel(p.get(), name, &err));
@@ -552,7 +563,7 @@ void ClGroup::buildProgram(GroupImpl& g, bool cull, bool hits) {
   substepsByDistance_ = gen.substepsByDistance;
   programActions_ = g.actions;
   programSource_ = gen.source;
-  programOptions_ = gen.options;
+  programOptions_ = options;
   programCheckedStructure_ = g.actionsStructure;
   programCheckedVersion_ = g.actionsVersion;
   moveKey(g.actions, programMoveKey_);

@@ -14,4 +14,11 @@ void finishGroup(GroupImpl& group);
 /// these attributes (tests, docs, and reproducing a build failure outside Flurry).
 std::string programSource(const ActionList& actions, AttributeSet stored, bool fp64);
 
+/// How a small group's one launch (fl_small) lays its particles over its work-items: by the
+/// device (runs of FL_SMALL_RUN on a CPU, which vectorise there; strided on a GPU, side by
+/// side in memory), or either one on any device (tests: both layouts on the device they
+/// have). Programs built after the call follow it.
+enum class SmallLayout { ByDevice, Runs, Strided };
+void setSmallLayout(SmallLayout layout);
+
 }  // namespace flurry::detail::ocl

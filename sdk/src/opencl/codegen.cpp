@@ -873,19 +873,24 @@ GeneratedProgram generateProgram(const ActionList& actions, AttributeSet stored,
   // Not for lists that read neighbours: their snapshot, copied before the act kernel, must
   // hold the newborns where they were born, so fl_birth runs before the copy.
   g.small = !g.substepsByDistance && !hair && !g.neighbours && !collisions;
-  // Without culling, each work-item takes a run of FL_SMALL_RUN particles in a loop PoCL's
-  // vectoriser takes as its innermost (as fl_act's loop over the work-items): no barrier, and
-  // the runs past n cost a branch. (A loop of passes over the work-group ending at a barrier
-  // gathered its slots: PoCL keeps a pass counter per work-item across the barrier, so the
-  // vectors of work-items it forms cannot see their slots are consecutive.) With culling, whose
-  // decisions are the work-group's, in passes each ending at the culling's barriers. Without
-  // everyone running (a callback), each work-item its particles, strided.
+  // Without culling, on a CPU device (FL_SMALL_RUNS: backend.cpp), each work-item takes a
+  // run of FL_SMALL_RUN particles in a loop PoCL's vectoriser takes as its innermost (as
+  // fl_act's loop over the work-items), with no barrier. (Passes of the work-group each
+  // ending at a barrier gathered their slots: PoCL keeps a pass counter bounded by n per
+  // work-item across a barrier, so the vectors of work-items it forms cannot see that their
+  // slots are consecutive.) On a GPU the work-group strides over them, each pass's
+  // work-items side by side in memory. With culling, whose decisions are the work-group's,
+  // passes end at the culling's barriers. Without everyone running (a callback), strided.
   const std::string loop =
-      everyone && !g.culls ? "  const size_t fl_from = (size_t)lid * FL_SMALL_RUN;\n"
+      everyone && !g.culls ? "#ifdef FL_SMALL_RUNS\n"
+                             "  const size_t fl_from = (size_t)lid * FL_SMALL_RUN;\n"
                              "  if (fl_from < n)\n"
                              "#pragma clang loop vectorize(assume_safety)\n"
                              "  for (uint fl_k = 0u; fl_k < FL_SMALL_RUN; ++fl_k) {\n"
-                             "    const size_t i = fl_from + fl_k;\n    "
+                             "    const size_t i = fl_from + fl_k;\n"
+                             "#else\n"
+                             "  for (size_t i = lid; i < n; i += lsize) {\n"
+                             "#endif\n    "
       : everyone           ? "  for (uint fl_first = 0u; fl_first < n; fl_first += lsize) {\n"
                              "    const size_t i = fl_first + get_local_id(0);\n    "
                            : "  for (uint i = lid; i < n; i += lsize) {\n    ";
