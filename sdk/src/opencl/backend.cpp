@@ -48,10 +48,10 @@ static_assert(FL_TILE % 16 == 0);
 
 namespace {
 
-constexpr std::size_t kActLocal =
-    FL_ACT_LOCAL;                        // fixed: PoCL compiles once per (kernel, local size)
-constexpr std::size_t kSmallLocal = 64;  // count, list and tail
-constexpr std::size_t kMaxInFlight = 4;  // steps queued before the host waits for the oldest
+// fl_act's and fl_small's work-group, fixed: PoCL compiles once per (kernel, local size).
+constexpr std::size_t kActLocal = FL_ACT_LOCAL;
+constexpr std::size_t kSmallLocal = 64;         // count, list and tail
+constexpr std::size_t kMaxInFlight = 4;         // steps queued before the host waits for the oldest
 constexpr std::size_t kMaxFillItems = 1 << 12;  // PoCL pays ~1 us per work-group, even an idle one
 constexpr std::size_t kSmallTiles = 4;          // up to 4096 particles: count-scan-list in one item
 // fl_small's one work-group reaches every particle of a group it steps.
